@@ -1,0 +1,44 @@
+//! Detector descriptions: the TOML format, its evaluation and checks, and the resulting model.
+
+mod build;
+mod model;
+mod spec;
+
+use std::path::Path;
+
+pub use model::{
+    BoundaryKind, Contact, ContactPotential, Detector, Passive, PassiveKind, Region, Semiconductor,
+    World, WorldSide,
+};
+
+use crate::expr::Parameters;
+use crate::{Error, ImpuritySpec, Result};
+
+impl Detector {
+    /// Reads, evaluates and checks a detector file; `overrides` replace values of its
+    /// `[parameters]` (each must be declared there).
+    pub fn from_file(path: &Path, overrides: &Parameters) -> Result<Self> {
+        let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+            file: path.to_path_buf(),
+            source,
+        })?;
+        Self::from_toml_str(&text, path, overrides)
+    }
+
+    /// As [`Detector::from_file`] for text already in memory; `file` is used in messages.
+    pub fn from_toml_str(text: &str, file: &Path, overrides: &Parameters) -> Result<Self> {
+        let spec: spec::DetectorSpec = toml::from_str(text).map_err(|e| Error::parse(file, &e))?;
+        build::build(&spec, file, overrides)
+    }
+
+    /// Replaces the impurity model by the one in an impurity file.
+    pub fn set_impurity_file(&mut self, path: &Path) -> Result<()> {
+        let spec = ImpuritySpec::from_file(path)?;
+        self.set_impurity(&spec, path)
+    }
+
+    /// Replaces the impurity model by `spec`; `file` is where it came from (for messages).
+    pub fn set_impurity(&mut self, spec: &ImpuritySpec, file: &Path) -> Result<()> {
+        build::set_impurity(self, spec, file)
+    }
+}

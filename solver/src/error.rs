@@ -1,0 +1,90 @@
+//! The one error type of the solver crate.
+
+use std::path::PathBuf;
+
+/// Everything that can go wrong in the solver crate.
+///
+/// Every variant names where the problem is (the file and, where there is one, the key path inside
+/// it) so that the command line can print a message a user can act on.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// A file could not be read.
+    #[error("{}: cannot read the file: {source}", file.display())]
+    Io {
+        /// The file that was asked for.
+        file: PathBuf,
+        /// The operating system's reason.
+        #[source]
+        source: std::io::Error,
+    },
+    /// The TOML text is malformed or does not fit the schema (syntax error, unknown key,
+    /// missing key, wrong type). `message` is the parser's message with line and column.
+    #[error("{}: {message}", file.display())]
+    Parse {
+        /// The file being parsed.
+        file: PathBuf,
+        /// What the parser said, with line, column and key.
+        message: String,
+    },
+    /// A value is well-formed but physically or logically invalid.
+    #[error("{}: `{key}`: {message}", file.display())]
+    Invalid {
+        /// The file the value came from.
+        file: PathBuf,
+        /// Dotted key path of the offending value, e.g. `contacts[0].geometry.tube.r_mm`.
+        key: String,
+        /// What is wrong with it.
+        message: String,
+    },
+    /// Two contacts share space (or touch) in the r-z plane.
+    #[error(
+        "{}: contacts `{first}` and `{second}` overlap or touch near (r, z) = ({r_mm:.4}, {z_mm:.4}) mm",
+        file.display()
+    )]
+    Overlap {
+        /// The detector file.
+        file: PathBuf,
+        /// The first contact, as `id (name)`.
+        first: String,
+        /// The second contact, as `id (name)`.
+        second: String,
+        /// A point inside both, in mm.
+        r_mm: f64,
+        /// A point inside both, in mm.
+        z_mm: f64,
+    },
+    /// A value given on the command line or through the API (not from a file) is invalid.
+    #[error("`{name}`: {message}")]
+    Argument {
+        /// Name of the argument, e.g. `--param` or `r_mm`.
+        name: String,
+        /// What is wrong with it.
+        message: String,
+    },
+}
+
+/// Result alias of the solver crate.
+pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+impl Error {
+    /// Shorthand for [`Error::Invalid`].
+    pub fn invalid(
+        file: impl Into<PathBuf>,
+        key: impl Into<String>,
+        message: impl Into<String>,
+    ) -> Self {
+        Error::Invalid {
+            file: file.into(),
+            key: key.into(),
+            message: message.into(),
+        }
+    }
+
+    /// Shorthand for [`Error::Parse`] from a TOML deserialisation error.
+    pub fn parse(file: impl Into<PathBuf>, err: &toml::de::Error) -> Self {
+        Error::Parse {
+            file: file.into(),
+            message: err.to_string().trim_end().to_string(),
+        }
+    }
+}

@@ -1,0 +1,165 @@
+//! The open set of impurity-density models, and the two simple ones (constant, linear in z).
+
+/// What a model says at one point.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct PointDensity {
+    /// The model's y (paper Eq. (21)), for models parametrised in y.
+    pub y: Option<f64>,
+    /// x = T(y) (paper Eqs. (19), (20)), for models parametrised in y.
+    pub x: Option<f64>,
+    /// The signed impurity density in cm^-3 (positive: n-type).
+    pub zeta_cm3: f64,
+}
+
+/// A signed impurity density zeta(r, z) in cm^-3 (positive: n-type, paper Eqs. (12), (13)).
+pub trait ImpurityModel: std::fmt::Debug + Send + Sync {
+    /// Short name as in the TOML `model` key: "constant", "linear-z", "rz".
+    fn name(&self) -> &'static str;
+    /// Signed density in cm^-3 at (r, z) in mm.
+    fn density_cm3(&self, r_mm: f64, z_mm: f64) -> f64;
+    /// y, x (where the model has them) and zeta at (r, z).
+    fn evaluate(&self, r_mm: f64, z_mm: f64) -> PointDensity {
+        PointDensity {
+            y: None,
+            x: None,
+            zeta_cm3: self.density_cm3(r_mm, z_mm),
+        }
+    }
+}
+
+/// A density constant in space, zeta_c (the paper's sensitivity scan, Fig.
+/// "impurity_level_sensitivity").
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct ConstantModel {
+    /// The signed density in cm^-3.
+    pub zeta_cm3: f64,
+}
+
+impl ConstantModel {
+    /// A constant density; errors if it is not finite.
+    pub fn new(zeta_cm3: f64) -> Result<Self, String> {
+        if !zeta_cm3.is_finite() {
+            return Err(format!(
+                "the density must be a finite number, got {zeta_cm3}"
+            ));
+        }
+        Ok(ConstantModel { zeta_cm3 })
+    }
+}
+
+impl ImpurityModel for ConstantModel {
+    fn name(&self) -> &'static str {
+        "constant"
+    }
+
+    /// zeta(r, z) = zeta_c.
+    fn density_cm3(&self, _r_mm: f64, _z_mm: f64) -> f64 {
+        self.zeta_cm3
+    }
+}
+
+/// The manufacturer's model zeta_M(z), linear in z (paper Eq. (14)
+/// `eq:ManufacturerImpurityDensity`), independent of r.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct LinearZModel {
+    /// Signed density at z = z_bottom_mm, in cm^-3.
+    pub bottom_cm3: f64,
+    /// Signed density at z = z_top_mm, in cm^-3.
+    pub top_cm3: f64,
+    /// z of the crystal's bottom face in mm.
+    pub z_bottom_mm: f64,
+    /// z of the crystal's top face in mm.
+    pub z_top_mm: f64,
+}
+
+impl LinearZModel {
+    /// The linear model; errors unless all values are finite and z_top_mm > z_bottom_mm.
+    pub fn new(
+        bottom_cm3: f64,
+        top_cm3: f64,
+        z_bottom_mm: f64,
+        z_top_mm: f64,
+    ) -> Result<Self, String> {
+        for (name, value) in [
+            ("bottom_cm3", bottom_cm3),
+            ("top_cm3", top_cm3),
+            ("z_bottom_mm", z_bottom_mm),
+            ("z_top_mm", z_top_mm),
+        ] {
+            if !value.is_finite() {
+                return Err(format!("`{name}` must be a finite number, got {value}"));
+            }
+        }
+        if z_top_mm <= z_bottom_mm {
+            return Err(format!(
+                "the top z ({z_top_mm} mm) must be greater than the bottom z ({z_bottom_mm} mm)"
+            ));
+        }
+        Ok(LinearZModel {
+            bottom_cm3,
+            top_cm3,
+            z_bottom_mm,
+            z_top_mm,
+        })
+    }
+}
+
+impl ImpurityModel for LinearZModel {
+    fn name(&self) -> &'static str {
+        "linear-z"
+    }
+
+    /// zeta_M(z) = bottom + (top - bottom) (z - z_bottom) / (z_top - z_bottom) (paper Eq. (14),
+    /// where z_bottom = 0 and z_top - z_bottom = l_D); not clamped: it extrapolates outside.
+    fn density_cm3(&self, _r_mm: f64, z_mm: f64) -> f64 {
+        let fraction = (z_mm - self.z_bottom_mm) / (self.z_top_mm - self.z_bottom_mm);
+        self.bottom_cm3 + (self.top_cm3 - self.bottom_cm3) * fraction
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn constant() {
+        let m = ConstantModel::new(-3e9).unwrap();
+        assert_eq!(m.name(), "constant");
+        assert_eq!(m.density_cm3(1.0, 2.0), -3e9);
+        assert_eq!(
+            m.evaluate(0.0, 0.0),
+            PointDensity {
+                y: None,
+                x: None,
+                zeta_cm3: -3e9
+            }
+        );
+        assert!(ConstantModel::new(f64::NAN).is_err());
+        assert!(ConstantModel::new(f64::INFINITY).is_err());
+    }
+
+    #[test]
+    fn linear_z() {
+        let m = LinearZModel::new(1.3e10, 0.44e10, 0.0, 70.0).unwrap();
+        assert_eq!(m.name(), "linear-z");
+        assert_eq!(m.density_cm3(5.0, 0.0), 1.3e10);
+        assert!((m.density_cm3(0.0, 70.0) - 0.44e10).abs() < 1.0);
+        assert!((m.density_cm3(30.0, 35.0) - 0.87e10).abs() < 1.0);
+        // Not clamped outside [z_bottom, z_top].
+        assert!(m.density_cm3(0.0, -70.0) > 1.3e10);
+        assert_eq!(m.evaluate(0.0, 0.0).y, None);
+        assert!(LinearZModel::new(1.0, 1.0, 5.0, 5.0).is_err());
+        assert!(LinearZModel::new(1.0, 1.0, 5.0, 4.0).is_err());
+        assert!(LinearZModel::new(f64::NAN, 1.0, 0.0, 4.0).is_err());
+        assert!(LinearZModel::new(1.0, 1.0, 0.0, f64::INFINITY).is_err());
+    }
+
+    #[test]
+    fn models_are_object_safe() {
+        let models: Vec<Box<dyn ImpurityModel>> = vec![
+            Box::new(ConstantModel::new(1.0).unwrap()),
+            Box::new(LinearZModel::new(1.0, 2.0, 0.0, 1.0).unwrap()),
+        ];
+        assert_eq!(models[1].density_cm3(0.0, 0.5), 1.5);
+    }
+}

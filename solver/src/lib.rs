@@ -1,0 +1,30 @@
+//! # hpge-solver
+//!
+//! The physics of hpge-cv: detector descriptions (geometry, materials, contacts, passives, world),
+//! impurity-density models with their parameter transforms, and (from the field-solver issue on) the
+//! potential with depletion, weighting potentials and the capacitance matrix.
+//!
+//! Units at the interfaces: lengths in mm, potentials in V, impurity densities in cm^-3 (signed:
+//! positive is n-type), capacitances in pF. SI inside the numerics.
+
+mod detector;
+mod error;
+mod expr;
+mod geometry;
+mod impurity;
+mod material;
+
+pub mod constants;
+
+pub use detector::{
+    BoundaryKind, Contact, ContactPotential, Detector, Passive, PassiveKind, Region, Semiconductor,
+    World, WorldSide,
+};
+pub use error::{Error, Result};
+pub use expr::Parameters;
+pub use geometry::{BoundingBox, Solid};
+pub use impurity::{
+    ClampedNaturalSpline, ConstantModel, ImpurityContext, ImpurityModel, ImpuritySpec,
+    LinearZModel, LogTransform, ModelKind, PointDensity, RzModel,
+};
+pub use material::Material;

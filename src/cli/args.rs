@@ -1,0 +1,66 @@
+//! Value parsers for command-line arguments, and loading a detector from them.
+
+use anyhow::{Context, Result};
+use hpge_solver::{Detector, Parameters};
+
+use super::DetectorInput;
+
+/// Parses "R,Z" (mm) as given to `--at`.
+pub fn parse_point(text: &str) -> Result<(f64, f64), String> {
+    let (r, z) = text
+        .split_once(',')
+        .ok_or_else(|| format!("expected R,Z in mm (e.g. 20,35), got `{text}`"))?;
+    let num = |s: &str, what: &str| -> Result<f64, String> {
+        let v: f64 = s
+            .trim()
+            .parse()
+            .map_err(|_| format!("{what} `{}` in `{text}` is not a number", s.trim()))?;
+        if v.is_finite() {
+            Ok(v)
+        } else {
+            Err(format!("{what} in `{text}` must be finite"))
+        }
+    };
+    let r = num(r, "R")?;
+    let z = num(z, "Z")?;
+    if r < 0.0 {
+        return Err(format!(
+            "R must be >= 0 mm (r is the distance from the axis), got {r}"
+        ));
+    }
+    Ok((r, z))
+}
+
+/// Parses "NAME=VALUE" as given to `--param`.
+pub fn parse_param(text: &str) -> Result<(String, f64), String> {
+    Parameters::parse_assignment(text)
+}
+
+/// Loads the detector, applies parameter overrides and the impurity file.
+pub fn load_detector(input: &DetectorInput) -> Result<Detector> {
+    let mut overrides = Parameters::new();
+    for (k, v) in &input.params {
+        overrides.set(k.clone(), *v);
+    }
+    let mut det = Detector::from_file(&input.detector, &overrides)?;
+    if let Some(path) = &input.impurity {
+        det.set_impurity_file(path)
+            .with_context(|| format!("impurity model for {}", input.detector.display()))?;
+    }
+    Ok(det)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn points() {
+        assert_eq!(parse_point("20,35").unwrap(), (20.0, 35.0));
+        assert_eq!(parse_point(" 37.5 , -5 ").unwrap(), (37.5, -5.0));
+        assert!(parse_point("20").unwrap_err().contains("expected R,Z"));
+        assert!(parse_point("a,1").unwrap_err().contains("not a number"));
+        assert!(parse_point("-1,1").unwrap_err().contains("R must be >= 0"));
+        assert!(parse_point("1,nan").unwrap_err().contains("finite"));
+    }
+}

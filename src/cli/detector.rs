@@ -1,0 +1,138 @@
+//! `hpge-cv detector`: check a description, summarise it, draw its cross-section.
+
+use std::path::PathBuf;
+
+use anyhow::{Result, bail};
+use hpge_solver::{ContactPotential, Detector, WorldSide};
+use serde_json::json;
+
+use super::DetectorInput;
+use super::args::load_detector;
+use crate::plot;
+
+/// Loads and checks the detector, prints a summary (text or JSON) and writes the plots.
+pub fn run(input: &DetectorInput, plots: &[PathBuf], as_json: bool) -> Result<()> {
+    for p in plots {
+        if plot::Format::from_path(p).is_none() {
+            bail!(
+                "--plot {}: unknown file type; use a name ending in .svg or .png",
+                p.display()
+            );
+        }
+        if let Some(dir) = p.parent().filter(|d| !d.as_os_str().is_empty())
+            && !dir.is_dir()
+        {
+            bail!(
+                "--plot {}: the folder {} does not exist",
+                p.display(),
+                dir.display()
+            );
+        }
+    }
+    let det = load_detector(input)?;
+    for p in plots {
+        plot::cross_section(&det, p)?;
+        eprintln!("wrote {}", p.display());
+    }
+    if as_json {
+        println!("{}", summary_json(&det));
+    } else {
+        print_summary(&det);
+    }
+    Ok(())
+}
+
+fn potential(c: &ContactPotential) -> String {
+    match c {
+        ContactPotential::Bias => "bias".to_string(),
+        ContactPotential::Fixed(v) => format!("{v} V"),
+    }
+}
+
+fn print_summary(det: &Detector) {
+    let w = &det.world;
+    println!("detector  {} ({})", det.name, det.file.display());
+    if !det.parameters.is_empty() {
+        let p: Vec<String> = det
+            .parameters
+            .iter()
+            .map(|(k, v)| format!("{k} = {v}"))
+            .collect();
+        println!("parameters  {}", p.join(", "));
+    }
+    println!(
+        "world  r in [0, {}] mm, z in [{}, {}] mm, medium {} (eps_r {}); r_max {:?}, z_min {:?}, z_max {:?}",
+        w.r_max_mm,
+        w.z_min_mm,
+        w.z_max_mm,
+        w.medium.name,
+        w.medium.eps_r,
+        w.boundary(WorldSide::RMax),
+        w.boundary(WorldSide::ZMin),
+        w.boundary(WorldSide::ZMax)
+    );
+    let sc = &det.semiconductor;
+    let b = sc.geometry.bbox();
+    println!(
+        "semiconductor  {} ({}, eps_r {}), r in [{}, {}] mm, z in [{}, {}] mm",
+        sc.name,
+        sc.material.name,
+        sc.material.eps_r,
+        b.r_min_mm,
+        b.r_max_mm,
+        b.z_min_mm,
+        b.z_max_mm
+    );
+    println!(
+        "impurity  model \"{}\" from {}",
+        det.impurity().name(),
+        sc.impurity_file().display()
+    );
+    for c in &det.contacts {
+        let b = c.geometry.bbox();
+        println!(
+            "contact {}  {}: potential {}, {}, r in [{}, {}] mm, z in [{}, {}] mm",
+            c.id,
+            c.name,
+            potential(&c.potential),
+            if c.geometry.is_surface_only() {
+                "surface"
+            } else {
+                "volume"
+            },
+            b.r_min_mm,
+            b.r_max_mm,
+            b.z_min_mm,
+            b.z_max_mm
+        );
+    }
+    for p in &det.passives {
+        println!("passive  {}: {:?}, {}", p.name, p.kind, p.material.name);
+    }
+}
+
+fn summary_json(det: &Detector) -> serde_json::Value {
+    let sc = &det.semiconductor;
+    json!({
+        "name": det.name,
+        "file": det.file.display().to_string(),
+        "parameters": det.parameters.iter().collect::<std::collections::BTreeMap<_, _>>(),
+        "world": det.world,
+        "semiconductor": {
+            "name": sc.name,
+            "material": sc.material,
+            "bbox_mm": sc.geometry.bbox(),
+            "impurity_model": det.impurity().name(),
+            "impurity_file": sc.impurity_file().display().to_string(),
+        },
+        "contacts": det.contacts.iter().map(|c| json!({
+            "id": c.id, "name": c.name, "potential": potential(&c.potential),
+            "surface": c.geometry.is_surface_only(), "bbox_mm": c.geometry.bbox(),
+        })).collect::<Vec<_>>(),
+        "passives": det.passives.iter().map(|p| json!({
+            "name": p.name, "kind": p.kind, "material": p.material.name, "bbox_mm": p.geometry.bbox(),
+        })).collect::<Vec<_>>(),
+        "program": env!("CARGO_PKG_NAME"),
+        "version": env!("CARGO_PKG_VERSION"),
+    })
+}

@@ -1,0 +1,22 @@
+//! `hpge-cv`: impurity densities of HPGe detectors from capacitance-voltage curves.
+//!
+//! Every error is printed as one message naming the file, key or value at fault, and the program
+//! exits with code 2 (bad input); it never panics on user input.
+
+mod cli;
+mod plot;
+
+use std::process::ExitCode;
+
+use clap::Parser;
+
+fn main() -> ExitCode {
+    let args = cli::Cli::parse();
+    match cli::run(args) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(err) => {
+            eprintln!("error: {err:#}");
+            ExitCode::from(2)
+        }
+    }
+}

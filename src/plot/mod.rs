@@ -1,0 +1,28 @@
+//! Figures: SVG and PNG through plotters.
+
+mod colormap;
+mod cross_section;
+
+use std::path::Path;
+
+pub use cross_section::cross_section;
+
+/// Output format, chosen by the file extension.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Format {
+    /// Scalable vector graphics.
+    Svg,
+    /// Portable network graphics (bitmap).
+    Png,
+}
+
+impl Format {
+    /// `.svg` or `.png` (case-insensitive); anything else is `None`.
+    pub fn from_path(path: &Path) -> Option<Format> {
+        match path.extension()?.to_str()?.to_ascii_lowercase().as_str() {
+            "svg" => Some(Format::Svg),
+            "png" => Some(Format::Png),
+            _ => None,
+        }
+    }
+}

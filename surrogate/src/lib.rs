@@ -1,0 +1,11 @@
+//! # hpge-surrogate
+//!
+//! The machine-learning side of hpge-cv (paper, section 7): parameter spaces and their maps to the
+//! unit hypercube and to standard-normal coordinates, quasi-random (golden-sequence) sampling,
+//! training-set generation with the exact solver, the network (p_D -> c12) and its held-out
+//! accuracy. Filled in by the training-set and surrogate issues; this crate depends on
+//! `hpge-solver` only (data flows solver <- surrogate <- inference).
+
+mod error;
+
+pub use error::{Error, Result};

@@ -1,0 +1,330 @@
+//! Every kind of bad input gets one clear message naming the file, the key and the problem, and
+//! exit code 2; never a panic or a backtrace. One test per case (issue: foundation, item 5).
+
+use std::path::PathBuf;
+use std::process::Command;
+
+const DETECTOR: &str = r#"
+name = "test-coax"
+
+[parameters]
+inner_mm = 6.0
+
+[world]
+r_max_mm = 40.0
+z_min_mm = 0.0
+z_max_mm = 10.0
+
+[world.boundary]
+r_max = "grounded"
+z_min = "reflecting"
+z_max = "reflecting"
+
+[semiconductor]
+rz_knots_mm = [6.0, 16.0, 27.0, 37.5]
+geometry = { tube = { r_mm = ["inner_mm", 37.5], z_mm = [0.0, 10.0] } }
+
+[semiconductor.impurity]
+model = "constant"
+zeta_cm3 = 1.0e10
+
+[[contacts]]
+id = 1
+name = "n+"
+potential = "bias"
+geometry = { cylinder_surface = { r_mm = "inner_mm", z_mm = [0.0, 10.0] } }
+
+[[contacts]]
+id = 2
+name = "p+"
+potential = 0.0
+geometry = { cylinder_surface = { r_mm = 37.5, z_mm = [0.0, 10.0] } }
+"#;
+
+const RZ: &str = r#"
+model = "rz"
+knots_mm = [20.0, 28.0, 33.0, 37.5]
+y_bot = [0.70, 0.66, 0.60, 0.40]
+y_top = [0.60, 0.55, 0.50, 0.30]
+"#;
+
+fn write(name: &str, text: &str) -> PathBuf {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("bad_input");
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+/// Runs hpge-cv, asserts exit code 2 and no panic, returns stderr.
+fn fails(args: &[&str]) -> String {
+    let out = Command::new(env!("CARGO_BIN_EXE_hpge-cv"))
+        .args(args)
+        .env("RUST_BACKTRACE", "1")
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr).to_string();
+    assert_eq!(
+        out.status.code(),
+        Some(2),
+        "args {args:?}\nstderr: {stderr}"
+    );
+    assert!(!stderr.contains("panicked"), "panic: {stderr}");
+    assert!(!stderr.contains("stack backtrace"), "backtrace: {stderr}");
+    assert!(
+        stderr.starts_with("error:"),
+        "message should start with `error:`: {stderr}"
+    );
+    assert!(out.stdout.is_empty(), "nothing on stdout on error");
+    stderr
+}
+
+/// Checks a detector text that must be rejected; every needle must appear in the message.
+fn bad_detector(name: &str, text: &str, needles: &[&str]) {
+    let path = write(name, text);
+    let p = path.to_str().unwrap();
+    for cmd in [
+        vec!["detector", "--detector", p],
+        vec!["impurity", "--detector", p, "--at", "20,5"],
+    ] {
+        let msg = fails(&cmd);
+        assert!(
+            msg.contains(name),
+            "message must name the file {name}: {msg}"
+        );
+        for n in needles {
+            assert!(msg.contains(n), "message must contain `{n}`: {msg}");
+        }
+    }
+}
+
+/// Checks an impurity file that must be rejected.
+fn bad_impurity(name: &str, text: &str, needles: &[&str]) {
+    // Tests run in parallel: every test writes its own files.
+    let det = write(&format!("detector-for-{name}"), DETECTOR);
+    let path = write(name, text);
+    let msg = fails(&[
+        "impurity",
+        "--detector",
+        det.to_str().unwrap(),
+        "--impurity",
+        path.to_str().unwrap(),
+        "--at",
+        "20,5",
+        "--json",
+    ]);
+    assert!(
+        msg.contains(name),
+        "message must name the file {name}: {msg}"
+    );
+    for n in needles {
+        assert!(msg.contains(n), "message must contain `{n}`: {msg}");
+    }
+}
+
+#[test]
+fn the_base_files_are_good() {
+    let det = write("base-detector.toml", DETECTOR);
+    let imp = write("base-rz.toml", RZ);
+    let out = Command::new(env!("CARGO_BIN_EXE_hpge-cv"))
+        .args([
+            "impurity",
+            "--detector",
+            det.to_str().unwrap(),
+            "--impurity",
+        ])
+        .arg(&imp)
+        .args(["--at", "20,5", "--json"])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+#[test]
+fn syntax_error() {
+    let text = DETECTOR.replace("[world.boundary]", "[world.boundary");
+    bad_detector("syntax.toml", &text, &["TOML parse error", "line"]);
+}
+
+#[test]
+fn unknown_key() {
+    let text = DETECTOR.replace("name = \"p+\"", "name = \"p+\"\ncolour = \"red\"");
+    bad_detector("unknown-key.toml", &text, &["unknown field `colour`"]);
+}
+
+#[test]
+fn missing_field() {
+    let text = DETECTOR.replace("potential = 0.0\n", "");
+    bad_detector("missing.toml", &text, &["missing field `potential`"]);
+}
+
+#[test]
+fn negative_length() {
+    let text = DETECTOR.replace("r_max_mm = 40.0", "r_max_mm = -40.0");
+    bad_detector(
+        "negative.toml",
+        &text,
+        &["world.r_max_mm", "must be positive"],
+    );
+}
+
+#[test]
+fn zero_length() {
+    let text = DETECTOR.replace(
+        "z_mm = [0.0, 10.0] } }\n\n[semiconductor.impurity]",
+        "z_mm = [10.0, 10.0] } }\n\n[semiconductor.impurity]",
+    );
+    bad_detector(
+        "zero.toml",
+        &text,
+        &[
+            "semiconductor.geometry.tube.z_mm",
+            "zero or negative length",
+        ],
+    );
+}
+
+#[test]
+fn overlapping_contacts() {
+    let text = DETECTOR.replace(
+        "geometry = { cylinder_surface = { r_mm = 37.5, z_mm = [0.0, 10.0] } }",
+        "geometry = { tube = { r_mm = [5.0, 37.5], z_mm = [0.0, 10.0] } }",
+    );
+    bad_detector(
+        "overlap.toml",
+        &text,
+        &["contact 1 (n+)", "contact 2 (p+)", "overlap"],
+    );
+}
+
+#[test]
+fn contact_outside_world() {
+    let text = DETECTOR.replace(
+        "r_mm = 37.5, z_mm = [0.0, 10.0]",
+        "r_mm = 37.5, z_mm = [0.0, 12.0]",
+    );
+    bad_detector(
+        "outside.toml",
+        &text,
+        &["contacts[1].geometry", "outside the world"],
+    );
+}
+
+#[test]
+fn nan_in_detector() {
+    let text = DETECTOR.replace("z_max_mm = 10.0", "z_max_mm = nan");
+    bad_detector(
+        "nan.toml",
+        &text,
+        &["world.z_max_mm", "not a finite number"],
+    );
+}
+
+#[test]
+fn nan_in_impurity() {
+    bad_impurity(
+        "nan-imp.toml",
+        &RZ.replace("0.66, 0.60, 0.40]", "nan, 0.60, 0.40]"),
+        &["y_bot[1]"],
+    );
+}
+
+#[test]
+fn knots_not_increasing() {
+    bad_impurity(
+        "knots.toml",
+        &RZ.replace("[20.0, 28.0, 33.0, 37.5]", "[20.0, 28.0, 28.0, 37.5]"),
+        &["knots_mm", "increasing"],
+    );
+}
+
+#[test]
+fn y_outside_unit_interval() {
+    bad_impurity(
+        "y.toml",
+        &RZ.replace("[0.60, 0.55, 0.50, 0.30]", "[0.60, 1.5, 0.50, 0.30]"),
+        &["y_top[1]"],
+    );
+}
+
+#[test]
+fn density_outside_transform_range() {
+    let text = r#"
+model = "rz"
+zeta_bot_cm3 = [1.3e10, 1.3e10, 1.3e9, -0.44e10]
+zeta_top_cm3 = [0.44e10, 2e11, 0.44e9, -1.3e10]
+"#;
+    bad_impurity("range.toml", text, &["zeta_top_cm3[1]"]);
+}
+
+#[test]
+fn impurity_unknown_key_and_missing_model() {
+    bad_impurity(
+        "imp-unknown.toml",
+        &format!("{RZ}\nslope = 1.0\n"),
+        &["unknown field `slope`"],
+    );
+    bad_impurity(
+        "imp-missing.toml",
+        "zeta_cm3 = 1e10\n",
+        &["missing field `model`"],
+    );
+    bad_impurity(
+        "imp-wrong-model.toml",
+        "model = \"quadratic\"\nzeta_cm3 = 1e10\n",
+        &["unknown variant `quadratic`"],
+    );
+}
+
+#[test]
+fn unreadable_files() {
+    let msg = fails(&["detector", "--detector", "no/such/detector.toml"]);
+    assert!(
+        msg.contains("no/such/detector.toml") && msg.contains("cannot read"),
+        "{msg}"
+    );
+    let det = write("detector-for-unreadable.toml", DETECTOR);
+    let msg = fails(&[
+        "impurity",
+        "--detector",
+        det.to_str().unwrap(),
+        "--impurity",
+        "no/such/impurity.toml",
+        "--at",
+        "1,1",
+    ]);
+    assert!(msg.contains("no/such/impurity.toml"), "{msg}");
+}
+
+#[test]
+fn bad_arguments() {
+    let det = write("detector-for-arguments.toml", DETECTOR);
+    let d = det.to_str().unwrap();
+    let msg = fails(&["impurity", "--detector", d, "--at", "20"]);
+    assert!(msg.contains("--at") && msg.contains("R,Z"), "{msg}");
+    let msg = fails(&["impurity", "--detector", d, "--at", "-3,1"]);
+    assert!(msg.contains("R must be >= 0"), "{msg}");
+    let msg = fails(&[
+        "impurity",
+        "--detector",
+        d,
+        "--at",
+        "20,5",
+        "--param",
+        "d_li_mm=2",
+    ]);
+    assert!(msg.contains("declares no parameter `d_li_mm`"), "{msg}");
+    let msg = fails(&["detector", "--detector", d, "--param", "inner_mm=40"]);
+    assert!(msg.contains("semiconductor.geometry.tube.r_mm"), "{msg}");
+    let msg = fails(&["detector", "--detector", d, "--plot", "x.jpg"]);
+    assert!(
+        msg.contains("x.jpg") && msg.contains(".svg or .png"),
+        "{msg}"
+    );
+    let msg = fails(&["detector", "--detector", d, "--plot", "no/such/dir/x.png"]);
+    assert!(msg.contains("no/such/dir/x.png"), "{msg}");
+}

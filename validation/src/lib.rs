@@ -1,0 +1,19 @@
+//! # hpge-validation
+//!
+//! Problems with known answers, shared by tests, benches and reports: the long coax in closed form
+//! (DESIGN.md, "Analytic and reference checks"), and (with the solver issue) 1D high-precision
+//! references, planar cases and synthetic truths. The integration tests in `tests/` check the
+//! solver crate against them.
+
+mod coax;
+mod error;
+
+pub use coax::LongCoax;
+pub use error::{Error, Result};
+
+/// Absolute path of a file shipped in the repository (e.g. `detectors/coax-analytic.toml`).
+pub fn repo_path(relative: &str) -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("..")
+        .join(relative)
+}
