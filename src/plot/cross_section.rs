@@ -20,7 +20,7 @@ const MARGIN: u32 = 15;
 const Y_LABEL_W: u32 = 60;
 const X_LABEL_H: u32 = 50;
 /// Colour levels per sign of the impurity map in SVG files (keeps them small); PNG is continuous.
-const SVG_LEVELS: usize = 48;
+const SVG_LEVELS: usize = 32;
 
 const CONTACT_COLORS: [RGBColor; 5] = [
     RGBColor(44, 160, 44),
@@ -61,7 +61,18 @@ impl Layout {
         let s = (MAX_PLOT_W / w.r_max_mm).min(MAX_PLOT_H / dz);
         let plot_w = (s * w.r_max_mm).round().max(50.0) as u32;
         let plot_h = (s * dz).round().max(50.0) as u32;
-        let width = plot_w + Y_LABEL_W + 2 * MARGIN + PANEL_W;
+        // The legend panel grows with its longest line (about 8 px per character at 15 px).
+        let longest = det
+            .contacts
+            .iter()
+            .map(|c| c.name.len() + 30)
+            .chain(det.passives.iter().map(|p| p.name.len() + 30))
+            .chain([det.semiconductor.name.len() + 50])
+            .chain(det.world.labels.iter().flatten().map(|l| l.len() + 40))
+            .max()
+            .unwrap_or(0) as u32;
+        let panel_w = PANEL_W.max(70 + 8 * longest);
+        let width = plot_w + Y_LABEL_W + 2 * MARGIN + panel_w;
         let height = (TITLE_H + plot_h + X_LABEL_H + 2 * MARGIN).max(760);
         Layout {
             plot_w,
@@ -86,7 +97,7 @@ pub fn cross_section(det: &Detector, path: &Path) -> Result<()> {
                 .with_context(ctx)?;
         }
         Some(Format::Svg) => {
-            let cell = (layout.plot_h / 300).max(1);
+            let cell = (layout.plot_h / 450).max(1);
             let root = SVGBackend::new(path, size).into_drawing_area();
             draw(&root, det, &layout, cell, SVG_LEVELS).with_context(ctx)?;
             root.present()
@@ -259,7 +270,12 @@ fn draw_title<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, det: &Detector)
         .iter()
         .map(|(k, v)| format!("{k} = {v}"))
         .collect();
-    let line1 = format!("{}: r-z cross-section (axisymmetric)", det.name);
+    let line1 = format!(
+        "{}: r-z cross-section (axisymmetric)   [{} {}]",
+        det.name,
+        env!("CARGO_PKG_NAME"),
+        env!("CARGO_PKG_VERSION")
+    );
     let line2 = format!(
         "impurity model \"{}\" ({}){}",
         det.impurity().name(),
@@ -354,7 +370,7 @@ fn draw_panel<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, det: &Detector)
     entries.push((
         RGBColor(240, 240, 240),
         format!(
-            "{} ({}, eps_r {})",
+            "{} ({}, eps_r {}): colour = impurity density",
             det.semiconductor.name,
             det.semiconductor.material.name,
             det.semiconductor.material.eps_r

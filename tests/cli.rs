@@ -1,0 +1,105 @@
+//! The command line as a user runs it: help, JSON output, plots.
+
+use std::process::Command;
+
+fn hpge_cv(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_hpge-cv"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+#[test]
+fn help_lists_the_subcommands() {
+    let out = hpge_cv(&["--help"]);
+    assert!(out.status.success());
+    let text = String::from_utf8_lossy(&out.stdout);
+    for sub in ["impurity", "detector"] {
+        assert!(text.contains(sub), "{text}");
+    }
+}
+
+/// Acceptance: the paper's p_zeta,E at the four corners, exactly one JSON object on stdout.
+#[test]
+fn impurity_json_paper_example() {
+    let out = hpge_cv(&[
+        "impurity",
+        "--detector",
+        "detectors/super-siegfried-k1.toml",
+        "--impurity",
+        "detectors/impurities/paper-example-rz.toml",
+        "--at",
+        "20,0",
+        "--at",
+        "37.5,0",
+        "--at",
+        "20,70",
+        "--at",
+        "37.5,70",
+        "--json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("one JSON object");
+    let pts = v["points"].as_array().unwrap();
+    let want = [1.30e10, -0.44e10, 0.44e10, -1.30e10];
+    assert_eq!(pts.len(), 4);
+    for (p, w) in pts.iter().zip(want) {
+        let z = p["zeta_cm3"].as_f64().unwrap();
+        assert!(((z - w) / w).abs() < 1e-6, "{z} vs {w}");
+        assert!(p["y"].as_f64().unwrap().abs() <= 1.0);
+        assert!(p["x"].is_number());
+        assert!(p["r_mm"].is_number() && p["z_mm"].is_number());
+    }
+    assert_eq!(v["version"], env!("CARGO_PKG_VERSION"));
+}
+
+#[test]
+fn impurity_json_has_null_y_for_models_without_one() {
+    let out = hpge_cv(&[
+        "impurity",
+        "--detector",
+        "detectors/super-siegfried-k1.toml",
+        "--at",
+        "20,0",
+        "--json",
+    ]);
+    assert!(out.status.success());
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert!(v["points"][0]["y"].is_null() && v["points"][0]["x"].is_null());
+    assert_eq!(v["points"][0]["zeta_cm3"].as_f64().unwrap(), 1.30e10);
+}
+
+#[test]
+fn detector_plots_and_summary() {
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("cli_plots");
+    std::fs::create_dir_all(&dir).unwrap();
+    let png = dir.join("ppc.png");
+    let svg = dir.join("ppc.svg");
+    let out = hpge_cv(&[
+        "detector",
+        "--detector",
+        "detectors/ppc-example.toml",
+        "--plot",
+        png.to_str().unwrap(),
+        "--plot",
+        svg.to_str().unwrap(),
+        "--json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["name"], "ppc-example");
+    assert_eq!(v["contacts"].as_array().unwrap().len(), 2);
+    let bytes = std::fs::read(&png).unwrap();
+    assert_eq!(&bytes[..4], b"\x89PNG");
+    let text = std::fs::read_to_string(&svg).unwrap();
+    assert!(text.starts_with("<svg") && text.contains("impurity density"));
+}
