@@ -366,4 +366,22 @@ mod tests {
         assert!(Parameters::parse_assignment("x=abc").is_err());
         assert!(Parameters::parse_assignment("x=nan").is_err());
     }
+
+    mod properties {
+        use super::*;
+        use proptest::prelude::*;
+
+        proptest! {
+            #![proptest_config(ProptestConfig { cases: 256, failure_persistence: None, ..ProptestConfig::default() })]
+
+            /// Printing numbers into an expression and evaluating it is exact IEEE arithmetic.
+            #[test]
+            fn printed_arithmetic_round_trips(a in -1e6..1e6f64, b in -1e6..1e6f64, c in 0.5..100.0f64) {
+                let mut p = Parameters::new();
+                p.set("c_mm", c);
+                let text = format!("({a:e}) + ({b:e}) * c_mm - -({a:e}) / c_mm");
+                prop_assert_eq!(eval_expr(&text, &p).unwrap(), a + b * c - -a / c);
+            }
+        }
+    }
 }

@@ -51,22 +51,12 @@ mod tests {
     use super::super::Primitive;
     use super::*;
 
-    fn tube(r0: f64, r1: f64, z0: f64, z1: f64) -> Solid {
-        Solid::Primitive(Primitive::Tube {
-            r_in_mm: r0,
-            r_out_mm: r1,
-            z_min_mm: z0,
-            z_max_mm: z1,
-            round_outer_mm: 0.0,
-        })
-    }
-
     #[test]
     fn overlap_touch_and_separation() {
-        let a = tube(0.0, 2.0, 0.0, 2.0);
-        let b = tube(1.0, 3.0, 1.0, 3.0);
-        let c = tube(2.0, 3.0, 0.0, 1.0);
-        let d = tube(5.0, 6.0, 0.0, 1.0);
+        let a = Solid::tube(0.0, 2.0, 0.0, 2.0);
+        let b = Solid::tube(1.0, 3.0, 1.0, 3.0);
+        let c = Solid::tube(2.0, 3.0, 0.0, 1.0);
+        let d = Solid::tube(5.0, 6.0, 0.0, 1.0);
         assert!(common_point(&a, &b, -1e-6, -1e-6).is_some());
         // c touches a along r = 2 but does not overlap it.
         assert!(common_point(&a, &c, 1e-9, 1e-9).is_some());

@@ -25,6 +25,17 @@ pub enum Solid {
 }
 
 impl Solid {
+    /// A sharp-cornered tube r in [r_in, r_out], z in [z_min, z_max] (mm), the commonest solid.
+    pub fn tube(r_in_mm: f64, r_out_mm: f64, z_min_mm: f64, z_max_mm: f64) -> Self {
+        Solid::Primitive(Primitive::Tube {
+            r_in_mm,
+            r_out_mm,
+            z_min_mm,
+            z_max_mm,
+            round_outer_mm: 0.0,
+        })
+    }
+
     /// Membership of (r, z) (mm) in the closed solid grown by `tol` mm (shrunk when negative).
     pub fn contains(&self, r_mm: f64, z_mm: f64, tol: f64) -> bool {
         match self {
@@ -113,21 +124,11 @@ pub(crate) fn sorted_unique(mut v: Vec<f64>) -> Vec<f64> {
 mod tests {
     use super::*;
 
-    fn tube(r0: f64, r1: f64, z0: f64, z1: f64) -> Solid {
-        Solid::Primitive(Primitive::Tube {
-            r_in_mm: r0,
-            r_out_mm: r1,
-            z_min_mm: z0,
-            z_max_mm: z1,
-            round_outer_mm: 0.0,
-        })
-    }
-
     #[test]
     fn coax_with_borehole() {
         let crystal = Solid::Difference {
-            base: Box::new(tube(0.0, 37.5, 0.0, 70.0)),
-            minus: vec![tube(0.0, 5.0, 0.0, 70.0)],
+            base: Box::new(Solid::tube(0.0, 37.5, 0.0, 70.0)),
+            minus: vec![Solid::tube(0.0, 5.0, 0.0, 70.0)],
         };
         assert!(crystal.contains(20.0, 35.0, 0.0));
         assert!(!crystal.contains(2.0, 35.0, 0.0));
@@ -142,10 +143,16 @@ mod tests {
 
     #[test]
     fn union_intersection_surfaces() {
-        let u = Solid::Union(vec![tube(0.0, 1.0, 0.0, 1.0), tube(2.0, 3.0, 0.0, 1.0)]);
+        let u = Solid::Union(vec![
+            Solid::tube(0.0, 1.0, 0.0, 1.0),
+            Solid::tube(2.0, 3.0, 0.0, 1.0),
+        ]);
         assert!(u.contains(0.5, 0.5, 0.0) && u.contains(2.5, 0.5, 0.0));
         assert!(!u.contains(1.5, 0.5, 0.0));
-        let i = Solid::Intersection(vec![tube(0.0, 2.0, 0.0, 2.0), tube(1.0, 3.0, 1.0, 3.0)]);
+        let i = Solid::Intersection(vec![
+            Solid::tube(0.0, 2.0, 0.0, 2.0),
+            Solid::tube(1.0, 3.0, 1.0, 3.0),
+        ]);
         assert!(i.contains(1.5, 1.5, 0.0) && !i.contains(0.5, 0.5, 0.0));
         assert_eq!(i.bbox(), BoundingBox::new(1.0, 2.0, 1.0, 2.0));
         let s = Solid::Primitive(Primitive::CylinderSurface {
@@ -155,5 +162,44 @@ mod tests {
         assert!(s.is_surface_only());
         assert!(!u.is_surface_only());
         assert_eq!(s.surface_segments().len(), 1);
+    }
+
+    mod properties {
+        use super::*;
+        use proptest::prelude::*;
+
+        fn arb_tube() -> impl Strategy<Value = Solid> {
+            (0.0..20.0f64, 0.1..20.0f64, -20.0..20.0f64, 0.1..20.0f64)
+                .prop_map(|(r0, dr, z0, dz)| Solid::tube(r0, r0 + dr, z0, z0 + dz))
+        }
+
+        proptest! {
+            #![proptest_config(ProptestConfig { cases: 256, failure_persistence: None, ..ProptestConfig::default() })]
+
+            /// Set algebra: a difference lies in its base and outside the cut's interior; a union
+            /// holds each part; an intersection lies in each part; bounding boxes hold the sets.
+            #[test]
+            fn csg_set_algebra(a in arb_tube(), b in arb_tube(), r in 0.0..45.0f64, z in -25.0..45.0f64) {
+                let diff = Solid::Difference { base: Box::new(a.clone()), minus: vec![b.clone()] };
+                let uni = Solid::Union(vec![a.clone(), b.clone()]);
+                let inter = Solid::Intersection(vec![a.clone(), b.clone()]);
+                let tol = 1e-9;
+                if diff.contains(r, z, tol) {
+                    prop_assert!(a.contains(r, z, tol));
+                    prop_assert!(!b.contains(r, z, -tol));
+                }
+                prop_assert_eq!(uni.contains(r, z, tol), a.contains(r, z, tol) || b.contains(r, z, tol));
+                prop_assert_eq!(inter.contains(r, z, tol), a.contains(r, z, tol) && b.contains(r, z, tol));
+                for s in [&diff, &uni, &inter] {
+                    if s.contains(r, z, 0.0) {
+                        let bb = s.bbox();
+                        prop_assert!(r >= bb.r_min_mm && r <= bb.r_max_mm && z >= bb.z_min_mm && z <= bb.z_max_mm);
+                    }
+                }
+                // Shrinking never adds points, growing never removes them.
+                prop_assert!(!diff.contains(r, z, -1e-6) || diff.contains(r, z, 0.0));
+                prop_assert!(!uni.contains(r, z, 0.0) || uni.contains(r, z, 1e-6));
+            }
+        }
     }
 }
