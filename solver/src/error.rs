@@ -53,6 +53,34 @@ pub enum Error {
         /// A point inside both, in mm.
         z_mm: f64,
     },
+    /// An iterative field solve did not converge (a caller may treat the point as rejected).
+    #[error(
+        "the {method} solver did not converge after {iterations} iterations (residual {residual_v:e} V)"
+    )]
+    NotConverged {
+        /// Method name.
+        method: &'static str,
+        /// Iterations done.
+        iterations: usize,
+        /// Projected residual at the end, V (NaN if not computed).
+        residual_v: f64,
+    },
+    /// The discrete field problem has no unique solution (e.g. a region with no fixed potential).
+    #[error("the field problem is singular: {reason}")]
+    Singular {
+        /// What went wrong.
+        reason: String,
+    },
+    /// An undepleted region connects two conductors at different potentials (shorted contacts).
+    #[error("at U_B = {bias_v} V an undepleted region connects {first} and {second}")]
+    UndepletedBridge {
+        /// One conductor.
+        first: String,
+        /// The other.
+        second: String,
+        /// Bias, V.
+        bias_v: f64,
+    },
     /// A value given on the command line or through the API (not from a file) is invalid.
     #[error("`{name}`: {message}")]
     Argument {

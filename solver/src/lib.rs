@@ -10,7 +10,9 @@
 mod detector;
 mod error;
 mod expr;
+mod field;
 mod geometry;
+mod grid;
 mod impurity;
 mod material;
 
@@ -22,7 +24,12 @@ pub use detector::{
 };
 pub use error::{Error, Result};
 pub use expr::Parameters;
-pub use geometry::{BoundingBox, Solid};
+pub use field::{
+    CapacitanceMatrix, FieldSettings, Mesh, Method, NodeKind, PointResult, PotentialSolution,
+    SolveReport, Termination, WeightingPotentials, solve_fast, solve_point, weighting_potentials,
+};
+pub use geometry::{BoundingBox, Primitive, Solid};
+pub use grid::{Grid, GridSettings};
 pub use impurity::{
     ClampedNaturalSpline, ConstantModel, ImpurityContext, ImpurityModel, ImpuritySpec,
     LinearZModel, LogTransform, ModelKind, PointDensity, RzModel,

@@ -246,6 +246,21 @@ impl Detector {
         }
     }
 
+    /// Relative permittivity at (r, z) mm ignoring conductors, and whether the point is in the
+    /// semiconductor: the material a grid cell is filled with (conductor cells take what is
+    /// around them; their nodes are fixed anyway).
+    pub fn dielectric_at(&self, r_mm: f64, z_mm: f64) -> (f64, bool) {
+        if self.semiconductor.geometry.contains(r_mm, z_mm, 0.0) {
+            return (self.semiconductor.material.eps_r, true);
+        }
+        let eps = self
+            .passives
+            .iter()
+            .find(|p| p.kind == PassiveKind::Dielectric && p.geometry.contains(r_mm, z_mm, 0.0))
+            .map_or(self.world.medium.eps_r, |p| p.material.eps_r);
+        (eps, false)
+    }
+
     /// Every edge coordinate of every part plus the world box: the ticks a field grid must
     /// carry (r ticks, z ticks; sorted, unique, mm, clipped to the world).
     pub fn ticks(&self) -> (Vec<f64>, Vec<f64>) {

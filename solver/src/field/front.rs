@@ -1,0 +1,116 @@
+//! Sub-cell location of the depletion front, carried into the weighting potentials.
+//!
+//! The discrete obstacle problem places the free boundary on nodes, which makes c12's error
+//! O(h / depleted depth) and the C-V curve step-like. Next to the front the potential of the
+//! depleted side behaves like phi = B - a (x - x_f)^2 (B the bound, the field vanishes at the
+//! front), so sqrt|B - phi| is linear in x: two depleted nodes q1, q2 beyond the last undepleted
+//! node p give the front x_f by linear extrapolation to zero. In the weighting problem the
+//! conductor (the undepleted region) then ends at x_f instead of at p: the conductance of edge
+//! p-q1 becomes that of the gap [x_f, x_q1],
+//!   axial: w' = w |z_q1 - z_p| / |z_q1 - z_f|,
+//!   radial: w' = w ln(r_q1 / r_p) / ln(r_q1 / r_f)   (log conductance, same sign convention),
+//! with x_f clamped to lie between half a spacing behind p and a tenth of a spacing before q1.
+
+use super::mesh::{Mesh, NodeKind};
+
+const OFF: isize = 2;
+
+/// A copy of `mesh` whose edge conductances across the depletion front are corrected for the
+/// sub-cell front position. Returns the corrected mesh and the number of edges corrected.
+pub(crate) fn front_corrected(
+    mesh: &Mesh,
+    phi_v: &[f64],
+    undepleted: &[bool],
+    bounds_v: (f64, f64),
+) -> (Mesh, usize) {
+    let mut out = mesh.clone();
+    let g = &mesh.grid;
+    let (nr, nz) = (g.nr(), g.nz());
+    let r = g.r_mm();
+    let z = g.z_mm();
+    let semi = |n: usize| mesh.kind[n] == NodeKind::Semiconductor;
+    let depleted = |n: usize| semi(n) && !undepleted[n];
+    let bound_of = |n: usize| {
+        if (phi_v[n] - bounds_v.1).abs() <= (phi_v[n] - bounds_v.0).abs() {
+            bounds_v.1
+        } else {
+            bounds_v.0
+        }
+    };
+    // Front position along a line: coordinates x_p, x_1, x_2 and potentials at q1, q2.
+    let front = |b: f64, xp: f64, x1: f64, x2: f64, p1: f64, p2: f64| -> Option<f64> {
+        let (d1, d2) = ((b - p1).abs().sqrt(), (b - p2).abs().sqrt());
+        if !(d2 > d1 && d1 > 0.0) {
+            return None;
+        }
+        let xf = x1 - d1 * (x2 - x1) / (d2 - d1);
+        let h = x1 - xp;
+        // Between half a spacing behind p and a tenth of a spacing before q1 (h may be negative).
+        let lo = xp - 0.5 * h;
+        let hi = x1 - 0.1 * h;
+        let (a, c) = if lo < hi { (lo, hi) } else { (hi, lo) };
+        Some(xf.clamp(a, c))
+    };
+    let mut count = 0;
+    for j in 0..nz {
+        for i in 0..nr {
+            let p = j * nr + i;
+            if !(semi(p) && undepleted[p]) {
+                continue;
+            }
+            let b = bound_of(p);
+            // Radial neighbours: direction +1 and -1.
+            for dir in [1isize, -1] {
+                let i1 = i as isize + dir;
+                let i2 = i as isize + OFF * dir;
+                let i3 = i as isize + (OFF + 1) * dir;
+                if i3 < 0 || i3 >= nr as isize {
+                    continue;
+                }
+                let (i1, i2, i3) = (i1 as usize, i2 as usize, i3 as usize);
+                let (q1, q2, q3) = (j * nr + i1, j * nr + i2, j * nr + i3);
+                if !(depleted(q1) && depleted(q2) && depleted(q3)) {
+                    continue;
+                }
+                let Some(rf) = front(b, r[i], r[i2], r[i3], phi_v[q2], phi_v[q3]) else {
+                    continue;
+                };
+                let e = j * (nr - 1) + i.min(i1);
+                let (rp, r1) = (r[i], r[i1]);
+                let scale = if rp > 0.0 && rf > 0.0 && r1 > 0.0 {
+                    (r1 / rp).ln() / (r1 / rf).ln()
+                } else {
+                    (r1 - rp) / (r1 - rf)
+                };
+                if scale.is_finite() && scale > 0.0 {
+                    out.w_r[e] = mesh.w_r[e] * scale;
+                    count += 1;
+                }
+            }
+            // Axial neighbours.
+            for dir in [1isize, -1] {
+                let j1 = j as isize + dir;
+                let j2 = j as isize + OFF * dir;
+                let j3 = j as isize + (OFF + 1) * dir;
+                if j3 < 0 || j3 >= nz as isize {
+                    continue;
+                }
+                let (j1, j2, j3) = (j1 as usize, j2 as usize, j3 as usize);
+                let (q1, q2, q3) = (j1 * nr + i, j2 * nr + i, j3 * nr + i);
+                if !(depleted(q1) && depleted(q2) && depleted(q3)) {
+                    continue;
+                }
+                let Some(zf) = front(b, z[j], z[j2], z[j3], phi_v[q2], phi_v[q3]) else {
+                    continue;
+                };
+                let e = j.min(j1) * nr + i;
+                let scale = (z[j1] - z[j]) / (z[j1] - zf);
+                if scale.is_finite() && scale > 0.0 {
+                    out.w_z[e] = mesh.w_z[e] * scale;
+                    count += 1;
+                }
+            }
+        }
+    }
+    (out, count)
+}

@@ -1,0 +1,185 @@
+//! One bias point: grid refinement, potential with depletion, weighting potentials, C*.
+
+use serde::{Deserialize, Serialize};
+
+use super::capacitance::CapacitanceMatrix;
+use super::depletion::{PotentialSolution, solve_fast};
+use super::mesh::{Mesh, NodeKind};
+use super::report::{Method, SolveReport};
+use super::weighting::{WeightingPotentials, weighting_potentials};
+use crate::grid::{Grid, GridSettings};
+use crate::{Detector, Error, Result};
+
+/// Settings of a field calculation.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct FieldSettings {
+    /// Grid construction and refinement.
+    pub grid: GridSettings,
+    /// Potential method.
+    pub method: Method,
+    /// Locate the depletion front inside its cell and carry it into the weighting potentials
+    /// (see `field/front.rs`); off: the front sits on nodes, as in SolidStateDetectors.jl.
+    pub subcell_front: bool,
+}
+
+impl Default for FieldSettings {
+    fn default() -> Self {
+        Self {
+            grid: GridSettings::default(),
+            method: Method::Fast,
+            subcell_front: true,
+        }
+    }
+}
+
+impl FieldSettings {
+    /// Checks all fields (the message names the field).
+    pub fn validate(&self) -> Result<(), String> {
+        self.grid.validate().map_err(|m| format!("grid: {m}"))
+    }
+}
+
+/// Everything computed at one bias.
+#[derive(Debug, Clone)]
+pub struct PointResult {
+    /// Bias U_B, V.
+    pub bias_v: f64,
+    /// The final mesh.
+    pub mesh: Mesh,
+    /// Potential with depletion on the final mesh.
+    pub potential: PotentialSolution,
+    /// Weighting potentials on the final mesh.
+    pub weighting: WeightingPotentials,
+    /// Maxwell capacitance matrix, pF.
+    pub capacitance: CapacitanceMatrix,
+    /// Mutual capacitance c12 = -C*_12 between contacts 1 and 2, pF.
+    pub c12_pf: f64,
+    /// Number of undepleted semiconductor nodes.
+    pub undepleted_nodes: usize,
+    /// Reports of the potential solves (one per refinement pass).
+    pub reports: Vec<SolveReport>,
+}
+
+impl PointResult {
+    /// True when no semiconductor node is undepleted.
+    pub fn fully_depleted(&self) -> bool {
+        self.undepleted_nodes == 0
+    }
+}
+
+/// Indices of the contacts with ids 1 and 2, else the first two contacts.
+pub(crate) fn pair(det: &Detector) -> Result<(usize, usize)> {
+    let by_id = |id: u32| det.contacts.iter().position(|c| c.id == id);
+    match (by_id(1), by_id(2)) {
+        (Some(a), Some(b)) => Ok((a, b)),
+        _ if det.contacts.len() >= 2 => Ok((0, 1)),
+        _ => Err(Error::Argument {
+            name: "detector".into(),
+            message: format!(
+                "{}: c12 needs two contacts, the detector has {}",
+                det.file.display(),
+                det.contacts.len()
+            ),
+        }),
+    }
+}
+
+/// Solves the potential at `bias_v` with refinement, then the weighting potentials and C*.
+///
+/// `seed` may carry a mesh and potential from a neighbouring voltage: its grid is reused as the
+/// starting grid and its potential seeds the active set.
+pub fn solve_point(
+    det: &Detector,
+    bias_v: f64,
+    settings: &FieldSettings,
+    seed: Option<(&Grid, &[f64])>,
+) -> Result<PointResult> {
+    settings.validate().map_err(|m| Error::Argument {
+        name: "settings".into(),
+        message: m,
+    })?;
+    if !bias_v.is_finite() {
+        return Err(Error::Argument {
+            name: "bias_v".into(),
+            message: format!("must be finite, got {bias_v}"),
+        });
+    }
+    let (a, b) = pair(det)?;
+    let gs = &settings.grid;
+    let mut grid = Grid::initial(det, gs);
+    let mut guess: Option<Vec<f64>> = None;
+    if let Some((g, phi)) = seed {
+        guess = Some(g.interpolate_to(phi, &grid));
+    }
+    let mut reports = Vec::new();
+    let solve = |mesh: &Mesh, guess: Option<&[f64]>| match settings.method {
+        Method::Fast | Method::Sor => solve_fast(mesh, det, bias_v, guess),
+    };
+    let mut mesh = Mesh::new(det, grid.clone());
+    let mut pot = solve(&mesh, guess.as_deref())?;
+    reports.push(pot.report.clone());
+    let span = (pot.bounds_v.1 - pot.bounds_v.0)
+        .abs()
+        .max(f64::MIN_POSITIVE);
+    for &limit in &gs.refinement_limits {
+        let Some(finer) = grid.refined(&pot.phi_v, limit * span, gs) else {
+            continue;
+        };
+        let g = grid.interpolate_to(&pot.phi_v, &finer);
+        grid = finer;
+        mesh = Mesh::new(det, grid.clone());
+        pot = solve(&mesh, Some(&g))?;
+        reports.push(pot.report.clone());
+    }
+    // Resolve the depletion front: halve the intervals it crosses down to front_spacing_mm.
+    loop {
+        let (nr, nz) = (grid.nr(), grid.nz());
+        let mut split_r = vec![false; nr - 1];
+        let mut split_z = vec![false; nz - 1];
+        let semi = |n: usize| mesh.kind[n] == NodeKind::Semiconductor;
+        for n in (0..nr * nz).filter(|&n| semi(n)) {
+            let (i, j) = (n % nr, n / nr);
+            if i + 1 < nr && semi(n + 1) && pot.undepleted[n] != pot.undepleted[n + 1] {
+                split_r[i] = true;
+            }
+            if j + 1 < nz && semi(n + nr) && pot.undepleted[n] != pot.undepleted[n + nr] {
+                split_z[j] = true;
+            }
+        }
+        let Some(finer) = grid.split(&split_r, &split_z, gs.front_spacing_mm, gs) else {
+            break;
+        };
+        let g = grid.interpolate_to(&pot.phi_v, &finer);
+        grid = finer;
+        mesh = Mesh::new(det, grid.clone());
+        pot = solve(&mesh, Some(&g))?;
+        reports.push(pot.report.clone());
+    }
+    // The weighting problem sees the conductors end at the sub-cell front.
+    let wmesh = if settings.subcell_front {
+        super::front::front_corrected(&mesh, &pot.phi_v, &pot.undepleted, pot.bounds_v).0
+    } else {
+        mesh.clone()
+    };
+    let weighting = weighting_potentials(&wmesh, det, &pot.undepleted, bias_v)?;
+    let names = det.contacts.iter().map(|c| c.name.clone()).collect();
+    let capacitance = CapacitanceMatrix::from_weighting(&wmesh, &weighting, names);
+    let c12_pf = capacitance.mutual_pf(a, b);
+    let undepleted_nodes = pot
+        .undepleted
+        .iter()
+        .zip(&mesh.kind)
+        .filter(|(u, k)| **u && **k == NodeKind::Semiconductor)
+        .count();
+    Ok(PointResult {
+        bias_v,
+        mesh,
+        potential: pot,
+        weighting,
+        capacitance,
+        c12_pf,
+        undepleted_nodes,
+        reports,
+    })
+}

@@ -1,0 +1,55 @@
+//! What every solve reports.
+
+use serde::{Deserialize, Serialize};
+
+/// Method for the potential with depletion (a closed set).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Method {
+    /// Primal-dual active set (semismooth Newton) with sparse Cholesky solves: the exact
+    /// discrete solution in a few refactorisations.
+    #[default]
+    Fast,
+    /// Red-black projected successive over-relaxation (the class of SolidStateDetectors.jl and
+    /// fieldgen).
+    Sor,
+}
+
+impl Method {
+    /// Name as on the command line.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Method::Fast => "fast",
+            Method::Sor => "sor",
+        }
+    }
+}
+
+/// Why an iterative solve stopped.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Termination {
+    /// The active (undepleted) set did not change between two iterations: the discrete
+    /// complementarity problem is solved exactly (up to round-off).
+    ActiveSetStationary,
+    /// The largest update fell below the tolerance.
+    ToleranceReached,
+    /// A linear problem without constraints, solved directly.
+    Direct,
+}
+
+/// Report of one solve.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SolveReport {
+    /// Method used.
+    pub method: Method,
+    /// Iterations (active-set steps or SOR sweeps).
+    pub iterations: usize,
+    /// Largest projected residual at the end, in V: max_n |phi_n - clamp(phi_n - g_n / A_nn)|,
+    /// g the gradient of the discrete energy.
+    pub residual_v: f64,
+    /// Why it stopped.
+    pub termination: Termination,
+    /// Wall time in seconds.
+    pub seconds: f64,
+}

@@ -1,0 +1,207 @@
+//! Sparse symmetric systems in "unknown space": fixed nodes eliminated, floating conductors
+//! aggregated into one unknown each, factorised by faer's sparse Cholesky with the symbolic
+//! analysis reused across numeric refactorisations of the same pattern.
+
+use faer::linalg::solvers::Solve;
+use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
+use faer::{Mat, Side};
+
+use super::Mesh;
+use crate::{Error, Result};
+
+/// Role of a node in one linear problem.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum Dof {
+    /// Potential given (V).
+    Fixed(f64),
+    /// Its own unknown.
+    Free,
+    /// Shares one unknown with all nodes of the same group (a floating conductor).
+    Group(usize),
+}
+
+/// A symmetric positive-definite system A x = f over the unknowns, stored as a full CSC matrix.
+pub(crate) struct System {
+    /// Unknown of every node (None for fixed nodes).
+    pub node_unknown: Vec<Option<usize>>,
+    /// Fixed potential of every node (0 where free).
+    pub node_fixed: Vec<f64>,
+    /// Number of unknowns.
+    pub n: usize,
+    pub col_ptr: Vec<usize>,
+    pub row_idx: Vec<usize>,
+    pub val: Vec<f64>,
+    /// Position of the diagonal entry of every column.
+    pub diag_pos: Vec<usize>,
+    /// Position of the transposed entry of every stored entry.
+    pub mirror: Vec<usize>,
+    /// Right-hand side: fixed charges plus couplings to fixed nodes (C).
+    pub rhs: Vec<f64>,
+}
+
+impl System {
+    /// Assembles the system for `dofs` with node charges `charge_c` (C).
+    pub fn assemble(mesh: &Mesh, dofs: &[Dof], charge_c: &[f64]) -> Self {
+        let nn = dofs.len();
+        let mut node_unknown = vec![None; nn];
+        let mut node_fixed = vec![0.0; nn];
+        let mut group_unknown = std::collections::HashMap::new();
+        let mut n = 0;
+        for (k, d) in dofs.iter().enumerate() {
+            match *d {
+                Dof::Fixed(v) => node_fixed[k] = v,
+                Dof::Free => {
+                    node_unknown[k] = Some(n);
+                    n += 1;
+                }
+                Dof::Group(g) => {
+                    let u = *group_unknown.entry(g).or_insert_with(|| {
+                        n += 1;
+                        n - 1
+                    });
+                    node_unknown[k] = Some(u);
+                }
+            }
+        }
+        let mut rhs = vec![0.0; n];
+        for k in 0..nn {
+            if let Some(u) = node_unknown[k] {
+                rhs[u] += charge_c[k];
+            }
+        }
+        let mut diag = vec![0.0; n];
+        let mut off: Vec<(usize, usize, f64)> = Vec::with_capacity(4 * n);
+        mesh.for_each_edge(|p, q, w| match (node_unknown[p], node_unknown[q]) {
+            (None, None) => {}
+            (Some(u), None) => {
+                diag[u] += w;
+                rhs[u] += w * node_fixed[q];
+            }
+            (None, Some(u)) => {
+                diag[u] += w;
+                rhs[u] += w * node_fixed[p];
+            }
+            (Some(u), Some(v)) if u == v => {}
+            (Some(u), Some(v)) => {
+                diag[u] += w;
+                diag[v] += w;
+                off.push((u, v, -w));
+                off.push((v, u, -w));
+            }
+        });
+        // Columns: (row, value) lists, sorted, duplicates merged (group unknowns).
+        let mut cols: Vec<Vec<(usize, f64)>> = (0..n).map(|c| vec![(c, diag[c])]).collect();
+        for (r, c, v) in off {
+            cols[c].push((r, v));
+        }
+        let mut col_ptr = Vec::with_capacity(n + 1);
+        let mut row_idx = Vec::new();
+        let mut val = Vec::new();
+        let mut diag_pos = vec![0; n];
+        col_ptr.push(0);
+        for (c, mut col) in cols.into_iter().enumerate() {
+            col.sort_by_key(|e| e.0);
+            for (r, v) in col {
+                if row_idx.len() > col_ptr[c] && *row_idx.last().unwrap_or(&usize::MAX) == r {
+                    *val.last_mut().expect("non-empty") += v;
+                } else {
+                    if r == c {
+                        diag_pos[c] = row_idx.len();
+                    }
+                    row_idx.push(r);
+                    val.push(v);
+                }
+            }
+            col_ptr.push(row_idx.len());
+        }
+        // Mirror positions: entry (r, c) <-> (c, r).
+        let mut mirror = vec![0; row_idx.len()];
+        for c in 0..n {
+            for e in col_ptr[c]..col_ptr[c + 1] {
+                let r = row_idx[e];
+                let range = col_ptr[r]..col_ptr[r + 1];
+                let pos = row_idx[range.clone()]
+                    .binary_search(&c)
+                    .map(|p| range.start + p)
+                    .unwrap_or(e);
+                mirror[e] = pos;
+            }
+        }
+        Self {
+            node_unknown,
+            node_fixed,
+            n,
+            col_ptr,
+            row_idx,
+            val,
+            diag_pos,
+            mirror,
+            rhs,
+        }
+    }
+
+    /// y = A x with the stored values `val` (same pattern).
+    pub fn matvec(&self, val: &[f64], x: &[f64]) -> Vec<f64> {
+        let mut y = vec![0.0; self.n];
+        for (c, &xc) in x.iter().enumerate().take(self.n) {
+            for e in self.col_ptr[c]..self.col_ptr[c + 1] {
+                y[self.row_idx[e]] += val[e] * xc;
+            }
+        }
+        y
+    }
+
+    /// The symbolic Cholesky analysis of the pattern (reusable for any values).
+    pub fn symbolic(&self) -> Result<SymbolicLlt<usize>> {
+        let sym = SymbolicSparseColMatRef::new_checked(
+            self.n,
+            self.n,
+            &self.col_ptr,
+            None,
+            &self.row_idx,
+        );
+        SymbolicLlt::try_new(sym, Side::Lower).map_err(|e| Error::Singular {
+            reason: format!("symbolic factorisation failed: {e:?}"),
+        })
+    }
+
+    /// Factorises the matrix with values `val` and solves for `rhs`.
+    pub fn solve(&self, sym: &SymbolicLlt<usize>, val: &[f64], rhs: &[f64]) -> Result<Vec<f64>> {
+        let llt = self.factor(sym, val)?;
+        Ok(solve_with(&llt, rhs))
+    }
+
+    /// Numeric Cholesky factorisation with values `val`.
+    pub fn factor(&self, sym: &SymbolicLlt<usize>, val: &[f64]) -> Result<Llt<usize, f64>> {
+        let symbolic = SymbolicSparseColMatRef::new_checked(
+            self.n,
+            self.n,
+            &self.col_ptr,
+            None,
+            &self.row_idx,
+        );
+        let mat = SparseColMatRef::new(symbolic, val);
+        Llt::try_new_with_symbolic(sym.clone(), mat, Side::Lower).map_err(|e| Error::Singular {
+            reason: format!(
+                "the field matrix is not positive definite ({e:?}): is some region cut off from every fixed potential?"
+            ),
+        })
+    }
+
+    /// Expands unknown values to all nodes (fixed nodes take their fixed potential).
+    pub fn to_nodes(&self, x: &[f64]) -> Vec<f64> {
+        self.node_unknown
+            .iter()
+            .zip(&self.node_fixed)
+            .map(|(u, f)| u.map_or(*f, |u| x[u]))
+            .collect()
+    }
+}
+
+/// Solves with an existing factorisation.
+pub(crate) fn solve_with(llt: &Llt<usize, f64>, rhs: &[f64]) -> Vec<f64> {
+    let mut b = Mat::from_fn(rhs.len(), 1, |i, _| rhs[i]);
+    llt.solve_in_place(b.as_mut());
+    (0..rhs.len()).map(|i| b[(i, 0)]).collect()
+}

@@ -1,0 +1,9 @@
+//! Non-uniform tensor grids in (r, z): ticks on every geometry boundary, bounded spacing and
+//! spacing ratio, refinement where neighbouring potential differences are large.
+
+mod axis;
+mod settings;
+mod tensor;
+
+pub use settings::GridSettings;
+pub use tensor::Grid;

@@ -1,0 +1,209 @@
+//! The tensor grid: ticks in r and z (mm), node index n = j * nr + i.
+
+use super::GridSettings;
+use super::axis::{AxisRule, build_axis, limit_ratio};
+use crate::Detector;
+
+/// A non-uniform tensor grid over the world; node (i, j) sits at (r[i], z[j]) in mm.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Grid {
+    r_mm: Vec<f64>,
+    z_mm: Vec<f64>,
+}
+
+impl Grid {
+    /// A grid from explicit ticks (each strictly increasing, at least two).
+    pub fn new(r_mm: Vec<f64>, z_mm: Vec<f64>) -> Result<Self, String> {
+        for (name, t) in [("r", &r_mm), ("z", &z_mm)] {
+            if t.len() < 2 {
+                return Err(format!("the {name} axis needs at least two ticks"));
+            }
+            if t.windows(2)
+                .any(|w| w[1] <= w[0] || w[1].is_nan() || !w[0].is_finite() || !w[1].is_finite())
+            {
+                return Err(format!(
+                    "the {name} ticks must be finite and strictly increasing"
+                ));
+            }
+        }
+        Ok(Self { r_mm, z_mm })
+    }
+
+    /// The initial grid of a detector: a tick on every geometry edge, spacing limited by the
+    /// settings (fine over the semiconductor's extent), neighbour ratio limited.
+    pub fn initial(det: &Detector, s: &GridSettings) -> Self {
+        let (rt, zt) = det.ticks();
+        let sb = det.semiconductor.geometry.bbox();
+        let w = &det.world;
+        let rule = |range: (f64, f64)| AxisRule {
+            fine_range: range,
+            fine: s.max_spacing_semiconductor_mm,
+            coarse: s.max_spacing_mm,
+            min_tick: s.min_tick_distance_mm,
+            max_ratio: s.max_distance_ratio,
+        };
+        let r = build_axis(&rt, 0.0, w.r_max_mm, &rule((sb.r_min_mm, sb.r_max_mm)));
+        let z = build_axis(
+            &zt,
+            w.z_min_mm,
+            w.z_max_mm,
+            &rule((sb.z_min_mm, sb.z_max_mm)),
+        );
+        Self { r_mm: r, z_mm: z }
+    }
+
+    /// r ticks in mm.
+    pub fn r_mm(&self) -> &[f64] {
+        &self.r_mm
+    }
+
+    /// z ticks in mm.
+    pub fn z_mm(&self) -> &[f64] {
+        &self.z_mm
+    }
+
+    /// Number of r ticks.
+    pub fn nr(&self) -> usize {
+        self.r_mm.len()
+    }
+
+    /// Number of z ticks.
+    pub fn nz(&self) -> usize {
+        self.z_mm.len()
+    }
+
+    /// Number of nodes.
+    pub fn len(&self) -> usize {
+        self.nr() * self.nz()
+    }
+
+    /// Always false (a grid has at least 2 x 2 nodes).
+    pub fn is_empty(&self) -> bool {
+        false
+    }
+
+    /// Node index of (i, j).
+    pub fn index(&self, i: usize, j: usize) -> usize {
+        j * self.nr() + i
+    }
+
+    /// Halves every interval across which `field` (one value per node) changes by more than
+    /// `limit`, never below `min_tick_mm`, then restores the spacing-ratio limit. Returns
+    /// `None` when nothing needed refining.
+    pub fn refined(&self, field: &[f64], limit: f64, s: &GridSettings) -> Option<Grid> {
+        let (nr, nz) = (self.nr(), self.nz());
+        let mut split_r = vec![false; nr - 1];
+        let mut split_z = vec![false; nz - 1];
+        for j in 0..nz {
+            for i in 0..nr {
+                let v = field[self.index(i, j)];
+                if i + 1 < nr && (field[self.index(i + 1, j)] - v).abs() > limit {
+                    split_r[i] = true;
+                }
+                if j + 1 < nz && (field[self.index(i, j + 1)] - v).abs() > limit {
+                    split_z[j] = true;
+                }
+            }
+        }
+        let refine = |t: &[f64], split: &[bool]| -> (Vec<f64>, bool) {
+            let mut out = Vec::with_capacity(t.len() * 2);
+            let mut any = false;
+            for k in 0..t.len() - 1 {
+                out.push(t[k]);
+                if split[k] && (t[k + 1] - t[k]) / 2.0 >= s.min_tick_distance_mm {
+                    out.push(0.5 * (t[k] + t[k + 1]));
+                    any = true;
+                }
+            }
+            out.push(t[t.len() - 1]);
+            if any {
+                limit_ratio(&mut out, s.min_tick_distance_mm, s.max_distance_ratio);
+            }
+            (out, any)
+        };
+        let (r, ar) = refine(&self.r_mm, &split_r);
+        let (z, az) = refine(&self.z_mm, &split_z);
+        (ar || az).then_some(Grid { r_mm: r, z_mm: z })
+    }
+
+    /// Halves every r interval for which `split_r[i]` and every z interval for which
+    /// `split_z[j]` holds while it is wider than `max_width_mm`, then restores the ratio limit.
+    /// `None` when nothing was split.
+    pub fn split(
+        &self,
+        split_r: &[bool],
+        split_z: &[bool],
+        max_width_mm: f64,
+        s: &GridSettings,
+    ) -> Option<Grid> {
+        let width = max_width_mm.max(s.min_tick_distance_mm);
+        let go = |t: &[f64], split: &[bool]| -> (Vec<f64>, bool) {
+            let mut out = Vec::with_capacity(t.len() * 2);
+            let mut any = false;
+            for k in 0..t.len() - 1 {
+                out.push(t[k]);
+                if split[k] && t[k + 1] - t[k] > width * (1.0 + 1e-9) {
+                    out.push(0.5 * (t[k] + t[k + 1]));
+                    any = true;
+                }
+            }
+            out.push(t[t.len() - 1]);
+            if any {
+                limit_ratio(&mut out, s.min_tick_distance_mm, s.max_distance_ratio);
+            }
+            (out, any)
+        };
+        let (r, ar) = go(&self.r_mm, split_r);
+        let (z, az) = go(&self.z_mm, split_z);
+        (ar || az).then_some(Grid { r_mm: r, z_mm: z })
+    }
+
+    /// Bilinear interpolation of a node field of `self` onto the nodes of `finer` (whose
+    /// extent must equal this grid's).
+    pub fn interpolate_to(&self, field: &[f64], finer: &Grid) -> Vec<f64> {
+        let locate = |t: &[f64], x: f64| -> (usize, f64) {
+            let k = match t.binary_search_by(|v| v.total_cmp(&x)) {
+                Ok(k) => k.min(t.len() - 2),
+                Err(k) => k.clamp(1, t.len() - 1) - 1,
+            };
+            let f = ((x - t[k]) / (t[k + 1] - t[k])).clamp(0.0, 1.0);
+            (k, f)
+        };
+        let rl: Vec<(usize, f64)> = finer.r_mm.iter().map(|&r| locate(&self.r_mm, r)).collect();
+        let zl: Vec<(usize, f64)> = finer.z_mm.iter().map(|&z| locate(&self.z_mm, z)).collect();
+        let mut out = Vec::with_capacity(finer.len());
+        for &(j, fz) in &zl {
+            for &(i, fr) in &rl {
+                let v00 = field[self.index(i, j)];
+                let v10 = field[self.index(i + 1, j)];
+                let v01 = field[self.index(i, j + 1)];
+                let v11 = field[self.index(i + 1, j + 1)];
+                out.push(
+                    (1.0 - fz) * ((1.0 - fr) * v00 + fr * v10) + fz * ((1.0 - fr) * v01 + fr * v11),
+                );
+            }
+        }
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn refine_and_interpolate() {
+        let g = Grid::new(vec![0.0, 1.0, 2.0], vec![0.0, 1.0]).unwrap();
+        // A step between r = 1 and r = 2.
+        let f = vec![0.0, 0.0, 1.0, 0.0, 0.0, 1.0];
+        let s = GridSettings::default();
+        let h = g.refined(&f, 0.5, &s).unwrap();
+        assert_eq!(h.r_mm(), &[0.0, 1.0, 1.5, 2.0]);
+        assert_eq!(h.z_mm(), &[0.0, 1.0]);
+        assert!(g.refined(&f, 2.0, &s).is_none());
+        let fi = g.interpolate_to(&f, &h);
+        assert_eq!(fi, vec![0.0, 0.0, 0.5, 1.0, 0.0, 0.0, 0.5, 1.0]);
+        assert!(Grid::new(vec![0.0], vec![0.0, 1.0]).is_err());
+        assert!(Grid::new(vec![0.0, 0.0], vec![0.0, 1.0]).is_err());
+    }
+}

@@ -1,0 +1,38 @@
+//! One c12 point of super-siegfried-k1 (manufacturer model, d_Li = 1 mm) at the default settings.
+//! `cargo run --release -p hpge-validation --example ss_point [-- U_B ...]`
+
+use hpge_solver::{Detector, FieldSettings, Parameters, solve_point};
+use hpge_validation::repo_path;
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let det = Detector::from_file(
+        &repo_path("detectors/super-siegfried-k1.toml"),
+        &Parameters::new(),
+    )?;
+    let s = FieldSettings::default();
+    let volts: Vec<f64> = std::env::args()
+        .skip(1)
+        .map(|a| a.parse())
+        .collect::<Result<_, _>>()?;
+    let volts = if volts.is_empty() {
+        vec![25.0, 1025.0, 2975.0]
+    } else {
+        volts
+    };
+    for v in volts {
+        let t = std::time::Instant::now();
+        let p = solve_point(&det, v, &s, None)?;
+        let it: usize = p.reports.iter().map(|r| r.iterations).sum();
+        println!(
+            "U_B {v:>6} V  c12 {:>9.4} pF  grid {}x{} ({} nodes)  passes {}  pdas iters {it}  undepleted {}  {:.2} s",
+            p.c12_pf,
+            p.mesh.grid.nr(),
+            p.mesh.grid.nz(),
+            p.mesh.grid.len(),
+            p.reports.len(),
+            p.undepleted_nodes,
+            t.elapsed().as_secs_f64()
+        );
+    }
+    Ok(())
+}
