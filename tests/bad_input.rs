@@ -328,3 +328,52 @@ fn bad_arguments() {
     let msg = fails(&["detector", "--detector", d, "--plot", "no/such/dir/x.png"]);
     assert!(msg.contains("no/such/dir/x.png"), "{msg}");
 }
+
+#[test]
+fn simulate_bad_voltages_and_options() {
+    let det = write("detector-for-simulate.toml", DETECTOR);
+    let d = det.to_str().unwrap();
+    let msg = fails(&["simulate", "--detector", d, "--voltages", "0,25"]);
+    assert!(
+        msg.contains("--voltages") && msg.contains("positive"),
+        "{msg}"
+    );
+    let msg = fails(&["simulate", "--detector", d, "--voltages", "-25"]);
+    assert!(msg.contains("positive"), "{msg}");
+    let msg = fails(&["simulate", "--detector", d, "--voltages", "25:10:5"]);
+    assert!(msg.contains("STOP"), "{msg}");
+    let msg = fails(&["simulate", "--detector", d]);
+    assert!(msg.contains("--voltages"), "{msg}");
+    let msg = fails(&[
+        "simulate",
+        "--detector",
+        d,
+        "--voltages",
+        "25",
+        "--field-plot",
+        "f.png",
+    ]);
+    assert!(msg.contains("--field"), "{msg}");
+    let msg = fails(&[
+        "simulate",
+        "--detector",
+        d,
+        "--voltages",
+        "25",
+        "--d-li",
+        "1",
+    ]);
+    assert!(msg.contains("d_li_mm"), "{msg}");
+    let msg = fails(&["capacitance", "--detector", d, "--voltage", "nan"]);
+    assert!(msg.contains("--voltage"), "{msg}");
+    let nobias = DETECTOR.replace("potential = \"bias\"", "potential = 5.0");
+    let nb = write("detector-no-bias.toml", &nobias);
+    let msg = fails(&[
+        "simulate",
+        "--detector",
+        nb.to_str().unwrap(),
+        "--voltages",
+        "25",
+    ]);
+    assert!(msg.contains("bias"), "{msg}");
+}

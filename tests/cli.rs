@@ -103,3 +103,81 @@ fn detector_plots_and_summary() {
     let text = std::fs::read_to_string(&svg).unwrap();
     assert!(text.starts_with("<svg") && text.contains("impurity density"));
 }
+
+/// `simulate` on the validation coax: one JSON object with the documented fields.
+#[test]
+fn simulate_coax_json_csv_and_plots() {
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("cli_simulate");
+    std::fs::create_dir_all(&dir).unwrap();
+    let csv = dir.join("cv.csv");
+    let png = dir.join("cv.png");
+    let field = dir.join("field.svg");
+    let out = hpge_cv(&[
+        "simulate",
+        "--detector",
+        "detectors/coax-analytic.toml",
+        "--voltages",
+        "3600,25,1025,25",
+        "--json",
+        "--out",
+        csv.to_str().unwrap(),
+        "--plot",
+        png.to_str().unwrap(),
+        "--field",
+        "1025",
+        "--field-plot",
+        field.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("one JSON object");
+    let volts: Vec<f64> = v["voltage_V"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect();
+    assert_eq!(volts, vec![25.0, 1025.0, 3600.0], "sorted and deduplicated");
+    let c: Vec<f64> = v["c12_pF"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect();
+    assert!(c[0] > c[1] && c[1] > c[2]);
+    assert_eq!(v["fully_depleted"][2], true);
+    assert_eq!(v["fully_depleted"][0], false);
+    assert_eq!(v["depletion_voltage_V"], 3600.0);
+    assert_eq!(v["method"], "fast");
+    assert!(v["grid"]["nr"].as_u64().unwrap() > 10 && v["seconds"].as_f64().unwrap() > 0.0);
+    let text = std::fs::read_to_string(&csv).unwrap();
+    assert!(text.starts_with("voltage_V,c12_pF,fully_depleted\n25,"));
+    assert_eq!(&std::fs::read(&png).unwrap()[..4], b"\x89PNG");
+    assert!(std::fs::read_to_string(&field).unwrap().starts_with("<svg"));
+}
+
+#[test]
+fn capacitance_matrix_json() {
+    let out = hpge_cv(&[
+        "capacitance",
+        "--detector",
+        "detectors/coax-analytic.toml",
+        "--voltage",
+        "3600",
+        "--json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let m = v["maxwell_pF"].as_array().unwrap();
+    let c12 = -m[0][1].as_f64().unwrap();
+    assert!((c12 / v["c12_pF"].as_f64().unwrap() - 1.0).abs() < 1e-12);
+    // Fully depleted coax, 10 mm: 2 pi eps0 16 / ln(37.5 / 6) * 10 mm.
+    assert!((c12 - 4.857_19).abs() < 1e-4, "{c12}");
+}

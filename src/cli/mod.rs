@@ -3,13 +3,14 @@
 mod args;
 mod detector;
 mod impurity;
+mod simulate;
 
 use std::path::PathBuf;
 
 use anyhow::Result;
 use clap::{Parser, Subcommand};
 
-pub use args::{parse_param, parse_point};
+pub use args::{parse_param, parse_point, parse_voltages};
 
 /// Impurity densities of HPGe detectors from capacitance-voltage curves: field solver, neural
 /// surrogate and Bayesian inference (Abt et al., EPJ C 2023).
@@ -26,6 +27,74 @@ enum Command {
     Impurity(ImpurityArgs),
     /// Check a detector description, print a summary and draw its r-z cross-section.
     Detector(DetectorArgs),
+    /// Compute a C-V curve c12(U_B) with the field solver (potential with depletion, weighting
+    /// potentials, capacitance matrix).
+    Simulate(SimulateArgs),
+    /// The full Maxwell capacitance matrix at one bias.
+    Capacitance(CapacitanceArgs),
+}
+
+/// The potential method.
+#[derive(Debug, Clone, Copy, clap::ValueEnum)]
+enum MethodArg {
+    /// Primal-dual active set with sparse Cholesky solves (exact discrete solution).
+    Fast,
+    /// Red-black projected SOR (the SolidStateDetectors.jl class of method).
+    Sor,
+}
+
+impl From<MethodArg> for hpge_solver::Method {
+    fn from(m: MethodArg) -> Self {
+        match m {
+            MethodArg::Fast => hpge_solver::Method::Fast,
+            MethodArg::Sor => hpge_solver::Method::Sor,
+        }
+    }
+}
+
+#[derive(Debug, clap::Args)]
+struct SimulateArgs {
+    #[command(flatten)]
+    input: DetectorInput,
+    /// Lithium (n+) thickness in mm: sets the detector parameter d_li_mm.
+    #[arg(long = "d-li", value_name = "MM", allow_hyphen_values = true)]
+    d_li: Option<f64>,
+    /// Bias voltages: START:STOP:STEP (inclusive) or a comma list, e.g. 25:2975:50 or 25,75,125.
+    #[arg(long, value_name = "LIST", value_parser = parse_voltages, allow_hyphen_values = true)]
+    voltages: Option<args::VoltageList>,
+    /// Potential method.
+    #[arg(long, value_enum, default_value = "fast")]
+    method: MethodArg,
+    /// Print exactly one JSON object on stdout.
+    #[arg(long)]
+    json: bool,
+    /// Write the curve as CSV (voltage_V,c12_pF,fully_depleted).
+    #[arg(long, value_name = "FILE")]
+    out: Option<PathBuf>,
+    /// Draw the C-V curve (.svg or .png).
+    #[arg(long, value_name = "FILE")]
+    plot: Option<PathBuf>,
+    /// Bias (V) at which to draw the potential and the undepleted region (with --field-plot).
+    #[arg(long, value_name = "U", allow_hyphen_values = true)]
+    field: Option<f64>,
+    /// Where to draw the potential at --field (.svg or .png).
+    #[arg(long = "field-plot", value_name = "FILE")]
+    field_plot: Option<PathBuf>,
+}
+
+#[derive(Debug, clap::Args)]
+struct CapacitanceArgs {
+    #[command(flatten)]
+    input: DetectorInput,
+    /// Bias voltage in V.
+    #[arg(long, value_name = "U", allow_hyphen_values = true)]
+    voltage: f64,
+    /// Potential method.
+    #[arg(long, value_enum, default_value = "fast")]
+    method: MethodArg,
+    /// Print exactly one JSON object on stdout.
+    #[arg(long)]
+    json: bool,
 }
 
 /// Options shared by commands that load a detector.
@@ -71,5 +140,24 @@ pub fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Impurity(a) => impurity::run(&a.input, &a.at, a.json),
         Command::Detector(a) => detector::run(&a.input, &a.plot, a.json),
+        Command::Simulate(a) => {
+            let Some(args::VoltageList(volts)) = a.voltages.clone() else {
+                anyhow::bail!("--voltages is required, e.g. --voltages 25:2975:50");
+            };
+            simulate::run(&simulate::SimulateOptions {
+                input: &a.input,
+                d_li_mm: a.d_li,
+                voltages: &volts,
+                method: a.method.into(),
+                json: a.json,
+                out: a.out.as_ref(),
+                plot: a.plot.as_ref(),
+                field: a.field,
+                field_plot: a.field_plot.as_ref(),
+            })
+        }
+        Command::Capacitance(a) => {
+            simulate::capacitance(&a.input, a.voltage, a.method.into(), a.json)
+        }
     }
 }

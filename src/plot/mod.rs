@@ -2,10 +2,14 @@
 
 mod colormap;
 mod cross_section;
+mod cv;
+mod field;
 
 use std::path::Path;
 
 pub use cross_section::cross_section;
+pub use cv::cv_curve;
+pub use field::field_map;
 
 /// Output format, chosen by the file extension.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -7,9 +7,11 @@
 
 mod coax;
 mod error;
+mod radial1d;
 
 pub use coax::LongCoax;
 pub use error::{Error, Result};
+pub use radial1d::{DEFAULT_NODES, MIN_NODES, RadialReference, RadialSolution};
 
 /// Absolute path of a file shipped in the repository (e.g. `detectors/coax-analytic.toml`).
 pub fn repo_path(relative: &str) -> std::path::PathBuf {

@@ -114,3 +114,55 @@ pub(crate) fn front_corrected(
     }
     (out, count)
 }
+
+/// Intervals the depletion front crosses, for refinement: an r interval is marked when an edge
+/// along r joins an undepleted and a depleted semiconductor node and the front is not nearly
+/// parallel to r there, likewise for z. The front's normal is estimated from the potential
+/// gradient at the depleted node; a component below a quarter of the gradient's magnitude
+/// (front within about 15 degrees of the edge) does not mark its interval. This keeps a
+/// tensor grid from filling with lines along a curved front.
+pub(crate) fn front_splits(
+    mesh: &Mesh,
+    phi_v: &[f64],
+    undepleted: &[bool],
+) -> (Vec<bool>, Vec<bool>) {
+    let g = &mesh.grid;
+    let (nr, nz) = (g.nr(), g.nz());
+    let (r, z) = (g.r_mm(), g.z_mm());
+    let semi = |n: usize| mesh.kind[n] == NodeKind::Semiconductor;
+    let grad = |n: usize| -> (f64, f64) {
+        let (i, j) = (n % nr, n / nr);
+        let (i0, i1) = (i.saturating_sub(1), (i + 1).min(nr - 1));
+        let (j0, j1) = (j.saturating_sub(1), (j + 1).min(nz - 1));
+        let gr = (phi_v[j * nr + i1] - phi_v[j * nr + i0]) / (r[i1] - r[i0]);
+        let gz = (phi_v[j1 * nr + i] - phi_v[j0 * nr + i]) / (z[j1] - z[j0]);
+        (gr, gz)
+    };
+    let mut split_r = vec![false; nr - 1];
+    let mut split_z = vec![false; nz - 1];
+    for n in (0..nr * nz).filter(|&n| semi(n)) {
+        let (i, j) = (n % nr, n / nr);
+        if i + 1 < nr && semi(n + 1) && undepleted[n] != undepleted[n + 1] {
+            let d = if undepleted[n] { n + 1 } else { n };
+            let (gr, gz) = grad(d);
+            if gr.abs() >= 0.25 * gr.hypot(gz) || gr.hypot(gz) == 0.0 {
+                split_r[i] = true;
+            }
+        }
+        if j + 1 < nz && semi(n + nr) && undepleted[n] != undepleted[n + nr] {
+            let d = if undepleted[n] { n + nr } else { n };
+            let (gr, gz) = grad(d);
+            if gz.abs() >= 0.25 * gr.hypot(gz) || gr.hypot(gz) == 0.0 {
+                split_z[j] = true;
+            }
+        }
+    }
+    // Also the neighbouring intervals: the front may move by a cell after the re-solve, and the
+    // sub-cell extrapolation reads the potential two and three nodes away.
+    let widen = |v: Vec<bool>| -> Vec<bool> {
+        (0..v.len())
+            .map(|k| v[k] || (k > 0 && v[k - 1]) || (k + 1 < v.len() && v[k + 1]))
+            .collect()
+    };
+    (widen(split_r), widen(split_z))
+}

@@ -114,7 +114,8 @@ pub fn solve_point(
     }
     let mut reports = Vec::new();
     let solve = |mesh: &Mesh, guess: Option<&[f64]>| match settings.method {
-        Method::Fast | Method::Sor => solve_fast(mesh, det, bias_v, guess),
+        Method::Fast => solve_fast(mesh, det, bias_v, guess),
+        Method::Sor => super::sor::solve_sor(mesh, det, bias_v, guess),
     };
     let mut mesh = Mesh::new(det, grid.clone());
     let mut pot = solve(&mesh, guess.as_deref())?;
@@ -134,19 +135,7 @@ pub fn solve_point(
     }
     // Resolve the depletion front: halve the intervals it crosses down to front_spacing_mm.
     loop {
-        let (nr, nz) = (grid.nr(), grid.nz());
-        let mut split_r = vec![false; nr - 1];
-        let mut split_z = vec![false; nz - 1];
-        let semi = |n: usize| mesh.kind[n] == NodeKind::Semiconductor;
-        for n in (0..nr * nz).filter(|&n| semi(n)) {
-            let (i, j) = (n % nr, n / nr);
-            if i + 1 < nr && semi(n + 1) && pot.undepleted[n] != pot.undepleted[n + 1] {
-                split_r[i] = true;
-            }
-            if j + 1 < nz && semi(n + nr) && pot.undepleted[n] != pot.undepleted[n + nr] {
-                split_z[j] = true;
-            }
-        }
+        let (split_r, split_z) = super::front::front_splits(&mesh, &pot.phi_v, &pot.undepleted);
         let Some(finer) = grid.split(&split_r, &split_z, gs.front_spacing_mm, gs) else {
             break;
         };

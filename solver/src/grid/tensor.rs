@@ -126,8 +126,9 @@ impl Grid {
         (ar || az).then_some(Grid { r_mm: r, z_mm: z })
     }
 
-    /// Halves every r interval for which `split_r[i]` and every z interval for which
-    /// `split_z[j]` holds while it is wider than `max_width_mm`, then restores the ratio limit.
+    /// Divides every r interval for which `split_r[i]` and every z interval for which
+    /// `split_z[j]` holds into equal parts no wider than `max_width_mm`, then restores the
+    /// ratio limit.
     /// `None` when nothing was split.
     pub fn split(
         &self,
@@ -142,8 +143,13 @@ impl Grid {
             let mut any = false;
             for k in 0..t.len() - 1 {
                 out.push(t[k]);
-                if split[k] && t[k + 1] - t[k] > width * (1.0 + 1e-9) {
-                    out.push(0.5 * (t[k] + t[k + 1]));
+                let h = t[k + 1] - t[k];
+                if split[k] && h > width * (1.0 + 1e-9) {
+                    // Straight to the target width: one pass instead of repeated halving.
+                    let parts = (h / width - 1e-9).ceil() as usize;
+                    for p in 1..parts {
+                        out.push(t[k] + h * p as f64 / parts as f64);
+                    }
                     any = true;
                 }
             }

@@ -1,0 +1,232 @@
+//! `hpge-cv simulate` and `hpge-cv capacitance`: field solves from the command line.
+
+use std::io::Write;
+use std::path::PathBuf;
+
+use anyhow::{Context, Result, bail};
+use hpge_solver::{CvCurve, FieldSettings, Method, cv_curve, normalise_voltages, solve_point};
+use indicatif::{ProgressBar, ProgressStyle};
+use serde_json::json;
+
+use super::DetectorInput;
+use super::args::load_detector;
+use crate::plot;
+
+/// Options of `simulate`.
+pub struct SimulateOptions<'a> {
+    pub input: &'a DetectorInput,
+    pub d_li_mm: Option<f64>,
+    pub voltages: &'a [f64],
+    pub method: Method,
+    pub json: bool,
+    pub out: Option<&'a PathBuf>,
+    pub plot: Option<&'a PathBuf>,
+    pub field: Option<f64>,
+    pub field_plot: Option<&'a PathBuf>,
+}
+
+fn check_plot_path(p: &std::path::Path, flag: &str) -> Result<()> {
+    if plot::Format::from_path(p).is_none() {
+        bail!(
+            "{flag} {}: unknown file type; use .svg or .png",
+            p.display()
+        );
+    }
+    if let Some(dir) = p.parent().filter(|d| !d.as_os_str().is_empty())
+        && !dir.is_dir()
+    {
+        bail!(
+            "{flag} {}: the folder {} does not exist",
+            p.display(),
+            dir.display()
+        );
+    }
+    Ok(())
+}
+
+/// Runs a C-V curve and writes what was asked for.
+pub fn run(o: &SimulateOptions<'_>) -> Result<()> {
+    if let Some(p) = o.plot {
+        check_plot_path(p, "--plot")?;
+    }
+    if let Some(p) = o.field_plot {
+        check_plot_path(p, "--field-plot")?;
+        if o.field.is_none() {
+            bail!("--field-plot needs --field U (the bias in V at which to draw the potential)");
+        }
+    }
+    if let Some(u) = o.field
+        && !(u.is_finite() && u > 0.0)
+    {
+        bail!("--field {u}: the bias must be a positive number of volts");
+    }
+    let volts = normalise_voltages(o.voltages)?;
+    if volts.len() != o.voltages.len() {
+        eprintln!(
+            "note: the voltage list was sorted and deduplicated ({} points)",
+            volts.len()
+        );
+    }
+    let mut input = DetectorInput {
+        detector: o.input.detector.clone(),
+        impurity: o.input.impurity.clone(),
+        params: o.input.params.clone(),
+    };
+    if let Some(d) = o.d_li_mm {
+        if !(d.is_finite() && d > 0.0) {
+            bail!("--d-li {d}: the lithium thickness must be a positive number of mm");
+        }
+        input.params.push(("d_li_mm".to_string(), d));
+    }
+    let det = load_detector(&input)?;
+    if det.bias_contacts().is_empty() {
+        bail!(
+            "{}: no contact has potential = \"bias\", so the bias voltage acts on nothing",
+            det.file.display()
+        );
+    }
+    let settings = FieldSettings {
+        method: o.method,
+        ..FieldSettings::default()
+    };
+    let bar = ProgressBar::new(volts.len() as u64);
+    bar.set_style(
+        ProgressStyle::with_template("{bar:40} {pos}/{len} voltages, {elapsed} elapsed, eta {eta}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    let start = std::time::Instant::now();
+    let curve = cv_curve(&det, &volts, &settings, |k, _| bar.set_position(k as u64));
+    bar.finish_and_clear();
+    let curve = curve?;
+    if curve.points.iter().all(|p| !p.fully_depleted) && curve.points.len() > 1 {
+        eprintln!("note: the detector is not fully depleted at any listed voltage");
+    }
+    let seconds = start.elapsed().as_secs_f64();
+    if let Some(path) = o.out {
+        write_csv(path, &curve)?;
+    }
+    if let Some(path) = o.plot {
+        plot::cv_curve(&curve, &det, path)?;
+    }
+    if let (Some(u), Some(path)) = (o.field, o.field_plot) {
+        let p = solve_point(&det, u, &settings, None)?;
+        plot::field_map(&det, &p, path)?;
+    }
+    let last = curve.points.last().map_or((0, 0), |p| p.grid);
+    if o.json {
+        let v = json!({
+            "voltage_V": curve.points.iter().map(|p| p.voltage_v).collect::<Vec<_>>(),
+            "c12_pF": curve.points.iter().map(|p| p.c12_pf).collect::<Vec<_>>(),
+            "fully_depleted": curve.points.iter().map(|p| p.fully_depleted).collect::<Vec<_>>(),
+            "depletion_voltage_V": curve.depletion_voltage_v,
+            "grid": {"nr": last.0, "nz": last.1},
+            "grid_per_point": curve.points.iter().map(|p| json!({"nr": p.grid.0, "nz": p.grid.1})).collect::<Vec<_>>(),
+            "method": o.method.as_str(),
+            "seconds": seconds,
+            "detector": det.file.display().to_string(),
+            "impurity_file": det.semiconductor.impurity_file().display().to_string(),
+            "parameters": det.parameters.iter().collect::<std::collections::BTreeMap<_, _>>(),
+            "version": env!("CARGO_PKG_VERSION"),
+        });
+        println!("{v}");
+    } else {
+        println!(
+            "{:>10} {:>12} {:>8} {:>11}",
+            "U_B (V)", "c12 (pF)", "depleted", "grid"
+        );
+        for p in &curve.points {
+            println!(
+                "{:>10} {:>12.5} {:>8} {:>5}x{:<5}",
+                p.voltage_v, p.c12_pf, p.fully_depleted, p.grid.0, p.grid.1
+            );
+        }
+        match curve.depletion_voltage_v {
+            Some(v) => println!(
+                "full depletion at or below {v} V (lowest listed bias with no undepleted node)"
+            ),
+            None => println!("not fully depleted at any listed bias"),
+        }
+        println!(
+            "{} points in {seconds:.2} s ({})",
+            curve.points.len(),
+            o.method.as_str()
+        );
+    }
+    Ok(())
+}
+
+fn write_csv(path: &std::path::Path, curve: &CvCurve) -> Result<()> {
+    let mut f = std::fs::File::create(path)
+        .with_context(|| format!("--out {}: cannot create the file", path.display()))?;
+    writeln!(f, "voltage_V,c12_pF,fully_depleted")?;
+    for p in &curve.points {
+        writeln!(f, "{},{},{}", p.voltage_v, p.c12_pf, p.fully_depleted)?;
+    }
+    Ok(())
+}
+
+/// `capacitance`: the full Maxwell matrix at one bias.
+pub fn capacitance(
+    input: &DetectorInput,
+    voltage: f64,
+    method: Method,
+    as_json: bool,
+) -> Result<()> {
+    if !(voltage.is_finite() && voltage > 0.0) {
+        bail!("--voltage {voltage}: the bias must be a positive number of volts");
+    }
+    let det = load_detector(input)?;
+    let settings = FieldSettings {
+        method,
+        ..FieldSettings::default()
+    };
+    let p = solve_point(&det, voltage, &settings, None)?;
+    let c = &p.capacitance;
+    if as_json {
+        let v = json!({
+            "voltage_V": voltage,
+            "contacts": det.contacts.iter().map(|c| json!({"id": c.id, "name": c.name})).collect::<Vec<_>>(),
+            "maxwell_pF": c.energy_pf,
+            "maxwell_from_charges_pF": c.charge_pf,
+            "c12_pF": p.c12_pf,
+            "fully_depleted": p.fully_depleted(),
+            "grid": {"nr": p.mesh.grid.nr(), "nz": p.mesh.grid.nz()},
+            "method": method.as_str(),
+            "detector": det.file.display().to_string(),
+            "version": env!("CARGO_PKG_VERSION"),
+        });
+        println!("{v}");
+    } else {
+        println!("Maxwell capacitance matrix C* (pF, Q = C* U) at U_B = {voltage} V:");
+        print!("{:>28}", "");
+        for k in &det.contacts {
+            print!(
+                " {:>14}",
+                format!("{} ({})", k.id, k.name)
+                    .chars()
+                    .take(14)
+                    .collect::<String>()
+            );
+        }
+        println!();
+        for (i, k) in det.contacts.iter().enumerate() {
+            print!(
+                "{:>28}",
+                format!("{} ({})", k.id, k.name)
+                    .chars()
+                    .take(28)
+                    .collect::<String>()
+            );
+            for j in 0..det.contacts.len() {
+                print!(" {:>14.5}", c.energy_pf[i][j]);
+            }
+            println!();
+        }
+        println!(
+            "c12 = -C*_12 = {:.5} pF; fully depleted: {}",
+            p.c12_pf,
+            p.fully_depleted()
+        );
+    }
+    Ok(())
+}
