@@ -73,6 +73,14 @@ fn draw<DB: DrawingBackend>(
         .configure_mesh()
         .x_desc("bias U_B (V)")
         .y_desc("c12 (pF)")
+        .y_labels(12)
+        .y_label_formatter(&|v| {
+            if *v >= 10.0 {
+                format!("{v:.0}")
+            } else {
+                format!("{v:.2}")
+            }
+        })
         .label_style(("sans-serif", 16))
         .axis_desc_style(("sans-serif", 18))
         .draw()
@@ -105,6 +113,18 @@ fn draw<DB: DrawingBackend>(
             .map_err(err)?
             .label(format!("fully depleted from {vd} V (filled points)"))
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], red.stroke_width(2)));
+    }
+    if curve.depletion_voltage_v.is_none() {
+        let slope = match curve.points.as_slice() {
+            [.., a, b] => (a.c12_pf - b.c12_pf) / (b.voltage_v - a.voltage_v),
+            _ => f64::NAN,
+        };
+        root.draw(&Text::new(
+            format!("not fully depleted at any listed bias; -dc12/dU at the last point: {slope:.2e} pF/V"),
+            (120, 75),
+            ("sans-serif", 16).into_font(),
+        ))
+        .map_err(err)?;
     }
     chart
         .configure_series_labels()
