@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use anyhow::{Result, bail};
+use anyhow::Result;
 use hpge_solver::{ContactPotential, Detector, WorldSide};
 use serde_json::json;
 
@@ -13,21 +13,7 @@ use crate::plot;
 /// Loads and checks the detector, prints a summary (text or JSON) and writes the plots.
 pub fn run(input: &DetectorInput, plots: &[PathBuf], as_json: bool) -> Result<()> {
     for p in plots {
-        if plot::Format::from_path(p).is_none() {
-            bail!(
-                "--plot {}: unknown file type; use a name ending in .svg or .png",
-                p.display()
-            );
-        }
-        if let Some(dir) = p.parent().filter(|d| !d.as_os_str().is_empty())
-            && !dir.is_dir()
-        {
-            bail!(
-                "--plot {}: the folder {} does not exist",
-                p.display(),
-                dir.display()
-            );
-        }
+        plot::check_output(p, "--plot")?;
     }
     let det = load_detector(input)?;
     for p in plots {

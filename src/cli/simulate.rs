@@ -25,32 +25,13 @@ pub struct SimulateOptions<'a> {
     pub field_plot: Option<&'a PathBuf>,
 }
 
-fn check_plot_path(p: &std::path::Path, flag: &str) -> Result<()> {
-    if plot::Format::from_path(p).is_none() {
-        bail!(
-            "{flag} {}: unknown file type; use .svg or .png",
-            p.display()
-        );
-    }
-    if let Some(dir) = p.parent().filter(|d| !d.as_os_str().is_empty())
-        && !dir.is_dir()
-    {
-        bail!(
-            "{flag} {}: the folder {} does not exist",
-            p.display(),
-            dir.display()
-        );
-    }
-    Ok(())
-}
-
 /// Runs a C-V curve and writes what was asked for.
 pub fn run(o: &SimulateOptions<'_>) -> Result<()> {
     if let Some(p) = o.plot {
-        check_plot_path(p, "--plot")?;
+        plot::check_output(p, "--plot")?;
     }
     if let Some(p) = o.field_plot {
-        check_plot_path(p, "--field-plot")?;
+        plot::check_output(p, "--field-plot")?;
         if o.field.is_none() {
             bail!("--field-plot needs --field U (the bias in V at which to draw the potential)");
         }

@@ -30,3 +30,24 @@ impl Format {
         }
     }
 }
+
+/// Checks an output path before any work: a known extension and an existing folder. `flag` names
+/// the option in the message.
+pub fn check_output(path: &Path, flag: &str) -> anyhow::Result<()> {
+    if Format::from_path(path).is_none() {
+        anyhow::bail!(
+            "{flag} {}: unknown file type; use a name ending in .svg or .png",
+            path.display()
+        );
+    }
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty())
+        && !dir.is_dir()
+    {
+        anyhow::bail!(
+            "{flag} {}: the folder {} does not exist",
+            path.display(),
+            dir.display()
+        );
+    }
+    Ok(())
+}
