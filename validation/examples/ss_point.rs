@@ -9,7 +9,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         &repo_path("detectors/super-siegfried-k1.toml"),
         &Parameters::new(),
     )?;
-    let s = FieldSettings::default();
+    let mut s = FieldSettings::default();
+    if let Ok(l) = std::env::var("LIMITS") {
+        s.grid.refinement_limits = l.split(',').map(|x| x.parse()).collect::<Result<_, _>>()?;
+    }
+    if let Ok(f) = std::env::var("FRONT") {
+        s.grid.front_spacing_mm = f.parse()?;
+    }
     let volts: Vec<f64> = std::env::args()
         .skip(1)
         .map(|a| a.parse())
