@@ -120,30 +120,31 @@ pub fn solve_point(
     let mut mesh = Mesh::new(det, grid.clone());
     let mut pot = solve(&mesh, guess.as_deref())?;
     reports.push(pot.report.clone());
+    // Moves to a finer grid: the current potential, interpolated, seeds the new solve.
+    let mut advance =
+        |grid: &mut Grid, mesh: &mut Mesh, pot: &mut PotentialSolution, finer: Grid| {
+            let g = grid.interpolate_to(&pot.phi_v, &finer);
+            *mesh = Mesh::new(det, finer.clone());
+            *grid = finer;
+            *pot = solve(mesh, Some(&g))?;
+            reports.push(pot.report.clone());
+            Ok::<(), Error>(())
+        };
     let span = (pot.bounds_v.1 - pot.bounds_v.0)
         .abs()
         .max(f64::MIN_POSITIVE);
     for &limit in &gs.refinement_limits {
-        let Some(finer) = grid.refined(&pot.phi_v, limit * span, gs) else {
-            continue;
-        };
-        let g = grid.interpolate_to(&pot.phi_v, &finer);
-        grid = finer;
-        mesh = Mesh::new(det, grid.clone());
-        pot = solve(&mesh, Some(&g))?;
-        reports.push(pot.report.clone());
+        if let Some(finer) = grid.refined(&pot.phi_v, limit * span, gs) {
+            advance(&mut grid, &mut mesh, &mut pot, finer)?;
+        }
     }
-    // Resolve the depletion front: halve the intervals it crosses down to front_spacing_mm.
+    // Resolve the depletion front: divide the intervals it crosses down to front_spacing_mm.
     loop {
         let (split_r, split_z) = super::front::front_splits(&mesh, &pot.phi_v, &pot.undepleted);
         let Some(finer) = grid.split(&split_r, &split_z, gs.front_spacing_mm, gs) else {
             break;
         };
-        let g = grid.interpolate_to(&pot.phi_v, &finer);
-        grid = finer;
-        mesh = Mesh::new(det, grid.clone());
-        pot = solve(&mesh, Some(&g))?;
-        reports.push(pot.report.clone());
+        advance(&mut grid, &mut mesh, &mut pot, finer)?;
     }
     // The weighting problem sees the conductors end at the sub-cell front.
     let wmesh = if settings.subcell_front {

@@ -189,6 +189,29 @@ impl System {
         })
     }
 
+    /// The right-hand side for other fixed potentials on the same fixed nodes (no charges):
+    /// sum over edges from a fixed node p to an unknown u of w V_p.
+    pub fn rhs_for_fixed(&self, mesh: &Mesh, fixed: &[f64]) -> Vec<f64> {
+        let mut rhs = vec![0.0; self.n];
+        mesh.for_each_edge(
+            |p, q, w| match (self.node_unknown[p], self.node_unknown[q]) {
+                (Some(u), None) => rhs[u] += w * fixed[q],
+                (None, Some(u)) => rhs[u] += w * fixed[p],
+                _ => {}
+            },
+        );
+        rhs
+    }
+
+    /// Expands unknown values to all nodes, fixed nodes taking `fixed`.
+    pub fn to_nodes_with(&self, x: &[f64], fixed: &[f64]) -> Vec<f64> {
+        self.node_unknown
+            .iter()
+            .zip(fixed)
+            .map(|(u, f)| u.map_or(*f, |u| x[u]))
+            .collect()
+    }
+
     /// Expands unknown values to all nodes (fixed nodes take their fixed potential).
     pub fn to_nodes(&self, x: &[f64]) -> Vec<f64> {
         self.node_unknown

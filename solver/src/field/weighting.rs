@@ -139,34 +139,33 @@ pub fn weighting_potentials(
 ) -> Result<WeightingPotentials> {
     let own = owners(mesh, det, undepleted, bias_v)?;
     let nc = det.contacts.len();
-    let zero = vec![0.0; mesh.kind.len()];
+    // One pattern and one factorisation for all contacts: only the fixed values differ.
+    let dofs: Vec<Dof> = own
+        .iter()
+        .map(|o| match o {
+            None => Dof::Free,
+            Some(Owner::Contact(_) | Owner::Ground) => Dof::Fixed(0.0),
+            Some(Owner::Floating(g)) => Dof::Group(*g),
+        })
+        .collect();
+    let sys = System::assemble(mesh, &dofs, &vec![0.0; mesh.kind.len()]);
+    let llt = if sys.n > 0 {
+        let sym = sys.symbolic()?;
+        Some(sys.factor(&sym, &sys.val)?)
+    } else {
+        None
+    };
     let mut w = Vec::with_capacity(nc);
     let mut owned = Vec::with_capacity(nc);
-    let mut factor = None;
     for k in 0..nc {
-        let dofs: Vec<Dof> = own
-            .iter()
-            .map(|o| match o {
-                None => Dof::Free,
-                Some(Owner::Contact(c)) => Dof::Fixed(if *c == k { 1.0 } else { 0.0 }),
-                Some(Owner::Ground) => Dof::Fixed(0.0),
-                Some(Owner::Floating(g)) => Dof::Group(*g),
-            })
-            .collect();
-        let sys = System::assemble(mesh, &dofs, &zero);
-        // The pattern and values are the same for every k; only the right-hand side differs.
-        if factor.is_none() {
-            let sym = sys.symbolic()?;
-            factor = Some(sys.factor(&sym, &sys.val)?);
-        }
-        let llt = factor.as_ref().expect("factorised above");
-        let x = if sys.n > 0 {
-            solve_with(llt, &sys.rhs)
-        } else {
-            Vec::new()
+        let mine: Vec<bool> = own.iter().map(|o| *o == Some(Owner::Contact(k))).collect();
+        let fixed: Vec<f64> = mine.iter().map(|&m| if m { 1.0 } else { 0.0 }).collect();
+        let x = match &llt {
+            Some(llt) => solve_with(llt, &sys.rhs_for_fixed(mesh, &fixed)),
+            None => Vec::new(),
         };
-        w.push(sys.to_nodes(&x));
-        owned.push(own.iter().map(|o| *o == Some(Owner::Contact(k))).collect());
+        w.push(sys.to_nodes_with(&x, &fixed));
+        owned.push(mine);
     }
     Ok(WeightingPotentials { w, owned })
 }
