@@ -15,6 +15,21 @@ use hpge_solver::constants::{
 
 use crate::{Error, Result};
 
+/// The closed-form numbers of `../shared/reference/coax-1d-reference.md` (computed outside this
+/// project) for the validation coax: (U_B in V, r_d in mm, c' in pF/mm), rounded to 4 and 5 decimals.
+pub const COAX_REFERENCE_TABLE: [(f64, f64, f64); 10] = [
+    (25.0, 35.3769, 15.27299),
+    (75.0, 33.7950, 8.55656),
+    (125.0, 32.6909, 6.48566),
+    (275.0, 30.2782, 4.16111),
+    (525.0, 27.3603, 2.82354),
+    (1025.0, 22.9450, 1.81198),
+    (1525.0, 19.2911, 1.33914),
+    (2025.0, 15.9622, 1.04215),
+    (2525.0, 12.7478, 0.82497),
+    (2975.0, 9.8044, 0.66352),
+];
+
 /// The long coax: radii in mm, density in cm^-3 (n-type, > 0), eps_r dimensionless.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LongCoax {

@@ -9,7 +9,7 @@ mod coax;
 mod error;
 mod radial1d;
 
-pub use coax::LongCoax;
+pub use coax::{COAX_REFERENCE_TABLE, LongCoax};
 pub use error::{Error, Result};
 pub use radial1d::{DEFAULT_NODES, MIN_NODES, RadialReference, RadialSolution};
 

@@ -3,19 +3,8 @@
 
 use hpge_validation::LongCoax;
 
-/// (U_B in V, r_d in mm, c' in pF/mm) from the reference table.
-const REFERENCE: [(f64, f64, f64); 10] = [
-    (25.0, 35.3769, 15.27299),
-    (75.0, 33.7950, 8.55656),
-    (125.0, 32.6909, 6.48566),
-    (275.0, 30.2782, 4.16111),
-    (525.0, 27.3603, 2.82354),
-    (1025.0, 22.9450, 1.81198),
-    (1525.0, 19.2911, 1.33914),
-    (2025.0, 15.9622, 1.04215),
-    (2525.0, 12.7478, 0.82497),
-    (2975.0, 9.8044, 0.66352),
-];
+/// (U_B in V, r_d in mm, c' in pF/mm): the independent reference table.
+const REFERENCE: [(f64, f64, f64); 10] = hpge_validation::COAX_REFERENCE_TABLE;
 
 #[test]
 fn matches_reference_table() {

@@ -12,19 +12,8 @@ const B_MM: f64 = 37.5;
 const Q_C: f64 = 1.602_176_634e-19;
 const EPS_F_PER_M: f64 = 8.854_187_812_8e-12 * 16.0;
 
-/// (U_B in V, r_d in mm, c' in pF/mm) from the reference table.
-const REFERENCE: [(f64, f64, f64); 10] = [
-    (25.0, 35.3769, 15.27299),
-    (75.0, 33.7950, 8.55656),
-    (125.0, 32.6909, 6.48566),
-    (275.0, 30.2782, 4.16111),
-    (525.0, 27.3603, 2.82354),
-    (1025.0, 22.9450, 1.81198),
-    (1525.0, 19.2911, 1.33914),
-    (2025.0, 15.9622, 1.04215),
-    (2525.0, 12.7478, 0.82497),
-    (2975.0, 9.8044, 0.66352),
-];
+/// (U_B in V, r_d in mm, c' in pF/mm): the independent reference table.
+const REFERENCE: [(f64, f64, f64); 10] = hpge_validation::COAX_REFERENCE_TABLE;
 
 fn reference(nodes: usize) -> RadialReference {
     RadialReference {
