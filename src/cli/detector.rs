@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use anyhow::Result;
-use hpge_solver::{ContactPotential, Detector, WorldSide};
+use hpge_solver::{Detector, WorldSide};
 use serde_json::json;
 
 use super::DetectorInput;
@@ -26,13 +26,6 @@ pub fn run(input: &DetectorInput, plots: &[PathBuf], as_json: bool) -> Result<()
         print_summary(&det);
     }
     Ok(())
-}
-
-fn potential(c: &ContactPotential) -> String {
-    match c {
-        ContactPotential::Bias => "bias".to_string(),
-        ContactPotential::Fixed(v) => format!("{v} V"),
-    }
 }
 
 fn print_summary(det: &Detector) {
@@ -80,7 +73,7 @@ fn print_summary(det: &Detector) {
             "contact {}  {}: potential {}, {}, r in [{}, {}] mm, z in [{}, {}] mm",
             c.id,
             c.name,
-            potential(&c.potential),
+            c.potential,
             if c.geometry.is_surface_only() {
                 "surface"
             } else {
@@ -112,7 +105,7 @@ fn summary_json(det: &Detector) -> serde_json::Value {
             "impurity_file": sc.impurity_file().display().to_string(),
         },
         "contacts": det.contacts.iter().map(|c| json!({
-            "id": c.id, "name": c.name, "potential": potential(&c.potential),
+            "id": c.id, "name": c.name, "potential": c.potential.to_string(),
             "surface": c.geometry.is_surface_only(), "bbox_mm": c.geometry.bbox(),
         })).collect::<Vec<_>>(),
         "passives": det.passives.iter().map(|p| json!({

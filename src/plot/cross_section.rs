@@ -3,13 +3,13 @@
 
 use std::path::Path;
 
-use anyhow::{Context, Result, anyhow, bail};
+use anyhow::Result;
 use hpge_solver::{BoundaryKind, Detector, PassiveKind, Region, WorldSide};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::Format;
 use super::colormap::{density_color, t_color};
+use super::err;
 
 /// Largest plot width and height in pixels (the scale is chosen so that both fit).
 const MAX_PLOT_W: f64 = 700.0;
@@ -87,33 +87,12 @@ impl Layout {
 pub fn cross_section(det: &Detector, path: &Path) -> Result<()> {
     let layout = Layout::new(det);
     let size = (layout.width, layout.height);
-    let ctx = || format!("cannot write the plot {}", path.display());
-    match Format::from_path(path) {
-        Some(Format::Png) => {
-            let root = BitMapBackend::new(path, size).into_drawing_area();
-            draw(&root, det, &layout, 1, 0).with_context(ctx)?;
-            root.present()
-                .map_err(|e| anyhow!("{e}"))
-                .with_context(ctx)?;
-        }
-        Some(Format::Svg) => {
-            let cell = (layout.plot_h / 450).max(1);
-            let root = SVGBackend::new(path, size).into_drawing_area();
-            draw(&root, det, &layout, cell, SVG_LEVELS).with_context(ctx)?;
-            root.present()
-                .map_err(|e| anyhow!("{e}"))
-                .with_context(ctx)?;
-        }
-        None => bail!(
-            "--plot {}: unknown file type; use .svg or .png",
-            path.display()
-        ),
-    }
-    Ok(())
-}
-
-fn err<E: std::fmt::Debug>(e: E) -> anyhow::Error {
-    anyhow!("drawing failed: {e:?}")
+    render!(path, size, |root, svg| if svg {
+        let cell = (layout.plot_h / 450).max(1);
+        draw(&root, det, &layout, cell, SVG_LEVELS)
+    } else {
+        draw(&root, det, &layout, 1, 0)
+    })
 }
 
 fn draw<DB: DrawingBackend>(
@@ -346,13 +325,9 @@ fn draw_panel<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, det: &Detector)
         .iter()
         .enumerate()
         .map(|(k, c)| {
-            let pot = match c.potential {
-                hpge_solver::ContactPotential::Bias => "bias".to_string(),
-                hpge_solver::ContactPotential::Fixed(v) => format!("{v} V"),
-            };
             (
                 contact_color(k),
-                format!("contact {}: {} ({pot})", c.id, c.name),
+                format!("contact {}: {} ({})", c.id, c.name, c.potential),
             )
         })
         .collect();

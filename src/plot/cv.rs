@@ -2,39 +2,16 @@
 
 use std::path::Path;
 
-use anyhow::{Context, Result, anyhow};
+use anyhow::Result;
 use hpge_solver::{CvCurve, Detector};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::Format;
-
-fn err<E: std::fmt::Debug>(e: E) -> anyhow::Error {
-    anyhow!("drawing failed: {e:?}")
-}
+use super::err;
 
 /// Draws c12 (log scale) against U_B, marking the full-depletion voltage.
 pub fn cv_curve(curve: &CvCurve, det: &Detector, path: &Path) -> Result<()> {
-    let ctx = || format!("cannot write the plot {}", path.display());
-    let size = (1000, 700);
-    match Format::from_path(path) {
-        Some(Format::Png) => {
-            let root = BitMapBackend::new(path, size).into_drawing_area();
-            draw(&root, curve, det).with_context(ctx)?;
-            root.present()
-                .map_err(|e| anyhow!("{e}"))
-                .with_context(ctx)?;
-        }
-        Some(Format::Svg) => {
-            let root = SVGBackend::new(path, size).into_drawing_area();
-            draw(&root, curve, det).with_context(ctx)?;
-            root.present()
-                .map_err(|e| anyhow!("{e}"))
-                .with_context(ctx)?;
-        }
-        None => return Err(anyhow!("{}: use .svg or .png", path.display())),
-    }
-    Ok(())
+    render!(path, (1000, 700), |root, _svg| draw(&root, curve, det))
 }
 
 fn draw<DB: DrawingBackend>(

@@ -2,16 +2,12 @@
 
 use std::path::Path;
 
-use anyhow::{Context, Result, anyhow};
+use anyhow::Result;
 use hpge_solver::{Detector, PointResult};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::Format;
-
-fn err<E: std::fmt::Debug>(e: E) -> anyhow::Error {
-    anyhow!("drawing failed: {e:?}")
-}
+use super::err;
 
 /// A perceptually ordered map (viridis anchors) for t in [0, 1].
 fn viridis(t: f64) -> RGBColor {
@@ -43,32 +39,10 @@ pub fn field_map(det: &Detector, p: &PointResult, path: &Path) -> Result<()> {
         (s * (w.z_max_mm - w.z_min_mm)) as u32,
     );
     let size = (pw + 260, (ph + 140).max(480));
-    let ctx = || format!("cannot write the plot {}", path.display());
-    match Format::from_path(path) {
-        Some(Format::Png) => {
-            let root = BitMapBackend::new(path, size).into_drawing_area();
-            draw(&root, det, p, (pw, ph), 1).with_context(ctx)?;
-            root.present()
-                .map_err(|e| anyhow!("{e}"))
-                .with_context(ctx)?;
-        }
-        Some(Format::Svg) => {
-            let root = SVGBackend::new(path, size).into_drawing_area();
-            draw(&root, det, p, (pw, ph), (ph / 250).max(1)).with_context(ctx)?;
-            root.present()
-                .map_err(|e| anyhow!("{e}"))
-                .with_context(ctx)?;
-        }
-        None => return Err(anyhow!("{}: use .svg or .png", path.display())),
-    }
-    Ok(())
-}
-
-fn locate(t: &[f64], x: f64) -> usize {
-    match t.binary_search_by(|v| v.total_cmp(&x)) {
-        Ok(k) => k.min(t.len() - 2),
-        Err(k) => k.clamp(1, t.len() - 1) - 1,
-    }
+    render!(path, size, |root, svg| {
+        let cell = if svg { (ph / 250).max(1) } else { 1 };
+        draw(&root, det, p, (pw, ph), cell)
+    })
 }
 
 fn draw<DB: DrawingBackend>(
@@ -105,7 +79,6 @@ fn draw<DB: DrawingBackend>(
         .draw()
         .map_err(err)?;
     let g = &p.mesh.grid;
-    let (r, z) = (g.r_mm(), g.z_mm());
     let nx = (pw / cell).max(1) as usize;
     let nz = (ph / cell).max(1) as usize;
     let dr = w.r_max_mm / nx as f64;
@@ -113,18 +86,10 @@ fn draw<DB: DrawingBackend>(
     let mut rects = Vec::with_capacity(nx * nz);
     for jz in 0..nz {
         let zc = w.z_min_mm + (jz as f64 + 0.5) * dz;
-        let j = locate(z, zc);
-        let fz = ((zc - z[j]) / (z[j + 1] - z[j])).clamp(0.0, 1.0);
         for ix in 0..nx {
             let rc = (ix as f64 + 0.5) * dr;
-            let i = locate(r, rc);
-            let fr = ((rc - r[i]) / (r[i + 1] - r[i])).clamp(0.0, 1.0);
-            let at = |a: usize, b: usize| p.potential.phi_v[g.index(a, b)];
-            let v = (1.0 - fz) * ((1.0 - fr) * at(i, j) + fr * at(i + 1, j))
-                + fz * ((1.0 - fr) * at(i, j + 1) + fr * at(i + 1, j + 1));
-            let near_i = if fr < 0.5 { i } else { i + 1 };
-            let near_j = if fz < 0.5 { j } else { j + 1 };
-            let undepleted = p.potential.undepleted[g.index(near_i, near_j)];
+            let v = g.interpolate_at(&p.potential.phi_v, rc, zc);
+            let undepleted = p.potential.undepleted[g.nearest(rc, zc)];
             let color = if undepleted {
                 RGBColor(150, 150, 150)
             } else {

@@ -1,5 +1,39 @@
 //! Figures: SVG and PNG through plotters.
 
+/// Draws `$body` (which sees the drawing area as `$root` and whether the target is SVG as
+/// `$svg`) on a PNG or SVG backend chosen by the extension of `$path`, then writes the file; every
+/// failure names the file.
+macro_rules! render {
+    ($path:expr, $size:expr, |$root:ident, $svg:ident| $body:expr) => {{
+        use anyhow::Context as _;
+        let path: &std::path::Path = $path;
+        let ctx = || format!("cannot write the plot {}", path.display());
+        match $crate::plot::Format::from_path(path) {
+            Some(format) => {
+                let $svg = format == $crate::plot::Format::Svg;
+                if $svg {
+                    let $root = plotters::prelude::SVGBackend::new(path, $size).into_drawing_area();
+                    $body.with_context(ctx)?;
+                    $root
+                        .present()
+                        .map_err(|e| anyhow::anyhow!("{e}"))
+                        .with_context(ctx)?;
+                } else {
+                    let $root =
+                        plotters::prelude::BitMapBackend::new(path, $size).into_drawing_area();
+                    $body.with_context(ctx)?;
+                    $root
+                        .present()
+                        .map_err(|e| anyhow::anyhow!("{e}"))
+                        .with_context(ctx)?;
+                }
+            }
+            None => anyhow::bail!("{}: unknown file type; use .svg or .png", path.display()),
+        }
+        Ok(())
+    }};
+}
+
 mod colormap;
 mod cross_section;
 mod cv;
@@ -50,4 +84,9 @@ pub fn check_output(path: &Path, flag: &str) -> anyhow::Result<()> {
         );
     }
     Ok(())
+}
+
+/// A plotters drawing error as an anyhow error.
+pub(crate) fn err<E: std::fmt::Debug>(e: E) -> anyhow::Error {
+    anyhow::anyhow!("drawing failed: {e:?}")
 }

@@ -88,6 +88,16 @@ pub struct Contact {
     pub geometry: Solid,
 }
 
+impl std::fmt::Display for ContactPotential {
+    /// `bias` or the potential with its unit, e.g. `0 V`.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            ContactPotential::Bias => f.write_str("bias"),
+            ContactPotential::Fixed(v) => write!(f, "{v} V"),
+        }
+    }
+}
+
 impl Contact {
     /// Potential (V) of this contact when the bias is `bias_v` (V).
     pub fn potential_v(&self, bias_v: f64) -> f64 {
@@ -280,8 +290,8 @@ impl Detector {
         r.retain(|v| *v >= w.r_min_mm && *v <= w.r_max_mm);
         z.retain(|v| *v >= w.z_min_mm && *v <= w.z_max_mm);
         (
-            crate::geometry::sorted_unique_pub(r),
-            crate::geometry::sorted_unique_pub(z),
+            crate::geometry::sorted_unique(r),
+            crate::geometry::sorted_unique(z),
         )
     }
 

@@ -14,7 +14,7 @@ pub use bbox::BoundingBox;
 pub use primitive::Primitive;
 pub(crate) use sampling::common_point;
 pub use solid::Solid;
-pub(crate) use solid::sorted_unique as sorted_unique_pub;
+pub(crate) use solid::sorted_unique;
 pub(crate) use spec::SolidSpec;
 
 /// Membership tolerance (mm) used for "on the boundary counts as inside".

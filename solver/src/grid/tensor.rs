@@ -167,30 +167,45 @@ impl Grid {
     /// Bilinear interpolation of a node field of `self` onto the nodes of `finer` (whose
     /// extent must equal this grid's).
     pub fn interpolate_to(&self, field: &[f64], finer: &Grid) -> Vec<f64> {
-        let locate = |t: &[f64], x: f64| -> (usize, f64) {
-            let k = match t.binary_search_by(|v| v.total_cmp(&x)) {
-                Ok(k) => k.min(t.len() - 2),
-                Err(k) => k.clamp(1, t.len() - 1) - 1,
-            };
-            let f = ((x - t[k]) / (t[k + 1] - t[k])).clamp(0.0, 1.0);
-            (k, f)
-        };
         let rl: Vec<(usize, f64)> = finer.r_mm.iter().map(|&r| locate(&self.r_mm, r)).collect();
         let zl: Vec<(usize, f64)> = finer.z_mm.iter().map(|&z| locate(&self.z_mm, z)).collect();
         let mut out = Vec::with_capacity(finer.len());
-        for &(j, fz) in &zl {
-            for &(i, fr) in &rl {
-                let v00 = field[self.index(i, j)];
-                let v10 = field[self.index(i + 1, j)];
-                let v01 = field[self.index(i, j + 1)];
-                let v11 = field[self.index(i + 1, j + 1)];
-                out.push(
-                    (1.0 - fz) * ((1.0 - fr) * v00 + fr * v10) + fz * ((1.0 - fr) * v01 + fr * v11),
-                );
+        for &jz in &zl {
+            for &ir in &rl {
+                out.push(self.bilinear(field, ir, jz));
             }
         }
         out
     }
+
+    /// Bilinear interpolation of a node field at (r, z) in mm (clamped to the grid).
+    pub fn interpolate_at(&self, field: &[f64], r_mm: f64, z_mm: f64) -> f64 {
+        self.bilinear(field, locate(&self.r_mm, r_mm), locate(&self.z_mm, z_mm))
+    }
+
+    /// Index of the node nearest to (r, z) in mm within its cell.
+    pub fn nearest(&self, r_mm: f64, z_mm: f64) -> usize {
+        let (i, fr) = locate(&self.r_mm, r_mm);
+        let (j, fz) = locate(&self.z_mm, z_mm);
+        self.index(i + usize::from(fr >= 0.5), j + usize::from(fz >= 0.5))
+    }
+
+    fn bilinear(&self, field: &[f64], (i, fr): (usize, f64), (j, fz): (usize, f64)) -> f64 {
+        let v00 = field[self.index(i, j)];
+        let v10 = field[self.index(i + 1, j)];
+        let v01 = field[self.index(i, j + 1)];
+        let v11 = field[self.index(i + 1, j + 1)];
+        (1.0 - fz) * ((1.0 - fr) * v00 + fr * v10) + fz * ((1.0 - fr) * v01 + fr * v11)
+    }
+}
+
+/// The interval k with t[k] <= x <= t[k+1] (clamped) and the fraction of x within it.
+fn locate(t: &[f64], x: f64) -> (usize, f64) {
+    let k = match t.binary_search_by(|v| v.total_cmp(&x)) {
+        Ok(k) => k.min(t.len() - 2),
+        Err(k) => k.clamp(1, t.len() - 1) - 1,
+    };
+    (k, ((x - t[k]) / (t[k + 1] - t[k])).clamp(0.0, 1.0))
 }
 
 #[cfg(test)]
