@@ -26,8 +26,8 @@ pub use error::{Error, Result};
 pub use expr::Parameters;
 pub use field::{
     CapacitanceMatrix, CvCurve, CvPoint, FieldSettings, Mesh, Method, NodeKind, PointResult,
-    PotentialSolution, SolveReport, Termination, WeightingPotentials, cv_curve, normalise_voltages,
-    solve_fast, solve_point, solve_sor, weighting_potentials,
+    PotentialSolution, Seed, SolveReport, Termination, WeightingPotentials, cv_curve,
+    normalise_voltages, solve_fast, solve_point, solve_sor, weighting_potentials,
 };
 pub use geometry::{BoundingBox, Primitive, Solid};
 pub use grid::{Grid, GridSettings};

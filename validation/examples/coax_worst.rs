@@ -20,6 +20,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if let Some(f) = args.get(1) {
         s.grid.front_spacing_mm = *f;
     }
+    if let Ok(l) = std::env::var("LIMITS") {
+        s.grid.refinement_limits = l
+            .split(',')
+            .filter(|x| !x.is_empty())
+            .map(|x| x.parse())
+            .collect::<Result<_, _>>()?;
+    }
+    let verbose = std::env::var("VERBOSE").is_ok();
     let exact = LongCoax::validation();
     let (mut worst, mut at, mut sum2) = (0.0f64, 0.0, 0.0);
     let t = std::time::Instant::now();
@@ -28,6 +36,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let p = solve_point(&det, v, &s, None)?;
         let e = p.c12_pf / 10.0 / exact.c12_per_mm_pf(v)? - 1.0;
         sum2 += e * e;
+        if verbose {
+            println!(
+                "{v:>6} {e:>10.2e} {}x{}",
+                p.mesh.grid.nr(),
+                p.mesh.grid.nz()
+            );
+        }
         if e.abs() > worst {
             worst = e.abs();
             at = v;

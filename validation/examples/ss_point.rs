@@ -11,7 +11,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     )?;
     let mut s = FieldSettings::default();
     if let Ok(l) = std::env::var("LIMITS") {
-        s.grid.refinement_limits = l.split(',').map(|x| x.parse()).collect::<Result<_, _>>()?;
+        s.grid.refinement_limits = l
+            .split(',')
+            .filter(|x| !x.is_empty())
+            .map(|x| x.parse())
+            .collect::<Result<_, _>>()?;
+    }
+    if std::env::var("METHOD").as_deref() == Ok("sor") {
+        s.method = hpge_solver::Method::Sor;
+    }
+    if let Ok(h) = std::env::var("SPACING") {
+        s.grid.max_spacing_semiconductor_mm = h.parse()?;
     }
     if let Ok(f) = std::env::var("FRONT") {
         s.grid.front_spacing_mm = f.parse()?;
@@ -29,8 +39,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let t = std::time::Instant::now();
         let p = solve_point(&det, v, &s, None)?;
         let it: usize = p.reports.iter().map(|r| r.iterations).sum();
+        let solve: f64 = p.reports.iter().map(|r| r.seconds).sum();
+        if std::env::var("PASSES").is_ok() {
+            for r in &p.reports {
+                println!("   pass: {} iterations, {:.3} s", r.iterations, r.seconds);
+            }
+        }
         println!(
-            "U_B {v:>6} V  c12 {:>9.4} pF  grid {}x{} ({} nodes)  passes {}  pdas iters {it}  undepleted {}  {:.2} s",
+            "U_B {v:>6} V  c12 {:>9.4} pF  grid {}x{} ({} nodes)  passes {}  iterations {it}  undepleted {}  potential {solve:.2} s  point {:.2} s",
             p.c12_pf,
             p.mesh.grid.nr(),
             p.mesh.grid.nz(),

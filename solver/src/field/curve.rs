@@ -2,7 +2,7 @@
 
 use serde::Serialize;
 
-use super::point::{FieldSettings, solve_point};
+use super::point::{FieldSettings, Seed, solve_point};
 use crate::{Detector, Error, Result};
 
 /// One point of a C-V curve.
@@ -16,9 +16,13 @@ pub struct CvPoint {
     pub fully_depleted: bool,
     /// Final grid size (r ticks, z ticks).
     pub grid: (usize, usize),
+    /// Potential solves (refinement passes) at this bias.
+    pub passes: usize,
     /// Potential iterations summed over the refinement passes.
     pub iterations: usize,
-    /// Wall time, s.
+    /// Time in the potential solves (all passes), s.
+    pub solve_seconds: f64,
+    /// Wall time of the point (grids, potential, weighting potentials, capacitances), s.
     pub seconds: f64,
 }
 
@@ -51,35 +55,55 @@ pub fn normalise_voltages(volts: &[f64]) -> Result<Vec<f64>> {
     Ok(v)
 }
 
-/// Computes c12 at every voltage (sorted, deduplicated). Each point starts from the previous
-/// point's potential (interpolated onto its grid) to seed the active set. `progress(k, n)` is
-/// called after each point.
+/// Computes c12 at every voltage (sorted, deduplicated).
+///
+/// The list is cut into contiguous chunks, one per rayon thread (at least `MIN_CHUNK` voltages
+/// each), solved in parallel; inside a chunk each point starts from the previous point's
+/// solution (`Seed`: the grid is split where the front lay, the rescaled potential seeds the
+/// active set). `progress(done, total)` is called after each point, from any thread.
 pub fn cv_curve(
     det: &Detector,
     volts: &[f64],
     settings: &FieldSettings,
-    mut progress: impl FnMut(usize, usize),
+    progress: impl Fn(usize, usize) + Sync,
 ) -> Result<CvCurve> {
+    use rayon::prelude::*;
+    use std::sync::atomic::{AtomicUsize, Ordering};
     let volts = normalise_voltages(volts)?;
+    let chunks = rayon::current_num_threads()
+        .min(volts.len() / MIN_CHUNK)
+        .max(1);
+    let size = volts.len().div_ceil(chunks);
+    let done = AtomicUsize::new(0);
+    let parts: Vec<Result<Vec<CvPoint>>> = volts
+        .par_chunks(size)
+        .map(|chunk| {
+            let mut points = Vec::with_capacity(chunk.len());
+            let mut prev: Option<Seed> = None;
+            for (k, &v) in chunk.iter().enumerate() {
+                let start = std::time::Instant::now();
+                let p = solve_point(det, v, settings, prev.as_ref())?;
+                // Scale the potential to the next bias for a better seed.
+                let scale = chunk.get(k + 1).map_or(1.0, |next| next / v);
+                points.push(CvPoint {
+                    voltage_v: v,
+                    c12_pf: p.c12_pf,
+                    fully_depleted: p.fully_depleted(),
+                    grid: (p.mesh.grid.nr(), p.mesh.grid.nz()),
+                    passes: p.reports.len(),
+                    iterations: p.reports.iter().map(|r| r.iterations).sum(),
+                    solve_seconds: p.reports.iter().map(|r| r.seconds).sum(),
+                    seconds: start.elapsed().as_secs_f64(),
+                });
+                prev = Some(p.seed(scale));
+                progress(done.fetch_add(1, Ordering::Relaxed) + 1, volts.len());
+            }
+            Ok(points)
+        })
+        .collect();
     let mut points = Vec::with_capacity(volts.len());
-    let mut prev: Option<(crate::Grid, Vec<f64>)> = None;
-    for (k, &v) in volts.iter().enumerate() {
-        let start = std::time::Instant::now();
-        let seed = prev.as_ref().map(|(g, phi)| (g, phi.as_slice()));
-        let p = solve_point(det, v, settings, seed)?;
-        // Scale the previous potential to the new bias for a better seed.
-        let scale = volts.get(k + 1).map_or(1.0, |next| next / v);
-        let phi: Vec<f64> = p.potential.phi_v.iter().map(|x| x * scale).collect();
-        points.push(CvPoint {
-            voltage_v: v,
-            c12_pf: p.c12_pf,
-            fully_depleted: p.fully_depleted(),
-            grid: (p.mesh.grid.nr(), p.mesh.grid.nz()),
-            iterations: p.reports.iter().map(|r| r.iterations).sum(),
-            seconds: start.elapsed().as_secs_f64(),
-        });
-        prev = Some((p.mesh.grid.clone(), phi));
-        progress(k + 1, volts.len());
+    for part in parts {
+        points.extend(part?);
     }
     let depletion_voltage_v = points
         .iter()
@@ -90,3 +114,6 @@ pub fn cv_curve(
         depletion_voltage_v,
     })
 }
+
+/// Fewest voltages per parallel chunk (the first point of a chunk has no seed).
+const MIN_CHUNK: usize = 8;

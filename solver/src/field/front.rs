@@ -13,8 +13,6 @@
 
 use super::mesh::{Mesh, NodeKind};
 
-const OFF: isize = 2;
-
 /// A copy of `mesh` whose edge conductances across the depletion front are corrected for the
 /// sub-cell front position. Returns the corrected mesh and the number of edges corrected.
 pub(crate) fn front_corrected(
@@ -37,13 +35,17 @@ pub(crate) fn front_corrected(
             bounds_v.0
         }
     };
-    // Front position along a line: coordinates x_p, x_1, x_2 and potentials at q1, q2.
+    // Front position along a line through p (undepleted, u = 0), q1 and q2 (depleted), u = |B - phi|:
+    // the vertex of the parabola through the three points.
     let front = |b: f64, xp: f64, x1: f64, x2: f64, p1: f64, p2: f64| -> Option<f64> {
-        let (d1, d2) = ((b - p1).abs().sqrt(), (b - p2).abs().sqrt());
-        if !(d2 > d1 && d1 > 0.0) {
+        let (u1, u2) = ((b - p1).abs(), (b - p2).abs());
+        let f01 = u1 / (x1 - xp);
+        let f12 = (u2 - u1) / (x2 - x1);
+        let a = (f12 - f01) / (x2 - xp);
+        if !(a > 0.0 && u1 > 0.0 && u2 > u1) {
             return None;
         }
-        let xf = x1 - d1 * (x2 - x1) / (d2 - d1);
+        let xf = 0.5 * (xp + x1) - f01 / (2.0 * a);
         let h = x1 - xp;
         // Between half a spacing behind p and a tenth of a spacing before q1 (h may be negative).
         let lo = xp - 0.5 * h;
@@ -62,17 +64,16 @@ pub(crate) fn front_corrected(
             // Radial neighbours: direction +1 and -1.
             for dir in [1isize, -1] {
                 let i1 = i as isize + dir;
-                let i2 = i as isize + OFF * dir;
-                let i3 = i as isize + (OFF + 1) * dir;
-                if i3 < 0 || i3 >= nr as isize {
+                let i2 = i as isize + 2 * dir;
+                if i2 < 0 || i2 >= nr as isize {
                     continue;
                 }
-                let (i1, i2, i3) = (i1 as usize, i2 as usize, i3 as usize);
-                let (q1, q2, q3) = (j * nr + i1, j * nr + i2, j * nr + i3);
-                if !(depleted(q1) && depleted(q2) && depleted(q3)) {
+                let (i1, i2) = (i1 as usize, i2 as usize);
+                let (q1, q2) = (j * nr + i1, j * nr + i2);
+                if !(depleted(q1) && depleted(q2)) {
                     continue;
                 }
-                let Some(rf) = front(b, r[i], r[i2], r[i3], phi_v[q2], phi_v[q3]) else {
+                let Some(rf) = front(b, r[i], r[i1], r[i2], phi_v[q1], phi_v[q2]) else {
                     continue;
                 };
                 let e = j * (nr - 1) + i.min(i1);
@@ -90,17 +91,16 @@ pub(crate) fn front_corrected(
             // Axial neighbours.
             for dir in [1isize, -1] {
                 let j1 = j as isize + dir;
-                let j2 = j as isize + OFF * dir;
-                let j3 = j as isize + (OFF + 1) * dir;
-                if j3 < 0 || j3 >= nz as isize {
+                let j2 = j as isize + 2 * dir;
+                if j2 < 0 || j2 >= nz as isize {
                     continue;
                 }
-                let (j1, j2, j3) = (j1 as usize, j2 as usize, j3 as usize);
-                let (q1, q2, q3) = (j1 * nr + i, j2 * nr + i, j3 * nr + i);
-                if !(depleted(q1) && depleted(q2) && depleted(q3)) {
+                let (j1, j2) = (j1 as usize, j2 as usize);
+                let (q1, q2) = (j1 * nr + i, j2 * nr + i);
+                if !(depleted(q1) && depleted(q2)) {
                     continue;
                 }
-                let Some(zf) = front(b, z[j], z[j2], z[j3], phi_v[q2], phi_v[q3]) else {
+                let Some(zf) = front(b, z[j], z[j1], z[j2], phi_v[q1], phi_v[q2]) else {
                     continue;
                 };
                 let e = j.min(j1) * nr + i;
@@ -155,6 +155,28 @@ pub(crate) fn front_splits(
             if gz.abs() >= 0.25 * gr.hypot(gz) || gr.hypot(gz) == 0.0 {
                 split_z[j] = true;
             }
+        }
+    }
+    // An undepleted node next to a contact at another potential: the depleted layer in front of
+    // the contact is thinner than the spacing (low bias on a coarse grid); split that interval so
+    // the layer can appear, else the undepleted bulk would touch the contact.
+    let span = phi_v
+        .iter()
+        .fold(0.0f64, |m, &p| m.max(p.abs()))
+        .max(f64::MIN_POSITIVE);
+    let touches = |n: usize, m: usize| {
+        semi(n)
+            && undepleted[n]
+            && matches!(mesh.kind[m], NodeKind::Contact(_))
+            && (phi_v[m] - phi_v[n]).abs() > 1e-9 * span
+    };
+    for n in 0..nr * nz {
+        let (i, j) = (n % nr, n / nr);
+        if i + 1 < nr && (touches(n, n + 1) || touches(n + 1, n)) {
+            split_r[i] = true;
+        }
+        if j + 1 < nz && (touches(n, n + nr) || touches(n + nr, n)) {
+            split_z[j] = true;
         }
     }
     // Also the neighbouring intervals: the front may move by a cell after the re-solve, and the

@@ -1,6 +1,7 @@
 //! Field solves: potential with depletion, weighting potentials, capacitance matrix.
 
 mod capacitance;
+mod cholesky;
 mod curve;
 mod depletion;
 mod front;
@@ -15,7 +16,7 @@ pub use capacitance::CapacitanceMatrix;
 pub use curve::{CvCurve, CvPoint, cv_curve, normalise_voltages};
 pub use depletion::{PotentialSolution, solve_fast};
 pub use mesh::{Mesh, NodeKind};
-pub use point::{FieldSettings, PointResult, solve_point};
+pub use point::{FieldSettings, PointResult, Seed, solve_point};
 pub use report::{Method, SolveReport, Termination};
 pub use sor::solve_sor;
 pub use weighting::{WeightingPotentials, weighting_potentials};

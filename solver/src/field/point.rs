@@ -68,6 +68,53 @@ impl PointResult {
     }
 }
 
+/// What a neighbouring bias passes on to the next solve: its grid and potential (seeding the
+/// active set) and where its depletion front lay (intervals in mm along r and z), so the next
+/// grid is split there before the first solve.
+#[derive(Debug, Clone)]
+pub struct Seed {
+    /// Grid of the neighbouring solution.
+    pub grid: Grid,
+    /// Its potential, V (may be rescaled to the next bias).
+    pub phi_v: Vec<f64>,
+    /// r intervals (mm) the front crossed.
+    pub front_r_mm: Vec<(f64, f64)>,
+    /// z intervals (mm) the front crossed.
+    pub front_z_mm: Vec<(f64, f64)>,
+}
+
+impl PointResult {
+    /// The seed for a neighbouring bias; the potential is multiplied by `scale` (e.g. the ratio of
+    /// the next bias to this one).
+    pub fn seed(&self, scale: f64) -> Seed {
+        let (sr, sz) = super::front::front_splits(
+            &self.mesh,
+            &self.potential.phi_v,
+            &self.potential.undepleted,
+        );
+        let ranges = |t: &[f64], m: &[bool]| -> Vec<(f64, f64)> {
+            m.iter()
+                .enumerate()
+                .filter(|(_, on)| **on)
+                .map(|(k, _)| (t[k], t[k + 1]))
+                .collect()
+        };
+        Seed {
+            grid: self.mesh.grid.clone(),
+            phi_v: self.potential.phi_v.iter().map(|x| x * scale).collect(),
+            front_r_mm: ranges(self.mesh.grid.r_mm(), &sr),
+            front_z_mm: ranges(self.mesh.grid.z_mm(), &sz),
+        }
+    }
+}
+
+/// Marks the intervals of `t` that overlap any of `ranges` (mm).
+fn overlapping(t: &[f64], ranges: &[(f64, f64)]) -> Vec<bool> {
+    (0..t.len() - 1)
+        .map(|k| ranges.iter().any(|&(a, b)| a < t[k + 1] && b > t[k]))
+        .collect()
+}
+
 /// Indices of the contacts with ids 1 and 2, else the first two contacts.
 pub(crate) fn pair(det: &Detector) -> Result<(usize, usize)> {
     let by_id = |id: u32| det.contacts.iter().position(|c| c.id == id);
@@ -87,13 +134,13 @@ pub(crate) fn pair(det: &Detector) -> Result<(usize, usize)> {
 
 /// Solves the potential at `bias_v` with refinement, then the weighting potentials and C*.
 ///
-/// `seed` may carry a mesh and potential from a neighbouring voltage: its grid is reused as the
-/// starting grid and its potential seeds the active set.
+/// `seed` may carry the solution at a neighbouring voltage: the initial grid is split down to
+/// `front_spacing_mm` where its front lay, and its potential seeds the active set.
 pub fn solve_point(
     det: &Detector,
     bias_v: f64,
     settings: &FieldSettings,
-    seed: Option<(&Grid, &[f64])>,
+    seed: Option<&Seed>,
 ) -> Result<PointResult> {
     settings.validate().map_err(|m| Error::Argument {
         name: "settings".into(),
@@ -109,8 +156,13 @@ pub fn solve_point(
     let gs = &settings.grid;
     let mut grid = Grid::initial(det, gs);
     let mut guess: Option<Vec<f64>> = None;
-    if let Some((g, phi)) = seed {
-        guess = Some(g.interpolate_to(phi, &grid));
+    if let Some(sd) = seed {
+        let sr = overlapping(grid.r_mm(), &sd.front_r_mm);
+        let sz = overlapping(grid.z_mm(), &sd.front_z_mm);
+        if let Some(g) = grid.split(&sr, &sz, gs.front_spacing_mm, gs) {
+            grid = g;
+        }
+        guess = Some(sd.grid.interpolate_to(&sd.phi_v, &grid));
     }
     let mut reports = Vec::new();
     let solve = |mesh: &Mesh, guess: Option<&[f64]>| match settings.method {

@@ -1,14 +1,10 @@
 //! Sparse symmetric systems in "unknown space": fixed nodes eliminated, floating conductors
-//! aggregated into one unknown each, factorised by faer's sparse Cholesky with the symbolic
-//! analysis reused across numeric refactorisations of the same pattern.
-
-use faer::linalg::solvers::Solve;
-use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
-use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
-use faer::{Mat, Side};
+//! aggregated into one unknown each, factorised by sparse Cholesky (`cholesky.rs`) with the
+//! symbolic analysis reused across numeric refactorisations of the same pattern.
 
 use super::Mesh;
-use crate::{Error, Result};
+use super::cholesky::{Factor, Symbolic, nested_dissection};
+use crate::Result;
 
 /// Role of a node in one linear problem.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -38,6 +34,8 @@ pub(crate) struct System {
     pub mirror: Vec<usize>,
     /// Right-hand side: fixed charges plus couplings to fixed nodes (C).
     pub rhs: Vec<f64>,
+    /// Grid size (nr, nz) the nodes live on.
+    dims: (usize, usize),
 }
 
 impl System {
@@ -138,7 +136,30 @@ impl System {
             diag_pos,
             mirror,
             rhs,
+            dims: (mesh.grid.nr(), mesh.grid.nz()),
         }
+    }
+
+    /// Elimination order of the unknowns: nested dissection of the grid nodes, each unknown at
+    /// its first node; floating-conductor unknowns (many nodes) last.
+    fn order(&self) -> Vec<usize> {
+        let mut seen = vec![false; self.n];
+        let mut count = vec![0usize; self.n];
+        for u in self.node_unknown.iter().flatten() {
+            count[*u] += 1;
+        }
+        let mut order = Vec::with_capacity(self.n);
+        for k in nested_dissection(self.dims.0, self.dims.1) {
+            if let Some(u) = self.node_unknown[k]
+                && count[u] == 1
+                && !seen[u]
+            {
+                seen[u] = true;
+                order.push(u);
+            }
+        }
+        order.extend((0..self.n).filter(|&u| !seen[u]));
+        order
     }
 
     /// y = A x with the stored values `val` (same pattern).
@@ -153,40 +174,23 @@ impl System {
     }
 
     /// The symbolic Cholesky analysis of the pattern (reusable for any values).
-    pub fn symbolic(&self) -> Result<SymbolicLlt<usize>> {
-        let sym = SymbolicSparseColMatRef::new_checked(
-            self.n,
-            self.n,
-            &self.col_ptr,
-            None,
-            &self.row_idx,
-        );
-        SymbolicLlt::try_new(sym, Side::Lower).map_err(|e| Error::Singular {
-            reason: format!("symbolic factorisation failed: {e:?}"),
-        })
+    pub fn symbolic(&self) -> Result<Symbolic> {
+        let order = if std::env::var("HPGE_AMD").is_ok() {
+            None
+        } else {
+            Some(self.order())
+        };
+        Symbolic::new(self.n, &self.col_ptr, &self.row_idx, order.as_deref())
     }
 
     /// Factorises the matrix with values `val` and solves for `rhs`.
-    pub fn solve(&self, sym: &SymbolicLlt<usize>, val: &[f64], rhs: &[f64]) -> Result<Vec<f64>> {
-        let llt = self.factor(sym, val)?;
-        Ok(solve_with(&llt, rhs))
+    pub fn solve(&self, sym: &Symbolic, val: &[f64], rhs: &[f64]) -> Result<Vec<f64>> {
+        Ok(self.factor(sym, val)?.solve(rhs))
     }
 
     /// Numeric Cholesky factorisation with values `val`.
-    pub fn factor(&self, sym: &SymbolicLlt<usize>, val: &[f64]) -> Result<Llt<usize, f64>> {
-        let symbolic = SymbolicSparseColMatRef::new_checked(
-            self.n,
-            self.n,
-            &self.col_ptr,
-            None,
-            &self.row_idx,
-        );
-        let mat = SparseColMatRef::new(symbolic, val);
-        Llt::try_new_with_symbolic(sym.clone(), mat, Side::Lower).map_err(|e| Error::Singular {
-            reason: format!(
-                "the field matrix is not positive definite ({e:?}): is some region cut off from every fixed potential?"
-            ),
-        })
+    pub fn factor(&self, sym: &Symbolic, val: &[f64]) -> Result<Factor> {
+        sym.factor(&self.col_ptr, &self.row_idx, val)
     }
 
     /// The right-hand side for other fixed potentials on the same fixed nodes (no charges):
@@ -220,11 +224,4 @@ impl System {
             .map(|(u, f)| u.map_or(*f, |u| x[u]))
             .collect()
     }
-}
-
-/// Solves with an existing factorisation.
-pub(crate) fn solve_with(llt: &Llt<usize, f64>, rhs: &[f64]) -> Vec<f64> {
-    let mut b = Mat::from_fn(rhs.len(), 1, |i, _| rhs[i]);
-    llt.solve_in_place(b.as_mut());
-    (0..rhs.len()).map(|i| b[(i, 0)]).collect()
 }

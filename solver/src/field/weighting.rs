@@ -6,7 +6,7 @@
 //! touching nothing is a floating conductor (one unknown potential, zero net charge).
 
 use super::mesh::{Mesh, NodeKind};
-use super::system::{Dof, System, solve_with};
+use super::system::{Dof, System};
 use crate::{Detector, Error, Result};
 
 /// What an undepleted node belongs to.
@@ -161,7 +161,7 @@ pub fn weighting_potentials(
         let mine: Vec<bool> = own.iter().map(|o| *o == Some(Owner::Contact(k))).collect();
         let fixed: Vec<f64> = mine.iter().map(|&m| if m { 1.0 } else { 0.0 }).collect();
         let x = match &llt {
-            Some(llt) => solve_with(llt, &sys.rhs_for_fixed(mesh, &fixed)),
+            Some(llt) => llt.solve(&sys.rhs_for_fixed(mesh, &fixed)),
             None => Vec::new(),
         };
         w.push(sys.to_nodes_with(&x, &fixed));

@@ -4,9 +4,13 @@ use serde::{Deserialize, Serialize};
 
 /// How the (r, z) grid is built and refined.
 ///
-/// Defaults follow the paper's SolidStateDetectors.jl settings where they exist (section 5:
-/// refinement limits, max_distance_ratio 3.0, min_tick_distance 10 um); the initial spacings are
-/// this project's choice (2D needs no azimuthal ticks).
+/// Defaults: max_distance_ratio 3.0 and min_tick_distance 10 um as in the paper's
+/// SolidStateDetectors.jl settings (section 5); the spacings and the front refinement are this
+/// project's, chosen by measurement (reports/solver-status.md): with the depletion front located
+/// inside its cell (`field/front.rs`) c12 is converged to about 0.1% on Super-Siegfried and within
+/// 0.1% of the closed form on the long coax at 1 mm in the crystal and 0.25 mm across the front.
+/// The paper's potential-difference refinement (`GridSettings::paper_refinement_limits`) changes
+/// c12 by less than 0.2% there at 10-100x the nodes, so it is off by default.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct GridSettings {
@@ -21,12 +25,13 @@ pub struct GridSettings {
     pub max_distance_ratio: f64,
     /// Refinement passes: in pass k, every interval across which the potential changes by more
     /// than `refinement_limits[k]` times the largest contact-potential difference is halved
-    /// (paper: [0.2, 0.2, 0.1, 0.1, 0.1, 0.05, 0.03, 0.02, 0.01]).
+    /// (paper: [`GridSettings::paper_refinement_limits`]; default: none).
     pub refinement_limits: Vec<f64>,
     /// Largest spacing (mm) across the depletion front: intervals between an undepleted and a
     /// depleted semiconductor node are halved until they are at most this wide. The front is a
-    /// free boundary located to the nearest node, so c12's error is O(spacing / depleted depth)
-    /// (DESIGN.md: 1.1% at 25 V on the long coax with 50-100 um, 0.15% with 20 um).
+    /// free boundary located to the nearest node and then inside its cell (vertex of the parabola
+    /// through the potential next to it, second order); on the long coax at 25 V the c12 error is
+    /// 2.5e-4 at 0.05 mm, 9.8e-4 at 0.25 mm, 5.3e-3 at 0.5 mm (default 0.25 mm).
     pub front_spacing_mm: f64,
 }
 
@@ -37,13 +42,18 @@ impl Default for GridSettings {
             max_spacing_mm: 4.0,
             min_tick_distance_mm: 0.01,
             max_distance_ratio: 3.0,
-            refinement_limits: vec![0.2, 0.2, 0.1, 0.1, 0.1, 0.05, 0.03, 0.02, 0.01],
-            front_spacing_mm: 0.05,
+            refinement_limits: Vec::new(),
+            front_spacing_mm: 0.25,
         }
     }
 }
 
 impl GridSettings {
+    /// The paper's refinement limits (section 5): [0.2, 0.2, 0.1, 0.1, 0.1, 0.05, 0.03, 0.02, 0.01].
+    pub fn paper_refinement_limits() -> Vec<f64> {
+        vec![0.2, 0.2, 0.1, 0.1, 0.1, 0.05, 0.03, 0.02, 0.01]
+    }
+
     /// Checks every field; the message names the field.
     pub fn validate(&self) -> Result<(), String> {
         let pos = |name: &str, v: f64| {
