@@ -18,4 +18,22 @@ $bin detector --detector detectors/super-siegfried-k1.toml \
 # The validation coax and the point-contact example.
 $bin detector --detector detectors/coax-analytic.toml --plot "$out/coax-analytic.png" > /dev/null
 $bin detector --detector detectors/ppc-example.toml --plot "$out/ppc-example.png" > /dev/null
-echo "figures written to $out/"
+
+# The simulated C-V curve of the manufacturer model with d_Li = 1 mm (the paper's section 5) and the
+# potential with the undepleted region at 1025 V.
+data=reports/data
+mkdir -p "$data"
+$bin simulate --detector detectors/super-siegfried-k1.toml --d-li 1 --voltages 25:2975:50 --json \
+  --out "$data/super-siegfried-k1-manufacturer-cv.csv" \
+  --plot "$out/super-siegfried-k1-manufacturer-cv.png" \
+  --field 1025 --field-plot "$out/super-siegfried-k1-manufacturer-field-1025V.png" \
+  > "$data/super-siegfried-k1-manufacturer-cv.json"
+$bin simulate --detector detectors/super-siegfried-k1.toml --d-li 1 --voltages 25:2975:50 \
+  --plot "$out/super-siegfried-k1-manufacturer-cv.svg" > /dev/null
+# The paper's sensitivity scan: c12 at 25 V for constant densities 1e7..2e11 cm^-3.
+$bin sensitivity --detector detectors/super-siegfried-k1.toml --param d_li_mm=1 --voltage 25 \
+  --zeta-range 1e7:2e11:18 --out "$data/sensitivity-scan-25V.csv" \
+  --plot "$out/super-siegfried-k1-sensitivity-25V.png" > /dev/null
+$bin sensitivity --detector detectors/super-siegfried-k1.toml --param d_li_mm=1 --voltage 25 \
+  --zeta-range 1e7:2e11:18 --plot "$out/super-siegfried-k1-sensitivity-25V.svg" > /dev/null
+echo "figures written to $out/, data to $data/"

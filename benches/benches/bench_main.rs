@@ -3,6 +3,7 @@
 use criterion::{criterion_group, criterion_main};
 
 mod impurity;
+mod solver;
 
-criterion_group!(benches, impurity::bench);
+criterion_group!(benches, impurity::bench, solver::bench);
 criterion_main!(benches);

@@ -25,9 +25,10 @@ pub use detector::{
 pub use error::{Error, Result};
 pub use expr::Parameters;
 pub use field::{
-    CapacitanceMatrix, CvCurve, CvPoint, FieldSettings, Mesh, Method, NodeKind, PointResult,
-    PotentialSolution, Seed, SolveReport, Termination, WeightingPotentials, cv_curve,
-    normalise_voltages, solve_fast, solve_point, solve_sor, weighting_potentials,
+    CapacitanceMatrix, CvCurve, CvPoint, FieldSettings, Mesh, Method, NodeKind,
+    PAPER_EPSILON_FACTOR, PointResult, PotentialSolution, Seed, SolveReport, Termination,
+    WeightingMode, WeightingPotentials, cv_curve, full_depletion_voltage, normalise_voltages,
+    solve_fast, solve_point, solve_sor, weighting_potentials,
 };
 pub use geometry::{BoundingBox, Primitive, Solid};
 pub use grid::{Grid, GridSettings};

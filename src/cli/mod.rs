@@ -3,6 +3,7 @@
 mod args;
 mod detector;
 mod impurity;
+mod sensitivity;
 mod simulate;
 
 use std::path::PathBuf;
@@ -11,6 +12,7 @@ use anyhow::Result;
 use clap::{Parser, Subcommand};
 
 pub use args::{parse_param, parse_point, parse_voltages};
+pub use sensitivity::ScanPoint;
 
 /// Impurity densities of HPGe detectors from capacitance-voltage curves: field solver, neural
 /// surrogate and Bayesian inference (Abt et al., EPJ C 2023).
@@ -32,7 +34,38 @@ enum Command {
     Simulate(SimulateArgs),
     /// The full Maxwell capacitance matrix at one bias.
     Capacitance(CapacitanceArgs),
+    /// c12 at one bias for constant impurity densities (the paper's sensitivity scan).
+    Sensitivity(SensitivityArgs),
 }
+
+#[derive(Debug, clap::Args)]
+struct SensitivityArgs {
+    #[command(flatten)]
+    input: DetectorInput,
+    /// Bias voltage in V.
+    #[arg(
+        long,
+        value_name = "U",
+        default_value_t = 25.0,
+        allow_hyphen_values = true
+    )]
+    voltage: f64,
+    /// Densities MIN:MAX:N in cm^-3, N values spaced evenly in log.
+    #[arg(long = "zeta-range", value_name = "MIN:MAX:N", default_value = "1e7:2e11:18", value_parser = sensitivity::parse_range)]
+    zeta_range: ZetaList,
+    /// Print exactly one JSON object on stdout.
+    #[arg(long)]
+    json: bool,
+    /// Write the scan as CSV (zeta_cm3,c12_pF,fully_depleted).
+    #[arg(long, value_name = "FILE")]
+    out: Option<PathBuf>,
+    /// Draw c12 against the density (.svg or .png).
+    #[arg(long, value_name = "FILE")]
+    plot: Option<PathBuf>,
+}
+
+/// A parsed list of densities (cm^-3).
+type ZetaList = Vec<f64>;
 
 /// The potential method.
 #[derive(Debug, Clone, Copy, clap::ValueEnum)]
@@ -52,6 +85,24 @@ impl From<MethodArg> for hpge_solver::Method {
     }
 }
 
+/// How undepleted semiconductor enters the weighting potentials.
+#[derive(Debug, Clone, Copy, clap::ValueEnum)]
+enum WeightingArg {
+    /// Undepleted regions are conductors ending at the sub-cell depletion front (exact; default).
+    Conductor,
+    /// The paper's approach: eps_r x 1e5 in undepleted semiconductor (for comparison).
+    PaperEpsilon,
+}
+
+impl From<WeightingArg> for hpge_solver::WeightingMode {
+    fn from(m: WeightingArg) -> Self {
+        match m {
+            WeightingArg::Conductor => hpge_solver::WeightingMode::Conductor,
+            WeightingArg::PaperEpsilon => hpge_solver::WeightingMode::PaperEpsilon,
+        }
+    }
+}
+
 #[derive(Debug, clap::Args)]
 struct SimulateArgs {
     #[command(flatten)]
@@ -65,6 +116,9 @@ struct SimulateArgs {
     /// Potential method.
     #[arg(long, value_enum, default_value = "fast")]
     method: MethodArg,
+    /// Weighting-potential mode.
+    #[arg(long, value_enum, default_value = "conductor")]
+    weighting: WeightingArg,
     /// Print exactly one JSON object on stdout.
     #[arg(long)]
     json: bool,
@@ -92,6 +146,9 @@ struct CapacitanceArgs {
     /// Potential method.
     #[arg(long, value_enum, default_value = "fast")]
     method: MethodArg,
+    /// Weighting-potential mode.
+    #[arg(long, value_enum, default_value = "conductor")]
+    weighting: WeightingArg,
     /// Print exactly one JSON object on stdout.
     #[arg(long)]
     json: bool,
@@ -149,6 +206,7 @@ pub fn run(cli: Cli) -> Result<()> {
                 d_li_mm: a.d_li,
                 voltages: &volts,
                 method: a.method.into(),
+                weighting: a.weighting.into(),
                 json: a.json,
                 out: a.out.as_ref(),
                 plot: a.plot.as_ref(),
@@ -156,8 +214,21 @@ pub fn run(cli: Cli) -> Result<()> {
                 field_plot: a.field_plot.as_ref(),
             })
         }
+        Command::Sensitivity(a) => sensitivity::run(&sensitivity::SensitivityOptions {
+            input: &a.input,
+            voltage_v: a.voltage,
+            zetas_cm3: &a.zeta_range,
+            json: a.json,
+            out: a.out.as_ref(),
+            plot: a.plot.as_ref(),
+        }),
         Command::Capacitance(a) => {
-            simulate::capacitance(&a.input, a.voltage, a.method.into(), a.json)
+            let settings = hpge_solver::FieldSettings {
+                method: a.method.into(),
+                weighting: a.weighting.into(),
+                ..hpge_solver::FieldSettings::default()
+            };
+            simulate::capacitance(&a.input, a.voltage, &settings, a.json)
         }
     }
 }

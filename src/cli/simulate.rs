@@ -4,7 +4,9 @@ use std::io::Write;
 use std::path::PathBuf;
 
 use anyhow::{Context, Result, bail};
-use hpge_solver::{CvCurve, FieldSettings, Method, cv_curve, normalise_voltages, solve_point};
+use hpge_solver::{
+    CvCurve, FieldSettings, Method, WeightingMode, cv_curve, normalise_voltages, solve_point,
+};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::json;
 
@@ -18,6 +20,7 @@ pub struct SimulateOptions<'a> {
     pub d_li_mm: Option<f64>,
     pub voltages: &'a [f64],
     pub method: Method,
+    pub weighting: WeightingMode,
     pub json: bool,
     pub out: Option<&'a PathBuf>,
     pub plot: Option<&'a PathBuf>,
@@ -68,6 +71,7 @@ pub fn run(o: &SimulateOptions<'_>) -> Result<()> {
     }
     let settings = FieldSettings {
         method: o.method,
+        weighting: o.weighting,
         ..FieldSettings::default()
     };
     let bar = ProgressBar::new(volts.len() as u64);
@@ -103,6 +107,7 @@ pub fn run(o: &SimulateOptions<'_>) -> Result<()> {
             "grid": {"nr": last.0, "nz": last.1},
             "grid_per_point": curve.points.iter().map(|p| json!({"nr": p.grid.0, "nz": p.grid.1})).collect::<Vec<_>>(),
             "method": o.method.as_str(),
+            "weighting": o.weighting.as_str(),
             "seconds": seconds,
             "detector": det.file.display().to_string(),
             "impurity_file": det.semiconductor.impurity_file().display().to_string(),
@@ -122,9 +127,7 @@ pub fn run(o: &SimulateOptions<'_>) -> Result<()> {
             );
         }
         match curve.depletion_voltage_v {
-            Some(v) => println!(
-                "full depletion at or below {v} V (lowest listed bias with no undepleted node)"
-            ),
+            Some(v) => println!("full-depletion voltage {v:.1} V"),
             None => println!("not fully depleted at any listed bias"),
         }
         println!(
@@ -150,18 +153,14 @@ fn write_csv(path: &std::path::Path, curve: &CvCurve) -> Result<()> {
 pub fn capacitance(
     input: &DetectorInput,
     voltage: f64,
-    method: Method,
+    settings: &FieldSettings,
     as_json: bool,
 ) -> Result<()> {
     if !(voltage.is_finite() && voltage > 0.0) {
         bail!("--voltage {voltage}: the bias must be a positive number of volts");
     }
     let det = load_detector(input)?;
-    let settings = FieldSettings {
-        method,
-        ..FieldSettings::default()
-    };
-    let p = solve_point(&det, voltage, &settings, None)?;
+    let p = solve_point(&det, voltage, settings, None)?;
     let c = &p.capacitance;
     if as_json {
         let v = json!({
@@ -172,7 +171,8 @@ pub fn capacitance(
             "c12_pF": p.c12_pf,
             "fully_depleted": p.fully_depleted(),
             "grid": {"nr": p.mesh.grid.nr(), "nz": p.mesh.grid.nz()},
-            "method": method.as_str(),
+            "method": settings.method.as_str(),
+            "weighting": settings.weighting.as_str(),
             "detector": det.file.display().to_string(),
             "version": env!("CARGO_PKG_VERSION"),
         });

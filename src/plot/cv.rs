@@ -88,7 +88,9 @@ fn draw<DB: DrawingBackend>(
                 red.stroke_width(2),
             ))
             .map_err(err)?
-            .label(format!("fully depleted from {vd} V (filled points)"))
+            .label(format!(
+                "full-depletion voltage {vd:.1} V (filled points: fully depleted)"
+            ))
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], red.stroke_width(2)));
     }
     if curve.depletion_voltage_v.is_none() {

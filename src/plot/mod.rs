@@ -38,12 +38,14 @@ mod colormap;
 mod cross_section;
 mod cv;
 mod field;
+mod sensitivity;
 
 use std::path::Path;
 
 pub use cross_section::cross_section;
 pub use cv::cv_curve;
 pub use field::field_map;
+pub use sensitivity::sensitivity;
 
 /// Output format, chosen by the file extension.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

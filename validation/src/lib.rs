@@ -7,10 +7,12 @@
 
 mod coax;
 mod error;
+mod planar;
 mod radial1d;
 
 pub use coax::{COAX_REFERENCE_TABLE, LongCoax};
 pub use error::{Error, Result};
+pub use planar::PlanarPn;
 pub use radial1d::{DEFAULT_NODES, MIN_NODES, RadialReference, RadialSolution};
 
 /// Absolute path of a file shipped in the repository (e.g. `detectors/coax-analytic.toml`).

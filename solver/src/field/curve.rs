@@ -2,6 +2,7 @@
 
 use serde::Serialize;
 
+use super::full_depletion::full_depletion_voltage;
 use super::point::{FieldSettings, Seed, solve_point};
 use crate::{Detector, Error, Result};
 
@@ -31,7 +32,10 @@ pub struct CvPoint {
 pub struct CvCurve {
     /// The points, in increasing voltage.
     pub points: Vec<CvPoint>,
-    /// Lowest listed bias with no undepleted semiconductor node (V), if any.
+    /// Full-depletion voltage (V): the lowest bias at which no semiconductor is undepleted,
+    /// between the last listed bias that is not fully depleted (or 0 V) and the first that is,
+    /// from the unconstrained potential on the first fully depleted point's grid
+    /// (`full_depletion_voltage`); None when no listed bias depletes the detector.
     pub depletion_voltage_v: Option<f64>,
 }
 
@@ -105,10 +109,15 @@ pub fn cv_curve(
     for part in parts {
         points.extend(part?);
     }
-    let depletion_voltage_v = points
-        .iter()
-        .find(|p| p.fully_depleted)
-        .map(|p| p.voltage_v);
+    let depletion_voltage_v = match points.iter().position(|p| p.fully_depleted) {
+        Some(k) => {
+            let lo = if k > 0 { points[k - 1].voltage_v } else { 0.0 };
+            let hi = points[k].voltage_v;
+            let p = solve_point(det, hi, settings, None)?;
+            Some(full_depletion_voltage(&p.mesh, det, lo, hi)?)
+        }
+        None => None,
+    };
     Ok(CvCurve {
         points,
         depletion_voltage_v,

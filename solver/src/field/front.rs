@@ -13,21 +13,55 @@
 
 use super::mesh::{Mesh, NodeKind};
 
-/// A copy of `mesh` whose edge conductances across the depletion front are corrected for the
-/// sub-cell front position. Returns the corrected mesh and the number of edges corrected.
-pub(crate) fn front_corrected(
+/// The front found inside one cell along a grid line.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Crossing {
+    /// Index into `w_r` (radial) or `w_z` (axial) of the edge p-q1.
+    pub edge: usize,
+    /// Along r (else z).
+    pub radial: bool,
+    /// Interval index (along the line's axis) of the edge.
+    pub interval: usize,
+    /// Coordinates (mm along the axis) of p, q1 and the front.
+    pub xp: f64,
+    pub x1: f64,
+    pub xf: f64,
+    /// p is a contact node at a bound: an undepleted layer thinner than the cell separates the
+    /// contact from the depleted region (no node is undepleted there).
+    pub at_contact: bool,
+}
+
+/// Front position along a line through p (u = 0), q1 and q2 (depleted), u = |B - phi|: the vertex
+/// of the parabola through the three points, or None when the data are not parabola-like.
+fn vertex(b: f64, xp: f64, x1: f64, x2: f64, p1: f64, p2: f64) -> Option<f64> {
+    let (u1, u2) = ((b - p1).abs(), (b - p2).abs());
+    let f01 = u1 / (x1 - xp);
+    let f12 = (u2 - u1) / (x2 - x1);
+    let a = (f12 - f01) / (x2 - xp);
+    if !(a > 0.0 && u1 > 0.0 && u2 > u1) {
+        return None;
+    }
+    Some(0.5 * (xp + x1) - f01 / (2.0 * a))
+}
+
+/// Every sub-cell front crossing: along each grid line from an anchor p (an undepleted
+/// semiconductor node, or a contact node at a bound) over two depleted nodes q1, q2.
+///
+/// For an undepleted p the front is clamped between half a spacing behind p and a tenth of a
+/// spacing before q1. For a contact p it must lie in front of the contact (between p and a tenth
+/// of a spacing before q1) by more than 1e-3 of the spacing, else there is no layer.
+pub(crate) fn crossings(
     mesh: &Mesh,
     phi_v: &[f64],
     undepleted: &[bool],
     bounds_v: (f64, f64),
-) -> (Mesh, usize) {
-    let mut out = mesh.clone();
+) -> Vec<Crossing> {
     let g = &mesh.grid;
     let (nr, nz) = (g.nr(), g.nz());
-    let r = g.r_mm();
-    let z = g.z_mm();
+    let (r, z) = (g.r_mm(), g.z_mm());
     let semi = |n: usize| mesh.kind[n] == NodeKind::Semiconductor;
     let depleted = |n: usize| semi(n) && !undepleted[n];
+    let span = (bounds_v.1 - bounds_v.0).abs().max(f64::MIN_POSITIVE);
     let bound_of = |n: usize| {
         if (phi_v[n] - bounds_v.1).abs() <= (phi_v[n] - bounds_v.0).abs() {
             bounds_v.1
@@ -35,81 +69,89 @@ pub(crate) fn front_corrected(
             bounds_v.0
         }
     };
-    // Front position along a line through p (undepleted, u = 0), q1 and q2 (depleted), u = |B - phi|:
-    // the vertex of the parabola through the three points.
-    let front = |b: f64, xp: f64, x1: f64, x2: f64, p1: f64, p2: f64| -> Option<f64> {
-        let (u1, u2) = ((b - p1).abs(), (b - p2).abs());
-        let f01 = u1 / (x1 - xp);
-        let f12 = (u2 - u1) / (x2 - x1);
-        let a = (f12 - f01) / (x2 - xp);
-        if !(a > 0.0 && u1 > 0.0 && u2 > u1) {
-            return None;
-        }
-        let xf = 0.5 * (xp + x1) - f01 / (2.0 * a);
-        let h = x1 - xp;
-        // Between half a spacing behind p and a tenth of a spacing before q1 (h may be negative).
-        let lo = xp - 0.5 * h;
-        let hi = x1 - 0.1 * h;
-        let (a, c) = if lo < hi { (lo, hi) } else { (hi, lo) };
-        Some(xf.clamp(a, c))
-    };
-    let mut count = 0;
-    for j in 0..nz {
-        for i in 0..nr {
-            let p = j * nr + i;
-            if !(semi(p) && undepleted[p]) {
+    let mut out = Vec::new();
+    for p in 0..nr * nz {
+        let at_contact = match mesh.kind[p] {
+            NodeKind::Semiconductor if undepleted[p] => false,
+            NodeKind::Contact(_) if (phi_v[p] - bound_of(p)).abs() <= 1e-9 * span => true,
+            _ => continue,
+        };
+        let b = bound_of(p);
+        let (i, j) = ((p % nr) as isize, (p / nr) as isize);
+        for (di, dj) in [(1isize, 0isize), (-1, 0), (0, 1), (0, -1)] {
+            let (i2, j2) = (i + 2 * di, j + 2 * dj);
+            if i2 < 0 || j2 < 0 || i2 >= nr as isize || j2 >= nz as isize {
                 continue;
             }
-            let b = bound_of(p);
-            // Radial neighbours: direction +1 and -1.
-            for dir in [1isize, -1] {
-                let i1 = i as isize + dir;
-                let i2 = i as isize + 2 * dir;
-                if i2 < 0 || i2 >= nr as isize {
-                    continue;
-                }
-                let (i1, i2) = (i1 as usize, i2 as usize);
-                let (q1, q2) = (j * nr + i1, j * nr + i2);
-                if !(depleted(q1) && depleted(q2)) {
-                    continue;
-                }
-                let Some(rf) = front(b, r[i], r[i1], r[i2], phi_v[q1], phi_v[q2]) else {
-                    continue;
-                };
-                let e = j * (nr - 1) + i.min(i1);
-                let (rp, r1) = (r[i], r[i1]);
-                let scale = if rp > 0.0 && rf > 0.0 && r1 > 0.0 {
-                    (r1 / rp).ln() / (r1 / rf).ln()
-                } else {
-                    (r1 - rp) / (r1 - rf)
-                };
-                if scale.is_finite() && scale > 0.0 {
-                    out.w_r[e] = mesh.w_r[e] * scale;
-                    count += 1;
-                }
+            let q1 = ((j + dj) as usize) * nr + (i + di) as usize;
+            let q2 = (j2 as usize) * nr + i2 as usize;
+            if !(depleted(q1) && depleted(q2)) {
+                continue;
             }
-            // Axial neighbours.
-            for dir in [1isize, -1] {
-                let j1 = j as isize + dir;
-                let j2 = j as isize + 2 * dir;
-                if j2 < 0 || j2 >= nz as isize {
-                    continue;
-                }
-                let (j1, j2) = (j1 as usize, j2 as usize);
-                let (q1, q2) = (j1 * nr + i, j2 * nr + i);
-                if !(depleted(q1) && depleted(q2)) {
-                    continue;
-                }
-                let Some(zf) = front(b, z[j], z[j1], z[j2], phi_v[q1], phi_v[q2]) else {
-                    continue;
-                };
-                let e = j.min(j1) * nr + i;
-                let scale = (z[j1] - z[j]) / (z[j1] - zf);
-                if scale.is_finite() && scale > 0.0 {
-                    out.w_z[e] = mesh.w_z[e] * scale;
-                    count += 1;
-                }
+            let radial = di != 0;
+            let (t, k0, k1, k2) = if radial {
+                (r, i as usize, (i + di) as usize, i2 as usize)
+            } else {
+                (z, j as usize, (j + dj) as usize, j2 as usize)
+            };
+            let Some(xv) = vertex(b, t[k0], t[k1], t[k2], phi_v[q1], phi_v[q2]) else {
+                continue;
+            };
+            let (xp, x1) = (t[k0], t[k1]);
+            let h = x1 - xp;
+            let lo = if at_contact { xp } else { xp - 0.5 * h };
+            let hi = x1 - 0.1 * h;
+            let (a, c) = if lo < hi { (lo, hi) } else { (hi, lo) };
+            let xf = xv.clamp(a, c);
+            if at_contact && (xf - xp).abs() <= 1e-3 * h.abs() {
+                continue;
             }
+            let interval = k0.min(k1);
+            let edge = if radial {
+                j as usize * (nr - 1) + interval
+            } else {
+                interval * nr + i as usize
+            };
+            out.push(Crossing {
+                edge,
+                radial,
+                interval,
+                xp,
+                x1,
+                xf,
+                at_contact,
+            });
+        }
+    }
+    out
+}
+
+/// A copy of `mesh` whose edge conductances across the depletion front are corrected for the
+/// sub-cell front position (every `Crossing`). Returns the corrected mesh and the number of edges
+/// corrected.
+pub(crate) fn front_corrected(
+    mesh: &Mesh,
+    phi_v: &[f64],
+    undepleted: &[bool],
+    bounds_v: (f64, f64),
+) -> (Mesh, usize) {
+    let mut out = mesh.clone();
+    let mut count = 0;
+    for c in crossings(mesh, phi_v, undepleted, bounds_v) {
+        let (rp, r1, rf) = (c.xp, c.x1, c.xf);
+        let scale = if c.radial && rp > 0.0 && rf > 0.0 && r1 > 0.0 {
+            (r1 / rp).ln() / (r1 / rf).ln()
+        } else {
+            (r1 - rp) / (r1 - rf)
+        };
+        if scale.is_finite() && scale > 0.0 {
+            let w = if c.radial {
+                &mut out.w_r[c.edge]
+            } else {
+                &mut out.w_z[c.edge]
+            };
+            *w *= scale;
+            count += 1;
         }
     }
     (out, count)
@@ -125,6 +167,7 @@ pub(crate) fn front_splits(
     mesh: &Mesh,
     phi_v: &[f64],
     undepleted: &[bool],
+    bounds_v: (f64, f64),
 ) -> (Vec<bool>, Vec<bool>) {
     let g = &mesh.grid;
     let (nr, nz) = (g.nr(), g.nz());
@@ -157,8 +200,8 @@ pub(crate) fn front_splits(
             }
         }
     }
-    // An undepleted node next to a contact at another potential: the depleted layer in front of
-    // the contact is thinner than the spacing (low bias on a coarse grid); split that interval so
+    // An undepleted node next to a contact or grounded part at another potential: the depleted
+    // layer in front of it is thinner than the spacing (low bias on a coarse grid); split that interval so
     // the layer can appear, else the undepleted bulk would touch the contact.
     let span = phi_v
         .iter()
@@ -167,7 +210,7 @@ pub(crate) fn front_splits(
     let touches = |n: usize, m: usize| {
         semi(n)
             && undepleted[n]
-            && matches!(mesh.kind[m], NodeKind::Contact(_))
+            && matches!(mesh.kind[m], NodeKind::Contact(_) | NodeKind::Grounded)
             && (phi_v[m] - phi_v[n]).abs() > 1e-9 * span
     };
     for n in 0..nr * nz {
@@ -177,6 +220,17 @@ pub(crate) fn front_splits(
         }
         if j + 1 < nz && (touches(n, n + nr) || touches(n + nr, n)) {
             split_z[j] = true;
+        }
+    }
+    // An undepleted layer thinner than the first cell in front of a contact (near full depletion):
+    // split that cell so the layer gets nodes.
+    for c in crossings(mesh, phi_v, undepleted, bounds_v) {
+        if c.at_contact {
+            if c.radial {
+                split_r[c.interval] = true;
+            } else {
+                split_z[c.interval] = true;
+            }
         }
     }
     // Also the neighbouring intervals: the front may move by a cell after the re-solve, and the

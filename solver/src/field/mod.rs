@@ -5,6 +5,7 @@ mod cholesky;
 mod curve;
 mod depletion;
 mod front;
+mod full_depletion;
 mod mesh;
 mod point;
 mod report;
@@ -15,8 +16,11 @@ mod weighting;
 pub use capacitance::CapacitanceMatrix;
 pub use curve::{CvCurve, CvPoint, cv_curve, normalise_voltages};
 pub use depletion::{PotentialSolution, solve_fast};
+pub use full_depletion::full_depletion_voltage;
 pub use mesh::{Mesh, NodeKind};
 pub use point::{FieldSettings, PointResult, Seed, solve_point};
 pub use report::{Method, SolveReport, Termination};
 pub use sor::solve_sor;
-pub use weighting::{WeightingPotentials, weighting_potentials};
+pub use weighting::{
+    PAPER_EPSILON_FACTOR, WeightingMode, WeightingPotentials, weighting_potentials,
+};

@@ -6,7 +6,10 @@ use super::capacitance::CapacitanceMatrix;
 use super::depletion::{PotentialSolution, solve_fast};
 use super::mesh::{Mesh, NodeKind};
 use super::report::{Method, SolveReport};
-use super::weighting::{WeightingPotentials, weighting_potentials};
+use super::weighting::{
+    PAPER_EPSILON_FACTOR, WeightingMode, WeightingPotentials, paper_epsilon_mesh,
+    weighting_potentials,
+};
 use crate::grid::{Grid, GridSettings};
 use crate::{Detector, Error, Result};
 
@@ -20,7 +23,10 @@ pub struct FieldSettings {
     pub method: Method,
     /// Locate the depletion front inside its cell and carry it into the weighting potentials
     /// (see `field/front.rs`); off: the front sits on nodes, as in SolidStateDetectors.jl.
+    /// Used by `WeightingMode::Conductor` only.
     pub subcell_front: bool,
+    /// How undepleted semiconductor enters the weighting potentials.
+    pub weighting: WeightingMode,
 }
 
 impl Default for FieldSettings {
@@ -29,6 +35,7 @@ impl Default for FieldSettings {
             grid: GridSettings::default(),
             method: Method::Fast,
             subcell_front: true,
+            weighting: WeightingMode::Conductor,
         }
     }
 }
@@ -57,14 +64,19 @@ pub struct PointResult {
     pub c12_pf: f64,
     /// Number of undepleted semiconductor nodes.
     pub undepleted_nodes: usize,
+    /// Grid lines on which an undepleted layer thinner than the first cell sits in front of a
+    /// contact (found by the sub-cell front; no node is undepleted there).
+    pub contact_layers: usize,
     /// Reports of the potential solves (one per refinement pass).
     pub reports: Vec<SolveReport>,
 }
 
 impl PointResult {
     /// True when no semiconductor node is undepleted.
+    /// True when no semiconductor is undepleted: no undepleted node and no sub-cell layer in
+    /// front of a contact.
     pub fn fully_depleted(&self) -> bool {
-        self.undepleted_nodes == 0
+        self.undepleted_nodes == 0 && self.contact_layers == 0
     }
 }
 
@@ -91,6 +103,7 @@ impl PointResult {
             &self.mesh,
             &self.potential.phi_v,
             &self.potential.undepleted,
+            self.potential.bounds_v,
         );
         let ranges = |t: &[f64], m: &[bool]| -> Vec<(f64, f64)> {
             m.iter()
@@ -192,22 +205,38 @@ pub fn solve_point(
     }
     // Resolve the depletion front: divide the intervals it crosses down to front_spacing_mm.
     loop {
-        let (split_r, split_z) = super::front::front_splits(&mesh, &pot.phi_v, &pot.undepleted);
+        let (split_r, split_z) =
+            super::front::front_splits(&mesh, &pot.phi_v, &pot.undepleted, pot.bounds_v);
         let Some(finer) = grid.split(&split_r, &split_z, gs.front_spacing_mm, gs) else {
             break;
         };
         advance(&mut grid, &mut mesh, &mut pot, finer)?;
     }
-    // The weighting problem sees the conductors end at the sub-cell front.
-    let wmesh = if settings.subcell_front {
-        super::front::front_corrected(&mesh, &pot.phi_v, &pot.undepleted, pot.bounds_v).0
-    } else {
-        mesh.clone()
+    let (wmesh, weighting) = match settings.weighting {
+        WeightingMode::Conductor => {
+            // The weighting problem sees the conductors end at the sub-cell front.
+            let wmesh = if settings.subcell_front {
+                super::front::front_corrected(&mesh, &pot.phi_v, &pot.undepleted, pot.bounds_v).0
+            } else {
+                mesh.clone()
+            };
+            let w = weighting_potentials(&wmesh, det, &pot.undepleted, bias_v)?;
+            (wmesh, w)
+        }
+        WeightingMode::PaperEpsilon => {
+            let wmesh = paper_epsilon_mesh(&mesh, &pot.undepleted, PAPER_EPSILON_FACTOR);
+            let none = vec![false; mesh.kind.len()];
+            let w = weighting_potentials(&wmesh, det, &none, bias_v)?;
+            (wmesh, w)
+        }
     };
-    let weighting = weighting_potentials(&wmesh, det, &pot.undepleted, bias_v)?;
     let names = det.contacts.iter().map(|c| c.name.clone()).collect();
     let capacitance = CapacitanceMatrix::from_weighting(&wmesh, &weighting, names);
     let c12_pf = capacitance.mutual_pf(a, b);
+    let contact_layers = super::front::crossings(&mesh, &pot.phi_v, &pot.undepleted, pot.bounds_v)
+        .iter()
+        .filter(|c| c.at_contact)
+        .count();
     let undepleted_nodes = pot
         .undepleted
         .iter()
@@ -222,6 +251,7 @@ pub fn solve_point(
         capacitance,
         c12_pf,
         undepleted_nodes,
+        contact_layers,
         reports,
     })
 }

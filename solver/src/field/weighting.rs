@@ -4,10 +4,63 @@
 //! (no space charge). Undepleted regions are conductors: a region touching a contact is part of
 //! that contact (the exact limit of the paper's eps_r x 1e5 in undepleted cells); a region
 //! touching nothing is a floating conductor (one unknown potential, zero net charge).
+//!
+//! For comparison the paper's own mode is available too (`WeightingMode::PaperEpsilon`): no
+//! conductors, the permittivity of undepleted semiconductor multiplied by 1e5.
+
+use serde::{Deserialize, Serialize};
 
 use super::mesh::{Mesh, NodeKind};
 use super::system::{Dof, System};
 use crate::{Detector, Error, Result};
+
+/// How undepleted semiconductor enters the weighting potentials (a closed set).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum WeightingMode {
+    /// Undepleted regions are conductors: part of the contact they touch, or floating (exact).
+    #[default]
+    Conductor,
+    /// The paper's approach (section 3, as in SolidStateDetectors.jl): eps_r x
+    /// `PAPER_EPSILON_FACTOR` in undepleted semiconductor, every node free except the contacts.
+    PaperEpsilon,
+}
+
+impl WeightingMode {
+    /// Name as on the command line.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            WeightingMode::Conductor => "conductor",
+            WeightingMode::PaperEpsilon => "paper-epsilon",
+        }
+    }
+}
+
+/// Factor on the permittivity of undepleted semiconductor in `WeightingMode::PaperEpsilon`.
+pub const PAPER_EPSILON_FACTOR: f64 = 1e5;
+
+/// The mesh of the paper's weighting mode: the conductance of every edge inside the undepleted
+/// region multiplied by `factor` (the node-based form of eps_r x factor in the cells of the
+/// undepleted region). An edge is inside when both ends are undepleted semiconductor nodes, or
+/// one is and the other lies on a contact (the undepleted bulk reaches up to the contact it
+/// touches); edges into depleted semiconductor keep their value.
+pub(crate) fn paper_epsilon_mesh(mesh: &Mesh, undepleted: &[bool], factor: f64) -> Mesh {
+    let mut out = mesh.clone();
+    let (nr, nz) = (mesh.grid.nr(), mesh.grid.nz());
+    let und = |n: usize| undepleted[n] && mesh.kind[n] == NodeKind::Semiconductor;
+    let contact = |n: usize| matches!(mesh.kind[n], NodeKind::Contact(_));
+    let inside = |a: usize, b: usize| (und(a) && (und(b) || contact(b))) || (und(b) && contact(a));
+    for n in 0..nr * nz {
+        let (i, j) = (n % nr, n / nr);
+        if i + 1 < nr && inside(n, n + 1) {
+            out.w_r[j * (nr - 1) + i] *= factor;
+        }
+        if j + 1 < nz && inside(n, n + nr) {
+            out.w_z[n] *= factor;
+        }
+    }
+    out
+}
 
 /// What an undepleted node belongs to.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
