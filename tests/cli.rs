@@ -250,3 +250,26 @@ fn simulate_paper_weighting_mode() {
     // nodes is within 0.5% here (validation/tests/weighting_modes.rs).
     assert!((c / 18.12 - 1.0).abs() < 5e-3, "{c}");
 }
+
+/// An impurity model under which the crystal stays undepleted between the contacts at every
+/// listed voltage: a clear error naming the bias and the contacts, exit code 2.
+#[test]
+fn simulate_undepleted_crystal_is_a_clear_error() {
+    let dir = std::env::temp_dir().join(format!("hpge-cv-undepleted-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let model = dir.join("dense.toml");
+    std::fs::write(&model, "model = \"constant\"\nzeta_cm3 = 1e16\n").unwrap();
+    let out = hpge_cv(&[
+        "simulate",
+        "--detector",
+        "detectors/coax-analytic.toml",
+        "--impurity",
+        model.to_str().unwrap(),
+        "--voltages",
+        "25,75",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("undepleted region connects"), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+}

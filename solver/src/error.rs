@@ -72,7 +72,9 @@ pub enum Error {
         reason: String,
     },
     /// An undepleted region connects two conductors at different potentials (shorted contacts).
-    #[error("at U_B = {bias_v} V an undepleted region connects {first} and {second}")]
+    #[error(
+        "at U_B = {bias_v} V an undepleted region connects {first} and {second}: the crystal does not deplete between them (impurity density too high for this bias, or a depleted layer thinner than the grid's min_tick_distance_mm)"
+    )]
     UndepletedBridge {
         /// One conductor.
         first: String,
