@@ -7,7 +7,7 @@ use hpge_solver::{CvCurve, Detector};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::err;
+use super::{err, log_key_points};
 
 /// Draws c12 (log scale) against U_B, marking the full-depletion voltage.
 pub fn cv_curve(curve: &CvCurve, det: &Detector, path: &Path) -> Result<()> {
@@ -44,13 +44,17 @@ fn draw<DB: DrawingBackend>(
         .margin(20)
         .x_label_area_size(50)
         .y_label_area_size(80)
-        .build_cartesian_2d(0.0..vmax.max(1.0), (cmin / 1.2..cmax * 1.2).log_scale())
+        .build_cartesian_2d(
+            0.0..vmax.max(1.0),
+            (cmin / 1.2..cmax * 1.2)
+                .log_scale()
+                .with_key_points(log_key_points(cmin / 1.2, cmax * 1.2)),
+        )
         .map_err(err)?;
     chart
         .configure_mesh()
         .x_desc("bias U_B (V)")
         .y_desc("c12 (pF)")
-        .y_labels(12)
         .y_label_formatter(&|v| {
             if *v >= 10.0 {
                 format!("{v:.0}")

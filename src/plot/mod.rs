@@ -92,3 +92,19 @@ pub fn check_output(path: &Path, flag: &str) -> anyhow::Result<()> {
 pub(crate) fn err<E: std::fmt::Debug>(e: E) -> anyhow::Error {
     anyhow::anyhow!("drawing failed: {e:?}")
 }
+
+/// 1, 2 and 5 times the powers of ten within [lo, hi] (log-axis labels at every scale).
+pub(crate) fn log_key_points(lo: f64, hi: f64) -> Vec<f64> {
+    let mut out = Vec::new();
+    let mut decade = 10f64.powf(lo.log10().floor());
+    while decade <= hi {
+        for m in [1.0, 2.0, 5.0] {
+            let v = m * decade;
+            if (lo..=hi).contains(&v) {
+                out.push(v);
+            }
+        }
+        decade *= 10.0;
+    }
+    out
+}

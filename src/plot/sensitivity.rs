@@ -6,7 +6,7 @@ use anyhow::Result;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::err;
+use super::{err, log_key_points};
 use crate::cli::ScanPoint;
 
 /// Draws c12 against zeta (both log scale); filled markers: fully depleted at the bias.
@@ -50,7 +50,9 @@ fn draw<DB: DrawingBackend>(
         .y_label_area_size(80)
         .build_cartesian_2d(
             (zmin / 1.3..zmax * 1.3).log_scale(),
-            (cmin / 1.3..cmax * 1.3).log_scale(),
+            (cmin / 1.3..cmax * 1.3)
+                .log_scale()
+                .with_key_points(log_key_points(cmin / 1.3, cmax * 1.3)),
         )
         .map_err(err)?;
     chart
