@@ -175,12 +175,7 @@ impl System {
 
     /// The symbolic Cholesky analysis of the pattern (reusable for any values).
     pub fn symbolic(&self) -> Result<Symbolic> {
-        let order = if std::env::var("HPGE_AMD").is_ok() {
-            None
-        } else {
-            Some(self.order())
-        };
-        Symbolic::new(self.n, &self.col_ptr, &self.row_idx, order.as_deref())
+        Symbolic::new(self.n, &self.col_ptr, &self.row_idx, Some(&self.order()))
     }
 
     /// Factorises the matrix with values `val` and solves for `rhs`.
