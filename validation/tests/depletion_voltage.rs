@@ -21,7 +21,7 @@ fn coax_full_depletion_voltage_matches_the_closed_form() {
     let got = curve.depletion_voltage_v.expect("3600 V depletes the coax");
     eprintln!("full depletion: solver {got} V, closed form {want} V");
     // Superposition on the 3600 V grid with the second-order check at the inner contact, where
-    // the last undepleted layer vanishes (measured: 3496.3 V, -0.14%; a node-only check gives
+    // the last undepleted layer vanishes (measured: 3496.2 V, -0.14%; a node-only check gives
     // -1.8%, first order in the 1 mm spacing).
     assert!((got - want).abs() < 0.003 * want, "{got} vs {want}");
     assert!(curve.points[1].fully_depleted && !curve.points[0].fully_depleted);

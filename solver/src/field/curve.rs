@@ -3,6 +3,7 @@
 use serde::Serialize;
 
 use super::full_depletion::full_depletion_voltage;
+use super::mesh::Mesh;
 use super::point::{FieldSettings, Seed, solve_point};
 use crate::{Detector, Error, Result};
 
@@ -79,11 +80,14 @@ pub fn cv_curve(
         .max(1);
     let size = volts.len().div_ceil(chunks);
     let done = AtomicUsize::new(0);
-    let parts: Vec<Result<Vec<CvPoint>>> = volts
+    // Each chunk returns its points and the mesh of its first fully depleted point (for the
+    // full-depletion voltage).
+    let parts: Vec<Result<(Vec<CvPoint>, Option<Mesh>)>> = volts
         .par_chunks(size)
         .map(|chunk| {
             let mut points = Vec::with_capacity(chunk.len());
             let mut prev: Option<Seed> = None;
+            let mut depleted_mesh: Option<Mesh> = None;
             for (k, &v) in chunk.iter().enumerate() {
                 let start = std::time::Instant::now();
                 let p = solve_point(det, v, settings, prev.as_ref())?;
@@ -99,24 +103,29 @@ pub fn cv_curve(
                     solve_seconds: p.reports.iter().map(|r| r.seconds).sum(),
                     seconds: start.elapsed().as_secs_f64(),
                 });
+                if depleted_mesh.is_none() && p.fully_depleted() {
+                    depleted_mesh = Some(p.mesh.clone());
+                }
                 prev = Some(p.seed(scale));
                 progress(done.fetch_add(1, Ordering::Relaxed) + 1, volts.len());
             }
-            Ok(points)
+            Ok((points, depleted_mesh))
         })
         .collect();
     let mut points = Vec::with_capacity(volts.len());
+    let mut depleted_mesh = None;
     for part in parts {
-        points.extend(part?);
+        let (pts, mesh) = part?;
+        points.extend(pts);
+        depleted_mesh = depleted_mesh.or(mesh);
     }
-    let depletion_voltage_v = match points.iter().position(|p| p.fully_depleted) {
-        Some(k) => {
+    // The first chunk with a fully depleted point holds the first such point overall.
+    let depletion_voltage_v = match (points.iter().position(|p| p.fully_depleted), depleted_mesh) {
+        (Some(k), Some(mesh)) => {
             let lo = if k > 0 { points[k - 1].voltage_v } else { 0.0 };
-            let hi = points[k].voltage_v;
-            let p = solve_point(det, hi, settings, None)?;
-            Some(full_depletion_voltage(&p.mesh, det, lo, hi)?)
+            Some(full_depletion_voltage(&mesh, det, lo, points[k].voltage_v)?)
         }
-        None => None,
+        _ => None,
     };
     Ok(CvCurve {
         points,

@@ -127,17 +127,10 @@ pub(crate) fn crossings(
 }
 
 /// A copy of `mesh` whose edge conductances across the depletion front are corrected for the
-/// sub-cell front position (every `Crossing`). Returns the corrected mesh and the number of edges
-/// corrected.
-pub(crate) fn front_corrected(
-    mesh: &Mesh,
-    phi_v: &[f64],
-    undepleted: &[bool],
-    bounds_v: (f64, f64),
-) -> (Mesh, usize) {
+/// sub-cell front positions `cross` (from [`crossings`] on the same mesh).
+pub(crate) fn front_corrected(mesh: &Mesh, cross: &[Crossing]) -> Mesh {
     let mut out = mesh.clone();
-    let mut count = 0;
-    for c in crossings(mesh, phi_v, undepleted, bounds_v) {
+    for c in cross {
         let (rp, r1, rf) = (c.xp, c.x1, c.xf);
         let scale = if c.radial && rp > 0.0 && rf > 0.0 && r1 > 0.0 {
             (r1 / rp).ln() / (r1 / rf).ln()
@@ -151,10 +144,9 @@ pub(crate) fn front_corrected(
                 &mut out.w_z[c.edge]
             };
             *w *= scale;
-            count += 1;
         }
     }
-    (out, count)
+    out
 }
 
 /// Intervals the depletion front crosses, for refinement: an r interval is marked when an edge
@@ -203,10 +195,7 @@ pub(crate) fn front_splits(
     // An undepleted node next to a contact or grounded part at another potential: the depleted
     // layer in front of it is thinner than the spacing (low bias on a coarse grid); split that interval so
     // the layer can appear, else the undepleted bulk would touch the contact.
-    let span = phi_v
-        .iter()
-        .fold(0.0f64, |m, &p| m.max(p.abs()))
-        .max(f64::MIN_POSITIVE);
+    let span = (bounds_v.1 - bounds_v.0).abs().max(f64::MIN_POSITIVE);
     let touches = |n: usize, m: usize| {
         semi(n)
             && undepleted[n]

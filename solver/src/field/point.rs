@@ -212,11 +212,12 @@ pub fn solve_point(
         };
         advance(&mut grid, &mut mesh, &mut pot, finer)?;
     }
+    let cross = super::front::crossings(&mesh, &pot.phi_v, &pot.undepleted, pot.bounds_v);
     let (wmesh, weighting) = match settings.weighting {
         WeightingMode::Conductor => {
             // The weighting problem sees the conductors end at the sub-cell front.
             let wmesh = if settings.subcell_front {
-                super::front::front_corrected(&mesh, &pot.phi_v, &pot.undepleted, pot.bounds_v).0
+                super::front::front_corrected(&mesh, &cross)
             } else {
                 mesh.clone()
             };
@@ -233,10 +234,7 @@ pub fn solve_point(
     let names = det.contacts.iter().map(|c| c.name.clone()).collect();
     let capacitance = CapacitanceMatrix::from_weighting(&wmesh, &weighting, names);
     let c12_pf = capacitance.mutual_pf(a, b);
-    let contact_layers = super::front::crossings(&mesh, &pot.phi_v, &pot.undepleted, pot.bounds_v)
-        .iter()
-        .filter(|c| c.at_contact)
-        .count();
+    let contact_layers = cross.iter().filter(|c| c.at_contact).count();
     let undepleted_nodes = pot
         .undepleted
         .iter()
