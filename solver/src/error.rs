@@ -83,6 +83,22 @@ pub enum Error {
         /// Bias, V.
         bias_v: f64,
     },
+    /// The wgpu backend found no usable adapter.
+    #[error("no GPU adapter for the wgpu backend ({tried}): {reason}; {hint}")]
+    NoGpuAdapter {
+        /// The graphics APIs tried and the adapters they offered.
+        tried: String,
+        /// Why none was usable.
+        reason: String,
+        /// How to get one (e.g. Mesa's software Vulkan).
+        hint: String,
+    },
+    /// The GPU device failed (shader compilation, out of memory, lost device, read-back).
+    #[error("wgpu backend: {message}")]
+    Gpu {
+        /// What failed, with the adapter's name.
+        message: String,
+    },
     /// A value given on the command line or through the API (not from a file) is invalid.
     #[error("`{name}`: {message}")]
     Argument {

@@ -12,6 +12,7 @@ mod error;
 mod expr;
 mod field;
 mod geometry;
+mod gpu;
 mod grid;
 mod impurity;
 mod material;
@@ -25,12 +26,14 @@ pub use detector::{
 pub use error::{Error, Result};
 pub use expr::Parameters;
 pub use field::{
-    CapacitanceMatrix, CvCurve, CvPoint, FieldSettings, Mesh, Method, NodeKind,
+    Backend, CapacitanceMatrix, CvCurve, CvPoint, FieldSettings, Mesh, Method, NodeKind,
     PAPER_EPSILON_FACTOR, PointResult, PotentialSolution, Seed, SolveReport, Termination,
     WeightingMode, WeightingPotentials, cv_curve, full_depletion_voltage, normalise_voltages,
-    solve_fast, solve_point, solve_sor, weighting_potentials,
+    solve_fast, solve_point, solve_sor, solve_sor_wgpu, weighting_potentials,
+    weighting_potentials_wgpu,
 };
 pub use geometry::{BoundingBox, Primitive, Solid};
+pub use gpu::{AdapterReport, Precision, gpu_adapter, gpu_test_gate};
 pub use grid::{Grid, GridSettings};
 pub use impurity::{
     ClampedNaturalSpline, ConstantModel, ImpurityContext, ImpurityModel, ImpuritySpec,

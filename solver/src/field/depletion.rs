@@ -12,7 +12,7 @@
 use std::time::Instant;
 
 use super::mesh::{Mesh, NodeKind};
-use super::report::{Method, SolveReport, Termination};
+use super::report::{Backend, Method, SolveReport, Termination};
 use super::system::{Dof, System};
 use crate::{Detector, Error, Result};
 
@@ -179,6 +179,7 @@ pub fn solve_fast(
         undepleted,
         bounds_v: (lo, hi),
         report: SolveReport {
+            backend: Backend::Cpu,
             method: Method::Fast,
             iterations,
             residual_v,

@@ -9,7 +9,7 @@ mod full_depletion;
 mod mesh;
 mod point;
 mod report;
-mod sor;
+pub(crate) mod sor;
 mod system;
 mod weighting;
 
@@ -19,8 +19,8 @@ pub use depletion::{PotentialSolution, solve_fast};
 pub use full_depletion::full_depletion_voltage;
 pub use mesh::{Mesh, NodeKind};
 pub use point::{FieldSettings, PointResult, Seed, solve_point};
-pub use report::{Method, SolveReport, Termination};
-pub use sor::solve_sor;
+pub use report::{Backend, Method, SolveReport, Termination};
+pub use sor::{solve_sor, solve_sor_wgpu, weighting_potentials_wgpu};
 pub use weighting::{
     PAPER_EPSILON_FACTOR, WeightingMode, WeightingPotentials, weighting_potentials,
 };

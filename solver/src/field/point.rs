@@ -5,11 +5,12 @@ use serde::{Deserialize, Serialize};
 use super::capacitance::CapacitanceMatrix;
 use super::depletion::{PotentialSolution, solve_fast};
 use super::mesh::{Mesh, NodeKind};
-use super::report::{Method, SolveReport};
+use super::report::{Backend, Method, SolveReport};
 use super::weighting::{
     PAPER_EPSILON_FACTOR, WeightingMode, WeightingPotentials, paper_epsilon_mesh,
     weighting_potentials,
 };
+use crate::gpu::Precision;
 use crate::grid::{Grid, GridSettings};
 use crate::{Detector, Error, Result};
 
@@ -27,6 +28,10 @@ pub struct FieldSettings {
     pub subcell_front: bool,
     /// How undepleted semiconductor enters the weighting potentials.
     pub weighting: WeightingMode,
+    /// Where the potential and weighting potentials are solved; `Wgpu` runs the `Sor` method.
+    pub backend: Backend,
+    /// Arithmetic on the wgpu backend.
+    pub gpu_precision: Precision,
 }
 
 impl Default for FieldSettings {
@@ -36,6 +41,8 @@ impl Default for FieldSettings {
             method: Method::Fast,
             subcell_front: true,
             weighting: WeightingMode::Conductor,
+            backend: Backend::Cpu,
+            gpu_precision: Precision::Auto,
         }
     }
 }
@@ -43,7 +50,14 @@ impl Default for FieldSettings {
 impl FieldSettings {
     /// Checks all fields (the message names the field).
     pub fn validate(&self) -> Result<(), String> {
-        self.grid.validate().map_err(|m| format!("grid: {m}"))
+        self.grid.validate().map_err(|m| format!("grid: {m}"))?;
+        if self.backend == Backend::Wgpu && self.method != Method::Sor {
+            return Err(format!(
+                "method: the wgpu backend runs the sor method; `{}` (sparse Cholesky) runs on the cpu backend only",
+                self.method.as_str()
+            ));
+        }
+        Ok(())
     }
 }
 
@@ -178,9 +192,23 @@ pub fn solve_point(
         guess = Some(sd.grid.interpolate_to(&sd.phi_v, &grid));
     }
     let mut reports = Vec::new();
-    let solve = |mesh: &Mesh, guess: Option<&[f64]>| match settings.method {
-        Method::Fast => solve_fast(mesh, det, bias_v, guess),
-        Method::Sor => super::sor::solve_sor(mesh, det, bias_v, guess),
+    let solve = |mesh: &Mesh, guess: Option<&[f64]>| match (settings.backend, settings.method) {
+        (Backend::Cpu, Method::Fast) => solve_fast(mesh, det, bias_v, guess),
+        (Backend::Cpu, Method::Sor) => super::sor::solve_sor(mesh, det, bias_v, guess),
+        // (Wgpu, Fast) is rejected by validate().
+        (Backend::Wgpu, _) => {
+            super::sor::solve_sor_wgpu(mesh, det, bias_v, guess, settings.gpu_precision)
+        }
+    };
+    let weigh = |mesh: &Mesh, undepleted: &[bool]| match settings.backend {
+        Backend::Cpu => weighting_potentials(mesh, det, undepleted, bias_v),
+        Backend::Wgpu => super::sor::weighting_potentials_wgpu(
+            mesh,
+            det,
+            undepleted,
+            bias_v,
+            settings.gpu_precision,
+        ),
     };
     let mut mesh = Mesh::new(det, grid.clone());
     let mut pot = solve(&mesh, guess.as_deref())?;
@@ -221,13 +249,13 @@ pub fn solve_point(
             } else {
                 mesh.clone()
             };
-            let w = weighting_potentials(&wmesh, det, &pot.undepleted, bias_v)?;
+            let w = weigh(&wmesh, &pot.undepleted)?;
             (wmesh, w)
         }
         WeightingMode::PaperEpsilon => {
             let wmesh = paper_epsilon_mesh(&mesh, &pot.undepleted, PAPER_EPSILON_FACTOR);
             let none = vec![false; mesh.kind.len()];
-            let w = weighting_potentials(&wmesh, det, &none, bias_v)?;
+            let w = weigh(&wmesh, &none)?;
             (wmesh, w)
         }
     };

@@ -25,6 +25,27 @@ impl Method {
     }
 }
 
+/// Where a solve runs (a closed set).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Backend {
+    /// The host's cores (faer and rayon).
+    #[default]
+    Cpu,
+    /// A GPU (or a software rasteriser) through wgpu compute shaders: the SOR method only.
+    Wgpu,
+}
+
+impl Backend {
+    /// Name as on the command line.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Backend::Cpu => "cpu",
+            Backend::Wgpu => "wgpu",
+        }
+    }
+}
+
 /// Why an iterative solve stopped.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -43,6 +64,9 @@ pub enum Termination {
 pub struct SolveReport {
     /// Method used.
     pub method: Method,
+    /// Where it ran.
+    #[serde(default)]
+    pub backend: Backend,
     /// Iterations (active-set steps or SOR sweeps).
     pub iterations: usize,
     /// Largest projected residual at the end, in V: max_n |phi_n - clamp(phi_n - g_n / A_nn)|,

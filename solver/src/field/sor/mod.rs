@@ -24,11 +24,18 @@
 mod residual;
 mod settings;
 mod solve;
+pub(crate) mod stencil;
+mod stop;
 mod sweep;
 #[cfg(test)]
 mod tests;
+mod wgpu;
+#[cfg(test)]
+mod wgpu_tests;
 
 pub use solve::solve_sor;
+pub(crate) use stop::StopRule;
+pub use wgpu::{solve_sor_wgpu, weighting_potentials_wgpu};
 // The rest of the SOR interface, at the same paths as when this was one file; only the tests
 // use it so far (outside them the field module needs `solve_sor` alone).
 #[allow(unused_imports)]

@@ -3,12 +3,14 @@
 
 use std::time::Instant;
 
-use super::residual::{projected_residual, target};
+use super::residual::projected_residual;
 use super::settings::{SorSettings, default_omega};
+use super::stencil::{groups, initial, inverse_sum, undepleted, weights};
+use super::stop::StopRule;
 use super::sweep::{Block, Coef, Layout, PARALLEL_MIN_NODES, half_sweep, to_nodes, update_blocks};
 use crate::field::depletion::{PotentialSolution, potential_dofs};
 use crate::field::mesh::{Mesh, NodeKind};
-use crate::field::report::{Method, SolveReport, Termination};
+use crate::field::report::{Backend, Method, SolveReport, Termination};
 use crate::field::system::Dof;
 use crate::{Detector, Error, Result};
 
@@ -82,81 +84,30 @@ pub fn solve_sor_with(
         nz,
         h: nr.div_ceil(2),
     };
-    let weights = |n: usize| -> [f64; 4] {
-        let (i, j) = (n % nr, n / nr);
-        [
-            if i > 0 {
-                mesh.w_r[j * (nr - 1) + i - 1]
-            } else {
-                0.0
-            },
-            if i + 1 < nr {
-                mesh.w_r[j * (nr - 1) + i]
-            } else {
-                0.0
-            },
-            if j > 0 {
-                mesh.w_z[(j - 1) * nr + i]
-            } else {
-                0.0
-            },
-            if j + 1 < nz {
-                mesh.w_z[j * nr + i]
-            } else {
-                0.0
-            },
-        ]
-    };
-    let neighbours = |n: usize| -> [Option<usize>; 4] {
-        let (i, j) = (n % nr, n / nr);
-        [
-            (i > 0).then(|| n - 1),
-            (i + 1 < nr).then_some(n + 1),
-            (j > 0).then(|| n - nr),
-            (j + 1 < nz).then_some(n + nr),
-        ]
-    };
-
     // Coefficients, initial iterate and floating blocks.
     let mut coef = [
         vec![Coef::default(); nz * lay.h],
         vec![Coef::default(); nz * lay.h],
     ];
     let mut x = [vec![0.0; nz * lay.h], vec![0.0; nz * lay.h]];
-    let mut groups: Vec<(usize, Vec<usize>)> = Vec::new();
     for n in 0..nn {
         let (c, s) = lay.slot(n);
         match dofs[n] {
             Dof::Fixed(v) => x[c][s] = v,
-            Dof::Group(g) => match groups.iter_mut().find(|(k, _)| *k == g) {
-                Some((_, nodes)) => nodes.push(n),
-                None => groups.push((g, vec![n])),
-            },
+            Dof::Group(_) => {}
             Dof::Free => {
-                let w = weights(n);
-                let sum: f64 = w.iter().sum();
-                if !(sum.is_finite() && sum > 0.0) {
-                    return Err(Error::Singular {
-                        reason: format!("node {n} has no conductance to any neighbour"),
-                    });
-                }
-                let semi = mesh.kind[n] == NodeKind::Semiconductor;
-                let (l, u) = if semi {
+                let w = weights(mesh, n);
+                let inv = inverse_sum(&w, n)?;
+                let (l, u) = if mesh.kind[n] == NodeKind::Semiconductor {
                     (lo, hi)
                 } else {
                     (f64::NEG_INFINITY, f64::INFINITY)
                 };
                 let q = mesh.charge_c[n];
-                let x0 = match guess_v {
-                    Some(g) if g[n].is_finite() => g[n],
-                    _ if semi && q > 0.0 => hi,
-                    _ if semi && q < 0.0 => lo,
-                    _ => 0.0,
-                };
-                x[c][s] = x0.clamp(l, u);
+                x[c][s] = initial(guess_v, n, q, (l, u));
                 coef[c][s] = Coef {
                     w,
-                    inv: 1.0 / sum,
+                    inv,
                     q,
                     lo: l,
                     hi: u,
@@ -165,49 +116,31 @@ pub fn solve_sor_with(
             }
         }
     }
-    let mut blocks = Vec::with_capacity(groups.len());
-    for (g, nodes) in &groups {
-        let mut edges = Vec::new();
-        let mut q = 0.0;
-        for &n in nodes {
-            q += mesh.charge_c[n];
-            for (m, w) in neighbours(n).into_iter().zip(weights(n)) {
-                if let Some(m) = m
-                    && w > 0.0
-                    && dofs[m] != Dof::Group(*g)
-                {
-                    edges.push((lay.slot(m), w));
-                }
-            }
-        }
-        let sum: f64 = edges.iter().map(|e| e.1).sum();
-        if !(sum.is_finite() && sum > 0.0) {
-            return Err(Error::Singular {
-                reason: format!("floating conductor {g} has no conductance to its surroundings"),
-            });
-        }
+    let mut blocks = Vec::new();
+    for g in groups(mesh, &dofs, &mesh.charge_c)? {
         let v0 = guess_v.map_or(0.0, |gv| {
-            nodes.iter().map(|&n| gv[n]).sum::<f64>() / nodes.len() as f64
+            g.nodes.iter().map(|&n| gv[n]).sum::<f64>() / g.nodes.len() as f64
         });
-        let slots: Vec<(usize, usize)> = nodes.iter().map(|&n| lay.slot(n)).collect();
+        let slots: Vec<(usize, usize)> = g.nodes.iter().map(|&n| lay.slot(n)).collect();
         for &(c, s) in &slots {
             x[c][s] = if v0.is_finite() { v0 } else { 0.0 };
         }
         blocks.push(Block {
             slots,
-            edges,
-            inv: 1.0 / sum,
-            q,
+            edges: g.edges.iter().map(|&(m, w)| (lay.slot(m), w)).collect(),
+            inv: 1.0 / g.sum,
+            q: g.q,
         });
     }
 
     // Sweeps.
     let parallel = nn >= PARALLEL_MIN_NODES;
-    let scale = (hi - lo).abs();
-    let limit = settings.tolerance * scale;
-    // Below this an update is round-off (a few ulps of the largest potential).
-    let floor = 16.0 * f64::EPSILON * scale.max(hi.abs()).max(lo.abs());
-    let mut history = [f64::NAN; 2];
+    let mut rule = StopRule::new(
+        settings,
+        (hi - lo).abs(),
+        hi.abs().max(lo.abs()),
+        f64::EPSILON,
+    );
     let mut sweeps = 0;
     loop {
         sweeps += 1;
@@ -217,27 +150,16 @@ pub fn solve_sor_with(
         let d1 = half_sweep(1, black, red, &coef[1], lay, omega, check, parallel);
         let d2 = update_blocks(&blocks, &mut x, omega);
         if check {
-            let d = d0.max(d1).max(d2);
-            if !d.is_finite() {
-                return Err(Error::NotConverged {
-                    method: Method::Sor.as_str(),
-                    iterations: sweeps,
-                    residual_v: f64::NAN,
-                });
-            }
-            // Asymptotically the updates shrink by rho per sweep, so the distance to the fixed
-            // point is d rho / (1 - rho): stop when that, and d itself, are within the limit.
-            // rho is the slower of the last two check intervals' rates (>= 1: not yet).
-            let rate = |a: f64, b: f64| (b / a).powf(1.0 / settings.check_every as f64);
-            let rho = rate(history[0], history[1]).max(rate(history[1], d));
-            history = [history[1], d];
-            let allowed = if rho < 1.0 {
-                limit * ((1.0 - rho) / rho).min(1.0)
-            } else {
-                0.0
-            };
-            if d <= allowed.max(floor.min(limit)) {
-                break;
+            match rule.converged(d0.max(d1).max(d2)) {
+                Some(true) => break,
+                Some(false) => {}
+                None => {
+                    return Err(Error::NotConverged {
+                        method: Method::Sor.as_str(),
+                        iterations: sweeps,
+                        residual_v: f64::NAN,
+                    });
+                }
             }
         }
         if sweeps >= settings.max_sweeps {
@@ -252,20 +174,13 @@ pub fn solve_sor_with(
 
     let phi_v = to_nodes(&x, lay);
     let residual_v = projected_residual(mesh, &dofs, &phi_v, (lo, hi));
-    let undepleted = (0..nn)
-        .map(|n| {
-            if mesh.kind[n] != NodeKind::Semiconductor || dofs[n] != Dof::Free {
-                return false;
-            }
-            let (t, _) = target(mesh, &phi_v, n, &weights(n), &neighbours(n));
-            t > hi || t < lo
-        })
-        .collect();
+    let undepleted = undepleted(mesh, &dofs, &phi_v, (lo, hi));
     Ok(PotentialSolution {
         phi_v,
         undepleted,
         bounds_v: (lo, hi),
         report: SolveReport {
+            backend: Backend::Cpu,
             method: Method::Sor,
             iterations: sweeps,
             residual_v,
