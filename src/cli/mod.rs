@@ -85,6 +85,66 @@ impl From<MethodArg> for hpge_solver::Method {
     }
 }
 
+/// Where the field solves run.
+#[derive(Debug, Clone, Copy, clap::ValueEnum)]
+enum BackendArg {
+    /// The host's cores.
+    Cpu,
+    /// A GPU through wgpu (Vulkan, Metal, DX12; Mesa's lavapipe without one): the sor method.
+    Wgpu,
+}
+
+/// Arithmetic on the wgpu backend.
+#[derive(Debug, Clone, Copy, clap::ValueEnum)]
+enum PrecisionArg {
+    /// f64 where the adapter offers shader-f64, else f32.
+    Auto,
+    /// f32.
+    F32,
+    /// f64 (an error without shader-f64).
+    F64,
+}
+
+/// Backend, method and device precision as given on the command line.
+#[derive(Debug, clap::Args)]
+struct SolverArgs {
+    /// Potential method [default: fast on the cpu backend, sor on wgpu].
+    #[arg(long, value_enum)]
+    method: Option<MethodArg>,
+    /// Where the potential and weighting potentials are solved.
+    #[arg(long, value_enum, default_value = "cpu")]
+    backend: BackendArg,
+    /// Floating-point precision on the wgpu backend.
+    #[arg(long = "gpu-precision", value_enum, default_value = "auto")]
+    gpu_precision: PrecisionArg,
+}
+
+impl SolverArgs {
+    /// Field settings with these choices (the rest default).
+    fn settings(&self, weighting: WeightingArg) -> hpge_solver::FieldSettings {
+        let backend = match self.backend {
+            BackendArg::Cpu => hpge_solver::Backend::Cpu,
+            BackendArg::Wgpu => hpge_solver::Backend::Wgpu,
+        };
+        let method = match (self.method, backend) {
+            (Some(m), _) => m.into(),
+            (None, hpge_solver::Backend::Cpu) => hpge_solver::Method::Fast,
+            (None, hpge_solver::Backend::Wgpu) => hpge_solver::Method::Sor,
+        };
+        hpge_solver::FieldSettings {
+            method,
+            weighting: weighting.into(),
+            backend,
+            gpu_precision: match self.gpu_precision {
+                PrecisionArg::Auto => hpge_solver::Precision::Auto,
+                PrecisionArg::F32 => hpge_solver::Precision::F32,
+                PrecisionArg::F64 => hpge_solver::Precision::F64,
+            },
+            ..hpge_solver::FieldSettings::default()
+        }
+    }
+}
+
 /// How undepleted semiconductor enters the weighting potentials.
 #[derive(Debug, Clone, Copy, clap::ValueEnum)]
 enum WeightingArg {
@@ -113,9 +173,8 @@ struct SimulateArgs {
     /// Bias voltages: START:STOP:STEP (inclusive) or a comma list, e.g. 25:2975:50 or 25,75,125.
     #[arg(long, value_name = "LIST", value_parser = parse_voltages, allow_hyphen_values = true)]
     voltages: Option<args::VoltageList>,
-    /// Potential method.
-    #[arg(long, value_enum, default_value = "fast")]
-    method: MethodArg,
+    #[command(flatten)]
+    solver: SolverArgs,
     /// Weighting-potential mode.
     #[arg(long, value_enum, default_value = "conductor")]
     weighting: WeightingArg,
@@ -143,9 +202,8 @@ struct CapacitanceArgs {
     /// Bias voltage in V.
     #[arg(long, value_name = "U", allow_hyphen_values = true)]
     voltage: f64,
-    /// Potential method.
-    #[arg(long, value_enum, default_value = "fast")]
-    method: MethodArg,
+    #[command(flatten)]
+    solver: SolverArgs,
     /// Weighting-potential mode.
     #[arg(long, value_enum, default_value = "conductor")]
     weighting: WeightingArg,
@@ -205,8 +263,7 @@ pub fn run(cli: Cli) -> Result<()> {
                 input: &a.input,
                 d_li_mm: a.d_li,
                 voltages: &volts,
-                method: a.method.into(),
-                weighting: a.weighting.into(),
+                settings: a.solver.settings(a.weighting),
                 json: a.json,
                 out: a.out.as_ref(),
                 plot: a.plot.as_ref(),
@@ -223,11 +280,7 @@ pub fn run(cli: Cli) -> Result<()> {
             plot: a.plot.as_ref(),
         }),
         Command::Capacitance(a) => {
-            let settings = hpge_solver::FieldSettings {
-                method: a.method.into(),
-                weighting: a.weighting.into(),
-                ..hpge_solver::FieldSettings::default()
-            };
+            let settings = a.solver.settings(a.weighting);
             simulate::capacitance(&a.input, a.voltage, &settings, a.json)
         }
     }

@@ -5,7 +5,8 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result, bail};
 use hpge_solver::{
-    CvCurve, FieldSettings, Method, WeightingMode, cv_curve, normalise_voltages, solve_point,
+    Backend, CvCurve, FieldSettings, Precision, cv_curve, gpu_adapter, normalise_voltages,
+    solve_point,
 };
 use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::json;
@@ -19,8 +20,7 @@ pub struct SimulateOptions<'a> {
     pub input: &'a DetectorInput,
     pub d_li_mm: Option<f64>,
     pub voltages: &'a [f64],
-    pub method: Method,
-    pub weighting: WeightingMode,
+    pub settings: FieldSettings,
     pub json: bool,
     pub out: Option<&'a PathBuf>,
     pub plot: Option<&'a PathBuf>,
@@ -69,11 +69,8 @@ pub fn run(o: &SimulateOptions<'_>) -> Result<()> {
             det.file.display()
         );
     }
-    let settings = FieldSettings {
-        method: o.method,
-        weighting: o.weighting,
-        ..FieldSettings::default()
-    };
+    let settings = o.settings.clone();
+    let device = backend_json(&settings)?;
     let bar = ProgressBar::new(volts.len() as u64);
     bar.set_style(
         ProgressStyle::with_template("{bar:40} {pos}/{len} voltages, {elapsed} elapsed, eta {eta}")
@@ -106,8 +103,10 @@ pub fn run(o: &SimulateOptions<'_>) -> Result<()> {
             "depletion_voltage_V": curve.depletion_voltage_v,
             "grid": {"nr": last.0, "nz": last.1},
             "grid_per_point": curve.points.iter().map(|p| json!({"nr": p.grid.0, "nz": p.grid.1})).collect::<Vec<_>>(),
-            "method": o.method.as_str(),
-            "weighting": o.weighting.as_str(),
+            "method": settings.method.as_str(),
+            "weighting": settings.weighting.as_str(),
+            "backend": settings.backend.as_str(),
+            "device": device,
             "seconds": seconds,
             "detector": det.file.display().to_string(),
             "impurity_file": det.semiconductor.impurity_file().display().to_string(),
@@ -131,12 +130,46 @@ pub fn run(o: &SimulateOptions<'_>) -> Result<()> {
             None => println!("not fully depleted at any listed bias"),
         }
         println!(
-            "{} points in {seconds:.2} s ({})",
+            "{} points in {seconds:.2} s ({} on {}{})",
             curve.points.len(),
-            o.method.as_str()
+            settings.method.as_str(),
+            settings.backend.as_str(),
+            device["adapter"]
+                .as_str()
+                .map_or(String::new(), |a| format!(": {a}, {}", device["precision"]))
         );
     }
     Ok(())
+}
+
+/// Checks the settings and, on the wgpu backend, finds the adapter (the clear error when there is
+/// none comes here, before any work); returns what ran where, for the JSON output:
+/// `{"adapter": name, "api": .., "device_type": .., "driver": .., "precision": "f64"|"f32"}` or
+/// null on the cpu backend.
+fn backend_json(settings: &FieldSettings) -> Result<serde_json::Value> {
+    settings
+        .validate()
+        .map_err(|m| anyhow::anyhow!("--method/--backend: {m}"))?;
+    if settings.backend == Backend::Cpu {
+        return Ok(serde_json::Value::Null);
+    }
+    let a = gpu_adapter()?;
+    let double = match settings.gpu_precision {
+        Precision::Auto => a.shader_f64,
+        Precision::F32 => false,
+        Precision::F64 if a.shader_f64 => true,
+        Precision::F64 => bail!(
+            "--gpu-precision f64: adapter `{}` has no shader-f64; use f32 or auto",
+            a.name
+        ),
+    };
+    Ok(json!({
+        "adapter": a.name,
+        "api": a.api,
+        "device_type": a.device_type,
+        "driver": a.driver,
+        "precision": if double { "f64" } else { "f32" },
+    }))
 }
 
 fn write_csv(path: &std::path::Path, curve: &CvCurve) -> Result<()> {
@@ -160,6 +193,7 @@ pub fn capacitance(
         bail!("--voltage {voltage}: the bias must be a positive number of volts");
     }
     let det = load_detector(input)?;
+    let device = backend_json(settings)?;
     let p = solve_point(&det, voltage, settings, None)?;
     let c = &p.capacitance;
     if as_json {
@@ -173,6 +207,8 @@ pub fn capacitance(
             "grid": {"nr": p.mesh.grid.nr(), "nz": p.mesh.grid.nz()},
             "method": settings.method.as_str(),
             "weighting": settings.weighting.as_str(),
+            "backend": settings.backend.as_str(),
+            "device": device,
             "detector": det.file.display().to_string(),
             "version": env!("CARGO_PKG_VERSION"),
         });
