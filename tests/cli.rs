@@ -273,3 +273,93 @@ fn simulate_undepleted_crystal_is_a_clear_error() {
     assert!(err.contains("undepleted region connects"), "{err}");
     assert!(!err.contains("panicked"), "{err}");
 }
+
+/// GPU issue: `--backend wgpu` gives the CPU's c12 and says in the JSON where it ran.
+#[test]
+fn simulate_on_wgpu_matches_cpu_json() {
+    if !hpge_solver::gpu_test_gate() {
+        return;
+    }
+    let run = |backend: &str| {
+        let out = hpge_cv(&[
+            "simulate",
+            "--detector",
+            "detectors/coax-analytic.toml",
+            "--voltages",
+            "25,1025",
+            "--method",
+            "sor",
+            "--backend",
+            backend,
+            "--json",
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        serde_json::from_slice::<serde_json::Value>(&out.stdout).unwrap()
+    };
+    let (cpu, gpu) = (run("cpu"), run("wgpu"));
+    assert_eq!(cpu["backend"], "cpu");
+    assert!(cpu["device"].is_null());
+    assert_eq!(gpu["backend"], "wgpu");
+    assert_eq!(gpu["method"], "sor");
+    assert!(
+        gpu["device"]["adapter"]
+            .as_str()
+            .is_some_and(|a| !a.is_empty())
+    );
+    assert!(["f32", "f64"].contains(&gpu["device"]["precision"].as_str().unwrap()));
+    for k in 0..2 {
+        let (a, b) = (
+            cpu["c12_pF"][k].as_f64().unwrap(),
+            gpu["c12_pF"][k].as_f64().unwrap(),
+        );
+        assert!((a / b - 1.0).abs() < 1e-4, "{a} vs {b}");
+    }
+}
+
+/// No adapter (here: none matches WGPU_ADAPTER_NAME) is a clear error with exit code 2 that
+/// says what was tried and how to get a software adapter; so is the fast method on wgpu.
+#[test]
+fn wgpu_without_adapter_is_a_clear_error() {
+    let out = Command::new(env!("CARGO_BIN_EXE_hpge-cv"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .env("WGPU_ADAPTER_NAME", "no-such-adapter-anywhere")
+        .args([
+            "capacitance",
+            "--detector",
+            "detectors/coax-analytic.toml",
+            "--voltage",
+            "25",
+            "--backend",
+            "wgpu",
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    for want in [
+        "no GPU adapter",
+        "adapters found",
+        "mesa-vulkan-drivers",
+        "--backend cpu",
+    ] {
+        assert!(err.contains(want), "{want} missing in: {err}");
+    }
+    let out = hpge_cv(&[
+        "simulate",
+        "--detector",
+        "detectors/coax-analytic.toml",
+        "--voltages",
+        "25",
+        "--backend",
+        "wgpu",
+        "--method",
+        "fast",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("wgpu backend runs the sor method"), "{err}");
+}

@@ -2,8 +2,9 @@
 
 use criterion::{criterion_group, criterion_main};
 
+mod gpu;
 mod impurity;
 mod solver;
 
-criterion_group!(benches, impurity::bench, solver::bench);
+criterion_group!(benches, impurity::bench, solver::bench, gpu::bench);
 criterion_main!(benches);

@@ -53,13 +53,16 @@ pub(crate) struct Kernels {
     pub(crate) blocks: wgpu::ComputePipeline,
 }
 
+/// (f64 arithmetic, neighbours per node).
+type KernelKey = (bool, usize);
+
 /// A device and its queue, shared by all solves of the process.
 pub(crate) struct Gpu {
     pub(crate) device: wgpu::Device,
     pub(crate) queue: wgpu::Queue,
     pub(crate) report: AdapterReport,
     /// Kernels per (precision f64?, stencil size), compiled on first use.
-    kernels: Mutex<Vec<((bool, usize), Arc<Kernels>)>>,
+    kernels: Mutex<Vec<(KernelKey, Arc<Kernels>)>>,
 }
 
 /// Threads per workgroup of every kernel.
@@ -136,15 +139,28 @@ impl Gpu {
                 format!("{} ({:?})", i.name, i.backend)
             })
             .collect();
+        let apis: Vec<&str> = [
+            (wgpu::Backends::VULKAN, "vulkan"),
+            (wgpu::Backends::METAL, "metal"),
+            (wgpu::Backends::DX12, "dx12"),
+            (wgpu::Backends::GL, "gl"),
+            (wgpu::Backends::BROWSER_WEBGPU, "webgpu"),
+        ]
+        .into_iter()
+        .filter(|(b, _)| backends.contains(*b))
+        .map(|(_, name)| name)
+        .collect();
         let tried = format!(
-            "APIs {backends:?}; adapters found: {}",
+            "APIs tried: {}; adapters found: {}",
+            apis.join(", "),
             if found.is_empty() {
                 "none".to_string()
             } else {
                 found.join(", ")
             }
         );
-        if let Ok(want) = std::env::var("WGPU_ADAPTER_NAME") {
+        let wanted = std::env::var("WGPU_ADAPTER_NAME").ok();
+        if let Some(want) = &wanted {
             let want = want.to_lowercase();
             adapters.retain(|a| a.get_info().name.to_lowercase().contains(&want));
         }
@@ -155,7 +171,12 @@ impl Gpu {
         });
         adapters.sort_by_key(|a| rank(&a.get_info()));
         let Some(adapter) = adapters.into_iter().next() else {
-            return Err((tried, "no adapter with compute shaders".to_string()));
+            let reason = match wanted {
+                _ if found.is_empty() => "no adapter found".to_string(),
+                Some(w) => format!("none with compute shaders matches WGPU_ADAPTER_NAME={w}"),
+                None => "none has compute shaders".to_string(),
+            };
+            return Err((tried, reason));
         };
         let info = adapter.get_info();
         let shader_f64 = adapter.features().contains(wgpu::Features::SHADER_F64);

@@ -12,6 +12,8 @@
 mod context;
 mod run;
 mod stencil;
+#[cfg(test)]
+mod tests;
 
 pub(crate) use context::shared;
 pub use context::{AdapterReport, Precision, gpu_adapter, gpu_test_gate};

@@ -90,9 +90,9 @@ pub fn solve_sor_with(
         vec![Coef::default(); nz * lay.h],
     ];
     let mut x = [vec![0.0; nz * lay.h], vec![0.0; nz * lay.h]];
-    for n in 0..nn {
+    for (n, dof) in dofs.iter().enumerate() {
         let (c, s) = lay.slot(n);
-        match dofs[n] {
+        match *dof {
             Dof::Fixed(v) => x[c][s] = v,
             Dof::Group(_) => {}
             Dof::Free => {

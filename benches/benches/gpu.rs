@@ -1,0 +1,89 @@
+//! The two backends side by side: one potential solve (with depletion, from the default initial
+//! iterate) and one weighting-potential solve (all contacts) of super-siegfried-k1 at 1025 V
+//! on three grids (crystal spacing 2, 1 and 0.5 mm, no refinement): CPU `fast` (active set with
+//! sparse Cholesky), CPU `sor`, and `sor` on the wgpu backend at the adapter's precision.
+//! CPU weighting potentials are one sparse Cholesky factorisation and two solves.
+//!
+//! On Mesa's lavapipe (a software Vulkan, as in CI) the wgpu numbers are correctness runs, not
+//! speed claims. Without an adapter the wgpu benches are skipped with one line.
+
+use std::hint::black_box;
+use std::time::Duration;
+
+use criterion::Criterion;
+use hpge_solver::{
+    Detector, Grid, GridSettings, Mesh, Parameters, Precision, gpu_adapter, solve_fast, solve_sor,
+    solve_sor_wgpu, weighting_potentials, weighting_potentials_wgpu,
+};
+use hpge_validation::repo_path;
+
+const BIAS_V: f64 = 1025.0;
+
+pub fn bench(c: &mut Criterion) {
+    let det = Detector::from_file(
+        &repo_path("detectors/super-siegfried-k1.toml"),
+        &Parameters::new(),
+    )
+    .expect("shipped detector loads");
+    let gpu = match gpu_adapter() {
+        Ok(a) => {
+            eprintln!(
+                "wgpu adapter: {} ({}, {}, {})",
+                a.name,
+                a.api,
+                a.device_type,
+                if a.shader_f64 { "f64" } else { "f32" }
+            );
+            true
+        }
+        Err(e) => {
+            eprintln!("skipping the wgpu benches: {e}");
+            false
+        }
+    };
+    let mut g = c.benchmark_group("backends");
+    g.sample_size(10).measurement_time(Duration::from_secs(10));
+    for spacing in [2.0, 1.0, 0.5] {
+        let gs = GridSettings {
+            max_spacing_semiconductor_mm: spacing,
+            max_spacing_mm: 4.0 * spacing,
+            ..GridSettings::default()
+        };
+        let mesh = Mesh::new(&det, Grid::initial(&det, &gs));
+        let nodes = mesh.kind.len();
+        let pot = solve_fast(&mesh, &det, BIAS_V, None).expect("solves");
+        g.bench_function(format!("potential/cpu_fast/{nodes}"), |b| {
+            b.iter(|| solve_fast(&mesh, &det, black_box(BIAS_V), None).expect("solves"))
+        });
+        g.bench_function(format!("potential/cpu_sor/{nodes}"), |b| {
+            b.iter(|| solve_sor(&mesh, &det, black_box(BIAS_V), None).expect("solves"))
+        });
+        g.bench_function(format!("weighting/cpu/{nodes}"), |b| {
+            b.iter(|| {
+                weighting_potentials(&mesh, &det, black_box(&pot.undepleted), BIAS_V)
+                    .expect("solves")
+            })
+        });
+        if gpu {
+            g.bench_function(format!("potential/wgpu_sor/{nodes}"), |b| {
+                b.iter(|| {
+                    solve_sor_wgpu(&mesh, &det, black_box(BIAS_V), None, Precision::Auto)
+                        .expect("solves")
+                })
+            });
+            g.bench_function(format!("weighting/wgpu_sor/{nodes}"), |b| {
+                b.iter(|| {
+                    weighting_potentials_wgpu(
+                        &mesh,
+                        &det,
+                        black_box(&pot.undepleted),
+                        BIAS_V,
+                        Precision::Auto,
+                    )
+                    .expect("solves")
+                })
+            });
+        }
+    }
+    g.finish();
+}
