@@ -1,8 +1,9 @@
 //! # hpge-solver
 //!
 //! The physics of hpge-cv: detector descriptions (geometry, materials, contacts, passives, world),
-//! impurity-density models with their parameter transforms, and (from the field-solver issue on) the
-//! potential with depletion, weighting potentials and the capacitance matrix.
+//! impurity-density models with their parameter transforms, and the potential with depletion,
+//! weighting potentials and the capacitance matrix, on the CPU or (the `sor` method) on a GPU
+//! through wgpu.
 //!
 //! Units at the interfaces: lengths in mm, potentials in V, impurity densities in cm^-3 (signed:
 //! positive is n-type), capacitances in pF. SI inside the numerics.
