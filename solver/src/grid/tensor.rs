@@ -4,7 +4,7 @@ use super::GridSettings;
 use super::axis::{AxisRule, build_axis, limit_ratio};
 use crate::Detector;
 
-/// A non-uniform tensor grid over the world; node (i, j) sits at (r[i], z[j]) in mm.
+/// A non-uniform tensor grid over the world; node (i, j) sits at (r\[i\], z\[j\]) in mm.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Grid {
     r_mm: Vec<f64>,

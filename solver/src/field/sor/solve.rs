@@ -15,7 +15,7 @@ use crate::field::system::Dof;
 use crate::{Detector, Error, Result};
 
 /// Solves for the potential with depletion by red-black projected SOR with default settings
-/// ([`SorSettings::default`]): the same discrete solution as
+/// (`SorSettings::default()`): the same discrete solution as
 /// [`solve_fast`](crate::field::solve_fast) up to the stopping tolerance, with the same
 /// undepleted nodes.
 ///
