@@ -214,6 +214,8 @@ fn sensitivity_scan_json_and_bad_range() {
     assert!(c[0] < c[1] && c[1] < c[2], "{c:?}");
     assert_eq!(v["fully_depleted"][0], true);
     assert_eq!(v["fully_depleted"][2], false);
+    assert_eq!(v["backend"], "cpu");
+    assert_eq!(v["method"], "fast");
     let bad = hpge_cv(&[
         "sensitivity",
         "--detector",

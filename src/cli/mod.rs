@@ -50,6 +50,8 @@ struct SensitivityArgs {
         allow_hyphen_values = true
     )]
     voltage: f64,
+    #[command(flatten)]
+    solver: SolverArgs,
     /// Densities MIN:MAX:N in cm^-3, N values spaced evenly in log.
     #[arg(long = "zeta-range", value_name = "MIN:MAX:N", default_value = "1e7:2e11:18", value_parser = sensitivity::parse_range)]
     zeta_range: ZetaList,
@@ -275,6 +277,7 @@ pub fn run(cli: Cli) -> Result<()> {
             input: &a.input,
             voltage_v: a.voltage,
             zetas_cm3: &a.zeta_range,
+            settings: a.solver.settings(WeightingArg::Conductor),
             json: a.json,
             out: a.out.as_ref(),
             plot: a.plot.as_ref(),

@@ -54,6 +54,8 @@ pub struct SensitivityOptions<'a> {
     pub json: bool,
     pub out: Option<&'a PathBuf>,
     pub plot: Option<&'a PathBuf>,
+    /// Backend, method and precision (weighting: conductor).
+    pub settings: FieldSettings,
 }
 
 /// Runs the scan and writes what was asked for.
@@ -68,7 +70,8 @@ pub fn run(o: &SensitivityOptions<'_>) -> Result<()> {
         plot::check_output(p, "--plot")?;
     }
     let mut det = load_detector(o.input)?;
-    let settings = FieldSettings::default();
+    let settings = o.settings.clone();
+    let device = super::simulate::backend_json(&settings)?;
     let bar = ProgressBar::new(o.zetas_cm3.len() as u64);
     bar.set_style(
         ProgressStyle::with_template(
@@ -113,6 +116,9 @@ pub fn run(o: &SensitivityOptions<'_>) -> Result<()> {
             "c12_pF": points.iter().map(|p| p.c12_pf).collect::<Vec<_>>(),
             "fully_depleted": points.iter().map(|p| p.fully_depleted).collect::<Vec<_>>(),
             "voltage_V": o.voltage_v,
+            "method": settings.method.as_str(),
+            "backend": settings.backend.as_str(),
+            "device": device,
             "seconds": seconds,
             "detector": det.file.display().to_string(),
             "parameters": det.parameters.iter().collect::<std::collections::BTreeMap<_, _>>(),

@@ -146,7 +146,7 @@ pub fn run(o: &SimulateOptions<'_>) -> Result<()> {
 /// none comes here, before any work); returns what ran where, for the JSON output:
 /// `{"adapter": name, "api": .., "device_type": .., "driver": .., "precision": "f64"|"f32"}` or
 /// null on the cpu backend.
-fn backend_json(settings: &FieldSettings) -> Result<serde_json::Value> {
+pub(super) fn backend_json(settings: &FieldSettings) -> Result<serde_json::Value> {
     settings
         .validate()
         .map_err(|m| anyhow::anyhow!("--method/--backend: {m}"))?;
