@@ -1,12 +1,85 @@
 //! The one error type of the inference crate.
 
-/// Errors of the inference crate.
+use std::path::PathBuf;
+
+/// Errors of the inference crate. Every variant names the file (and key) at fault, so the
+/// command line can print a message a user can act on.
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
     /// A failure in the surrogate layer (or, through it, the solver).
     #[error(transparent)]
     Surrogate(#[from] hpge_surrogate::Error),
+    /// A file could not be read or written.
+    #[error("{}: {action}: {source}", file.display())]
+    Io {
+        /// The file.
+        file: PathBuf,
+        /// What was attempted ("cannot read the file", "cannot create the file", ...).
+        action: &'static str,
+        /// The operating system's reason.
+        #[source]
+        source: std::io::Error,
+    },
+    /// A file is malformed: not an .npy array, truncated, a CSV with a wrong header or a
+    /// non-numeric cell, TOML that does not parse or fit the schema.
+    #[error("{}: {message}", file.display())]
+    Format {
+        /// The file.
+        file: PathBuf,
+        /// What is wrong, with line/column/key where known.
+        message: String,
+    },
+    /// A well-formed value that is invalid (NaN sample, negative period, shape disagreeing with
+    /// the sidecar, asymmetric covariance, ...).
+    #[error("{}: `{key}`: {message}", file.display())]
+    Invalid {
+        /// The file the value came from.
+        file: PathBuf,
+        /// The key, column or array element at fault.
+        key: String,
+        /// What is wrong with it.
+        message: String,
+    },
+    /// A numerical step failed (a fit that did not converge, too few events in a peak).
+    #[error("{what}: {message}")]
+    Numerical {
+        /// Which step, e.g. "pulser peak at 25 V".
+        what: String,
+        /// Why.
+        message: String,
+    },
+    /// A value given through the API or the command line is invalid.
+    #[error("`{name}`: {message}")]
+    Argument {
+        /// Name of the argument.
+        name: String,
+        /// What is wrong with it.
+        message: String,
+    },
 }
 
 /// Result alias of the inference crate.
 pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+impl Error {
+    /// Shorthand for [`Error::Format`].
+    pub fn format(file: impl Into<PathBuf>, message: impl Into<String>) -> Self {
+        Error::Format {
+            file: file.into(),
+            message: message.into(),
+        }
+    }
+
+    /// Shorthand for [`Error::Invalid`].
+    pub fn invalid(
+        file: impl Into<PathBuf>,
+        key: impl Into<String>,
+        message: impl Into<String>,
+    ) -> Self {
+        Error::Invalid {
+            file: file.into(),
+            key: key.into(),
+            message: message.into(),
+        }
+    }
+}

@@ -7,5 +7,13 @@
 //! the exact solver and the surrogate. Filled in by the measurement and inference issues.
 
 mod error;
+mod measurement;
 
 pub use error::{Error, Result};
+pub use measurement::{
+    Circuit, CvData, Data, MeasureSettings, Measurement, PC_PER_KEV, PeakFit, Problem, PulseSet,
+    RawProblem, RawRun, Sidecar, SynthSettings, SynthVoltage, TailFailure, TailFit, TailSettings,
+    Uncertainties, VoltagePoint, depletion_voltage, fit_peak, fit_tail, load_data, measure,
+    measure_voltage, negative_slopes, read_curve, read_pulses, read_raw_dir, synthesize_voltage,
+    voltage_seed, write_curve, write_curve_with_comments, write_pulses,
+};
