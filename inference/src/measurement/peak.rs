@@ -210,8 +210,17 @@ pub fn fit_peak(q_pc: &[f64], what: &str) -> Result<PeakFit> {
     let mut damping = 1e-3;
     let mut f = nll(&p);
     let mut converged = false;
-    for _ in 0..200 {
-        let (info, score) = fisher(&p);
+    for _ in 0..500 {
+        let (mut info, mut score) = fisher(&p);
+        // A background at its bound 0 that wants to go lower is held there (active bound).
+        if p[3] <= 0.0 && score[3] <= 0.0 {
+            for a in 0..4 {
+                info[3][a] = 0.0;
+                info[a][3] = 0.0;
+            }
+            info[3][3] = 1.0;
+            score[3] = 0.0;
+        }
         let mut m = info;
         for (a, row) in m.iter_mut().enumerate() {
             row[a] += damping * info[a][a].max(1e-300);
@@ -226,11 +235,13 @@ pub fn fit_peak(q_pc: &[f64], what: &str) -> Result<PeakFit> {
         q[3] = q[3].max(0.0);
         q[0] = q[0].max(1e-9);
         let fq = nll(&q);
-        if fq.is_finite() && fq <= f {
-            let small = (step[1].abs() < 1e-10 * s0) && (f - fq).abs() < 1e-12 * f.abs().max(1.0);
+        if fq.is_finite() && fq <= f + 1e-12 * f.abs().max(1.0) {
+            let small = step[1].abs() < 1e-9 * s0
+                && step[2].abs() < 1e-9
+                && (step[0].abs() < 1e-9 * p[0].max(1.0));
             p = q;
             f = fq;
-            damping = (damping * 0.3).max(1e-9);
+            damping = (damping * 0.3).max(1e-12);
             if small {
                 converged = true;
                 break;
@@ -238,6 +249,7 @@ pub fn fit_peak(q_pc: &[f64], what: &str) -> Result<PeakFit> {
         } else {
             damping *= 10.0;
             if damping > 1e12 {
+                // No step lowers the deviance any more: at the optimum within round-off.
                 converged = true;
                 break;
             }
