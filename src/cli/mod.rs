@@ -3,6 +3,7 @@
 mod args;
 mod detector;
 mod impurity;
+mod measure;
 mod sensitivity;
 mod simulate;
 
@@ -36,6 +37,54 @@ enum Command {
     Capacitance(CapacitanceArgs),
     /// c12 at one bias for constant impurity densities (the paper's sensitivity scan).
     Sensitivity(SensitivityArgs),
+    /// Raw pulser data (a directory of .npy pulse files) to a C-V curve with its covariance.
+    Measure(MeasureArgs),
+    /// Raw-like pulser data from a known C-V curve (for tests, and the shipped stand-in data).
+    Synthesize(SynthesizeArgs),
+}
+
+#[derive(Debug, clap::Args)]
+struct MeasureArgs {
+    /// Directory of pulse files: <stem>.npy [pulses, samples] in pC with a <stem>.toml sidecar
+    /// (bias_V, sampling_period_ns, charge_unit); optional measurement.toml (voltages_V,
+    /// circuit, uncertainties, tail fit).
+    #[arg(long, value_name = "DIR")]
+    raw: PathBuf,
+    /// The C-V curve (voltage_V,c12_pF,sigma_pF); the covariance goes to <stem>.covariance.csv
+    /// and a report to <stem>.measure.json.
+    #[arg(long, value_name = "FILE")]
+    out: PathBuf,
+    /// Write the figures (pulses, spectra, peak fits, C-V curve, slope; SVG and PNG) here.
+    #[arg(long, value_name = "DIR")]
+    plot: Option<PathBuf>,
+    /// Measurement settings (TOML) instead of <raw>/measurement.toml.
+    #[arg(long, value_name = "FILE")]
+    settings: Option<PathBuf>,
+    /// Print the report as one JSON object on stdout.
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(Debug, clap::Args)]
+struct SynthesizeArgs {
+    /// The true curve: a CSV with columns voltage_V and c12_pF (e.g. from `simulate --out`).
+    #[arg(long, value_name = "FILE")]
+    curve: PathBuf,
+    /// Output directory for the pulse files, measurement.toml and truth.json.
+    #[arg(long, value_name = "DIR")]
+    out: PathBuf,
+    /// Seed of the random generator.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Full-depletion voltage of the truth (V) [default: where its -dc12/dU_B falls to 1e-3 pF/V].
+    #[arg(long = "depletion-voltage", value_name = "V")]
+    depletion_voltage: Option<f64>,
+    /// Pulser pulses per bias [default: 200].
+    #[arg(long, value_name = "N")]
+    pulses: Option<usize>,
+    /// Average blocks of K samples (4 ns each) to keep files small [default: 1].
+    #[arg(long, value_name = "K")]
+    decimate: Option<usize>,
 }
 
 #[derive(Debug, clap::Args)]
@@ -282,6 +331,29 @@ pub fn run(cli: Cli) -> Result<()> {
             out: a.out.as_ref(),
             plot: a.plot.as_ref(),
         }),
+        Command::Measure(a) => measure::run(&measure::MeasureOptions {
+            raw: &a.raw,
+            out: &a.out,
+            plot: a.plot.as_ref(),
+            settings: a.settings.as_ref(),
+            json: a.json,
+        }),
+        Command::Synthesize(a) => {
+            let mut settings = hpge_inference::SynthSettings::default();
+            if let Some(n) = a.pulses {
+                settings.pulser_pulses = n;
+            }
+            if let Some(k) = a.decimate {
+                settings.decimate = k;
+            }
+            measure::synthesize(&measure::SynthOptions {
+                curve: &a.curve,
+                out: &a.out,
+                seed: a.seed,
+                depletion_v: a.depletion_voltage,
+                settings,
+            })
+        }
         Command::Capacitance(a) => {
             let settings = a.solver.settings(a.weighting);
             simulate::capacitance(&a.input, a.voltage, &settings, a.json)

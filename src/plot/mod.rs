@@ -38,6 +38,7 @@ mod colormap;
 mod cross_section;
 mod cv;
 mod field;
+mod measure;
 mod sensitivity;
 
 use std::path::Path;
@@ -45,6 +46,7 @@ use std::path::Path;
 pub use cross_section::cross_section;
 pub use cv::cv_curve;
 pub use field::field_map;
+pub use measure::measurement;
 pub use sensitivity::sensitivity;
 
 /// Output format, chosen by the file extension.

@@ -214,11 +214,10 @@ pub fn fit_peak(q_pc: &[f64], what: &str) -> Result<PeakFit> {
         let (mut info, mut score) = fisher(&p);
         // A background at its bound 0 that wants to go lower is held there (active bound).
         if p[3] <= 0.0 && score[3] <= 0.0 {
-            for a in 0..4 {
-                info[3][a] = 0.0;
-                info[a][3] = 0.0;
+            for row in info.iter_mut() {
+                row[3] = 0.0;
             }
-            info[3][3] = 1.0;
+            info[3] = [0.0, 0.0, 0.0, 1.0];
             score[3] = 0.0;
         }
         let mut m = info;

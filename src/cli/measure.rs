@@ -1,0 +1,290 @@
+//! `hpge-cv measure` (raw pulser data to a C-V curve with its covariance) and
+//! `hpge-cv synthesize` (a known C-V curve to raw-like pulser data).
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, bail};
+use hpge_inference::{
+    MeasureSettings, Measurement, PulseSet, RawProblem, SynthSettings, depletion_voltage, measure,
+    read_raw_dir, synthesize_voltage, voltage_seed, write_curve_with_comments, write_pulses,
+};
+use indicatif::{ProgressBar, ProgressStyle};
+use serde_json::json;
+
+use crate::plot;
+
+/// Options of `measure`.
+pub struct MeasureOptions<'a> {
+    pub raw: &'a Path,
+    pub out: &'a Path,
+    pub plot: Option<&'a PathBuf>,
+    pub settings: Option<&'a PathBuf>,
+    pub json: bool,
+}
+
+/// The settings: `--settings FILE`, else `<raw>/measurement.toml` if present, else defaults.
+fn settings_for(raw: &Path, explicit: Option<&PathBuf>) -> Result<(MeasureSettings, String)> {
+    let path = match explicit {
+        Some(p) => Some(p.clone()),
+        None => Some(raw.join("measurement.toml")).filter(|p| p.is_file()),
+    };
+    Ok(match path {
+        Some(p) => (MeasureSettings::from_file(&p)?, p.display().to_string()),
+        None => (MeasureSettings::default(), "defaults".to_string()),
+    })
+}
+
+/// Runs the measurement pipeline and writes the curve, its covariance, a JSON report and the
+/// figures.
+pub fn run(o: &MeasureOptions<'_>) -> Result<()> {
+    if let Some(dir) = o.plot
+        && !dir.is_dir()
+    {
+        std::fs::create_dir_all(dir)
+            .with_context(|| format!("--plot {}: cannot create the folder", dir.display()))?;
+    }
+    let (settings, settings_source) = settings_for(o.raw, o.settings)?;
+    let run = read_raw_dir(o.raw, settings.voltages_v.as_deref())?;
+    for p in &run.problems {
+        eprintln!(
+            "problem: {}{}: {}",
+            p.file.display(),
+            p.bias_v.map_or(String::new(), |v| format!(" ({v} V)")),
+            p.message
+        );
+    }
+    let bar = ProgressBar::new_spinner();
+    bar.set_style(
+        ProgressStyle::with_template("{spinner} fitting {msg} ({elapsed})")
+            .unwrap_or_else(|_| ProgressStyle::default_spinner()),
+    );
+    bar.set_message(format!("{} pulse files", run.sets.len()));
+    bar.enable_steady_tick(std::time::Duration::from_millis(200));
+    let m = measure(&run.sets, &settings, o.raw);
+    bar.finish_and_clear();
+    let m = m?;
+    for p in &m.problems {
+        eprintln!(
+            "problem: {}{}: {}",
+            p.file.display(),
+            p.bias_v.map_or(String::new(), |v| format!(" ({v} V)")),
+            p.message
+        );
+    }
+    let comments = vec![
+        format!(
+            "hpge-cv {} measure --raw {}",
+            env!("CARGO_PKG_VERSION"),
+            o.raw.display()
+        ),
+        format!("settings: {settings_source}"),
+        format!(
+            "uncertainties: relative {:?}; covariance in the sibling .covariance.csv",
+            settings.uncertainties
+        ),
+    ];
+    write_curve_with_comments(o.out, &m.curve, &comments)?;
+    let report = report_json(&m, o.raw, &settings_source, &run.problems);
+    let report_path = o.out.with_extension("measure.json");
+    std::fs::write(&report_path, format!("{report:#}\n"))
+        .with_context(|| format!("{}: cannot write the report", report_path.display()))?;
+    if let Some(dir) = o.plot {
+        plot::measurement(&m, &run.sets, dir)?;
+    }
+    if o.json {
+        println!("{report}");
+    } else {
+        println!(
+            "{:>8} {:>11} {:>9} {:>8} {:>7} {:>11}",
+            "U_B (V)", "c12 (pF)", "sigma", "stat", "pulses", "failed fits"
+        );
+        for (p, s) in m.points.iter().zip(&m.curve.sigma_pf) {
+            println!(
+                "{:>8} {:>11.4} {:>9.4} {:>8.1e} {:>7} {:>11}",
+                p.bias_v,
+                p.c12_pf,
+                s,
+                p.sigma_stat_pf,
+                p.n_pulses,
+                p.n_failed()
+            );
+        }
+        match m.depletion_voltage_v {
+            Some(v) => println!(
+                "full-depletion voltage (-dc12/dU_B = {} pF/V): {v:.0} V",
+                settings.depletion_slope_pf_per_v
+            ),
+            None => println!("-dc12/dU_B does not fall to the threshold within the curve"),
+        }
+        println!(
+            "wrote {} (+ .covariance.csv, .measure.json); {} problem(s)",
+            o.out.display(),
+            run.problems.len() + m.problems.len()
+        );
+    }
+    Ok(())
+}
+
+/// Everything about the run as one JSON object (also written beside the curve).
+fn report_json(
+    m: &Measurement,
+    raw: &Path,
+    settings: &str,
+    read_problems: &[RawProblem],
+) -> serde_json::Value {
+    let problems: Vec<serde_json::Value> = read_problems
+        .iter()
+        .map(|p| (p.file.clone(), p.bias_v, p.message.clone()))
+        .chain(
+            m.problems
+                .iter()
+                .map(|p| (p.file.clone(), p.bias_v, p.message.clone())),
+        )
+        .map(|(f, v, msg)| json!({"file": f.display().to_string(), "voltage_V": v, "message": msg}))
+        .collect();
+    json!({
+        "raw": raw.display().to_string(),
+        "settings": settings,
+        "voltage_V": m.curve.voltage_v,
+        "c12_pF": m.curve.c12_pf,
+        "sigma_pF": m.curve.sigma_pf,
+        "sigma_stat_pF": m.points.iter().map(|p| p.sigma_stat_pf).collect::<Vec<_>>(),
+        "depletion_voltage_V": m.depletion_voltage_v,
+        "points": m.points.iter().map(|p| json!({
+            "voltage_V": p.bias_v,
+            "file": p.source.display().to_string(),
+            "pulses": p.n_pulses,
+            "failed_fits": p.failed.iter().map(|(f, n)| json!({"reason": f.as_str(), "count": n})).collect::<Vec<_>>(),
+            "peak_mean_pC": p.peak.mean_pc,
+            "peak_mean_err_pC": p.peak.mean_err_pc,
+            "peak_width_pC": p.peak.sigma_pc,
+            "peak_events": p.peak.amplitude,
+        })).collect::<Vec<_>>(),
+        "problems": problems,
+        "version": env!("CARGO_PKG_VERSION"),
+    })
+}
+
+/// Options of `synthesize`.
+pub struct SynthOptions<'a> {
+    pub curve: &'a Path,
+    pub out: &'a Path,
+    pub seed: u64,
+    pub depletion_v: Option<f64>,
+    pub settings: SynthSettings,
+}
+
+/// Reads a curve CSV with columns `voltage_V` and `c12_pF` (the output of `simulate --out` or a
+/// measured curve).
+fn read_truth(path: &Path) -> Result<(Vec<f64>, Vec<f64>)> {
+    let mut rdr = csv::ReaderBuilder::new()
+        .comment(Some(b'#'))
+        .trim(csv::Trim::All)
+        .from_path(path)
+        .with_context(|| format!("--curve {}: cannot read the file", path.display()))?;
+    let headers = rdr.headers()?.clone();
+    let col = |name: &str| {
+        headers
+            .iter()
+            .position(|h| h == name)
+            .with_context(|| format!("--curve {}: no column `{name}`", path.display()))
+    };
+    let (cu, cc) = (col("voltage_V")?, col("c12_pF")?);
+    let (mut u, mut c) = (Vec::new(), Vec::new());
+    for (i, rec) in rdr.records().enumerate() {
+        let rec = rec.with_context(|| format!("--curve {}: line {}", path.display(), i + 2))?;
+        let num = |k: usize, name: &str| -> Result<f64> {
+            let t = rec.get(k).unwrap_or("");
+            t.parse::<f64>()
+                .ok()
+                .filter(|x| x.is_finite())
+                .with_context(|| {
+                    format!(
+                        "--curve {}: line {}, {name}: `{t}` is not a finite number",
+                        path.display(),
+                        i + 2
+                    )
+                })
+        };
+        u.push(num(cu, "voltage_V")?);
+        c.push(num(cc, "c12_pF")?);
+    }
+    if u.len() < 2 || u.windows(2).any(|w| w[1] <= w[0]) || c.iter().any(|x| *x <= 0.0) {
+        bail!(
+            "--curve {}: need at least 2 rows, strictly increasing voltages and c12 > 0",
+            path.display()
+        );
+    }
+    Ok((u, c))
+}
+
+/// Writes one pulse file per bias (`U<bias>V.npy` + sidecar), `measurement.toml` listing the
+/// biases, and `truth.json` with the curve, seed and settings.
+pub fn synthesize(o: &SynthOptions<'_>) -> Result<()> {
+    o.settings
+        .validate()
+        .map_err(|m| anyhow::anyhow!("synthesis settings: {m}"))?;
+    let (volts, c12) = read_truth(o.curve)?;
+    let ufd = match o.depletion_v {
+        Some(v) if v.is_finite() && v > 0.0 => v,
+        Some(v) => bail!("--depletion-voltage {v}: must be a positive number of volts"),
+        None => depletion_voltage(&volts, &c12, 1e-3).with_context(|| {
+            format!(
+                "--curve {}: -dc12/dU_B never falls to 1e-3 pF/V, so the full-depletion voltage is unknown; give --depletion-voltage",
+                o.curve.display()
+            )
+        })?,
+    };
+    std::fs::create_dir_all(o.out)
+        .with_context(|| format!("--out {}: cannot create the folder", o.out.display()))?;
+    let bar = ProgressBar::new(volts.len() as u64);
+    bar.set_style(
+        ProgressStyle::with_template("{bar:40} {pos}/{len} voltages, eta {eta}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    for (k, (&u, &c)) in volts.iter().zip(&c12).enumerate() {
+        let v = synthesize_voltage(u, c, ufd, &o.settings, voltage_seed(o.seed, k))?;
+        let name = o.out.join(format!("U{:04}V.npy", u.round() as i64));
+        let set = PulseSet {
+            source: name.clone(),
+            ..v.set
+        };
+        write_pulses(&name, &set, true)?;
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+    let toml_path = o.out.join("measurement.toml");
+    let list = volts
+        .iter()
+        .map(|v| format!("{v}"))
+        .collect::<Vec<_>>()
+        .join(", ");
+    std::fs::write(
+        &toml_path,
+        format!(
+            "# Written by hpge-cv {} synthesize (seed {}); the default circuit and uncertainties.\nvoltages_V = [{list}]\n",
+            env!("CARGO_PKG_VERSION"),
+            o.seed
+        ),
+    )
+    .with_context(|| format!("{}: cannot write", toml_path.display()))?;
+    let truth = json!({
+        "curve": o.curve.display().to_string(),
+        "voltage_V": volts,
+        "c12_pF": c12,
+        "depletion_voltage_V": ufd,
+        "seed": o.seed,
+        "settings": o.settings,
+        "version": env!("CARGO_PKG_VERSION"),
+    });
+    let truth_path = o.out.join("truth.json");
+    std::fs::write(&truth_path, format!("{truth:#}\n"))
+        .with_context(|| format!("{}: cannot write", truth_path.display()))?;
+    println!(
+        "wrote {} pulse files to {} (seed {}, U_fd {ufd:.0} V)",
+        volts.len(),
+        o.out.display(),
+        o.seed
+    );
+    Ok(())
+}
