@@ -233,3 +233,37 @@ pub fn measure(sets: &[PulseSet], s: &MeasureSettings, source: &Path) -> Result<
         settings: s.clone(),
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn settings_file_errors_name_the_file_and_key() {
+        let dir =
+            std::env::temp_dir().join(format!("hpge-measure-settings-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let f = dir.join("measurement.toml");
+        std::fs::write(
+            &f,
+            "voltages_V = [25.0, 75.0]\n[circuit]\nr1_ohm = 6190.0\n",
+        )
+        .unwrap();
+        let s = MeasureSettings::from_file(&f).unwrap();
+        assert_eq!(s.voltages_v, Some(vec![25.0, 75.0]));
+        assert_eq!(s.circuit, Circuit::default());
+        std::fs::write(&f, "[circuit]\nr3_ohm = 1.0\n").unwrap();
+        let e = MeasureSettings::from_file(&f).unwrap_err().to_string();
+        assert!(
+            e.contains("measurement.toml") && e.contains("r3_ohm"),
+            "{e}"
+        );
+        std::fs::write(&f, "[uncertainties]\nq_correlation = 2.0\n").unwrap();
+        let e = MeasureSettings::from_file(&f).unwrap_err().to_string();
+        assert!(
+            e.contains("measurement.toml") && e.contains("q_correlation"),
+            "{e}"
+        );
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}
