@@ -168,3 +168,22 @@ fn one_bad_voltage_leaves_the_others() {
         m.problems[0].message
     );
 }
+
+/// The shipped curve loads through the one validating loader, with its covariance (symmetric,
+/// positive definite, diagonal = sigma^2).
+#[test]
+fn shipped_curve_loads_with_its_covariance() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../data/super-siegfried-k1/cv.csv");
+    let hpge_inference::Data::Curve(c) = hpge_inference::load_data(&path).unwrap() else {
+        panic!("a .csv is a curve");
+    };
+    assert_eq!(c.voltage_v.len(), 60);
+    let cov = c.covariance_pf2.expect("the sibling covariance is found");
+    assert_eq!(cov.len(), 60);
+    let raw = Path::new(env!("CARGO_MANIFEST_DIR")).join("../data/super-siegfried-k1/raw");
+    let hpge_inference::Data::Raw(run) = hpge_inference::load_data(&raw).unwrap() else {
+        panic!("a directory is a raw run");
+    };
+    assert_eq!(run.sets.len(), 60);
+    assert!(run.problems.is_empty(), "{:?}", run.problems);
+}
