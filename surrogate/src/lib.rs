@@ -7,5 +7,9 @@
 //! `hpge-solver` only (data flows solver <- surrogate <- inference).
 
 mod error;
+mod sequence;
+mod space;
 
 pub use error::{Error, Result};
+pub use sequence::{Sequence, SequenceKind, phi_d};
+pub use space::{Dimension, Distribution, ParameterSpace, Target, normal_cdf, normal_quantile};

@@ -1,0 +1,221 @@
+//! A parameter space in TOML: per dimension a name, unit, range, distribution and the place it
+//! enters the simulation; maps to the unit hypercube [0, 1)^d and to standard-normal
+//! coordinates (the paper's T_N) and back.
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use super::normal::{normal_cdf, normal_quantile};
+use crate::{Error, Result};
+
+/// How a dimension is distributed over its range (a closed set).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Distribution {
+    /// x = lo + u (hi - lo).
+    #[default]
+    Uniform,
+    /// x = lo (hi / lo)^u (lo > 0): uniform in log x.
+    LogUniform,
+}
+
+/// Where a dimension enters a simulation.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Target {
+    /// The bias voltage U_B (V).
+    Bias,
+    /// A detector parameter from its `[parameters]` table, e.g. `d_li_mm`.
+    Parameter(String),
+    /// y at knot k of the rz model's bottom face.
+    YBot(usize),
+    /// y at knot k of the rz model's top face.
+    YTop(usize),
+}
+
+impl Target {
+    /// Parses `bias`, `parameter:NAME`, `y_bot[K]` or `y_top[K]`.
+    pub fn parse(s: &str) -> Option<Target> {
+        let s = s.trim();
+        if s == "bias" {
+            return Some(Target::Bias);
+        }
+        if let Some(name) = s.strip_prefix("parameter:") {
+            return (!name.is_empty()).then(|| Target::Parameter(name.to_string()));
+        }
+        let index = |rest: &str| rest.strip_prefix('[')?.strip_suffix(']')?.parse().ok();
+        if let Some(rest) = s.strip_prefix("y_bot") {
+            return index(rest).map(Target::YBot);
+        }
+        if let Some(rest) = s.strip_prefix("y_top") {
+            return index(rest).map(Target::YTop);
+        }
+        None
+    }
+}
+
+/// One dimension as written in the file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Dimension {
+    /// Column name, e.g. `d_li_mm` or `y1_bot`.
+    pub name: String,
+    /// Unit of the physical value (`mm`, `V`, `1`).
+    pub unit: String,
+    /// [lo, hi] of the physical value.
+    pub range: [f64; 2],
+    /// Distribution over the range.
+    #[serde(default)]
+    pub distribution: Distribution,
+    /// Where it enters the simulation: `bias`, `parameter:NAME`, `y_bot[K]`, `y_top[K]`.
+    pub target: String,
+}
+
+/// A parameter space.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ParameterSpace {
+    /// Name, e.g. `super-siegfried-rz`.
+    pub name: String,
+    /// Free text.
+    #[serde(default)]
+    pub description: String,
+    /// The dimensions, in column order.
+    pub dimensions: Vec<Dimension>,
+    /// The file it came from.
+    #[serde(skip)]
+    pub file: PathBuf,
+}
+
+impl ParameterSpace {
+    /// Reads and validates a space file.
+    pub fn from_file(path: &Path) -> Result<Self> {
+        let text = std::fs::read_to_string(path).map_err(|e| Error::Io {
+            file: path.into(),
+            action: "cannot read the file",
+            source: e,
+        })?;
+        Self::from_toml_str(&text, path)
+    }
+
+    /// Parses and validates TOML text (`path` names it in messages).
+    pub fn from_toml_str(text: &str, path: &Path) -> Result<Self> {
+        let mut s: Self = toml::from_str(text).map_err(|e| Error::Parse {
+            file: path.into(),
+            message: e.to_string().trim_end().to_string(),
+        })?;
+        s.file = path.into();
+        s.validate()?;
+        Ok(s)
+    }
+
+    fn validate(&self) -> Result<()> {
+        let bad = |k: usize, key: &str, m: String| Error::Invalid {
+            file: self.file.clone(),
+            key: format!("dimensions[{k}].{key}"),
+            message: m,
+        };
+        if self.dimensions.is_empty() {
+            return Err(Error::Invalid {
+                file: self.file.clone(),
+                key: "dimensions".into(),
+                message: "at least one dimension is needed".into(),
+            });
+        }
+        for (k, d) in self.dimensions.iter().enumerate() {
+            let [lo, hi] = d.range;
+            if !(lo.is_finite() && hi.is_finite() && lo < hi) {
+                return Err(bad(
+                    k,
+                    "range",
+                    format!("need finite lo < hi, got [{lo}, {hi}]"),
+                ));
+            }
+            if d.distribution == Distribution::LogUniform && lo <= 0.0 {
+                return Err(bad(
+                    k,
+                    "range",
+                    format!("log-uniform needs lo > 0, got {lo}"),
+                ));
+            }
+            if Target::parse(&d.target).is_none() {
+                return Err(bad(
+                    k,
+                    "target",
+                    format!(
+                        "`{}`: expected `bias`, `parameter:NAME`, `y_bot[K]` or `y_top[K]`",
+                        d.target
+                    ),
+                ));
+            }
+            if d.name.trim().is_empty() || d.name.contains(',') {
+                return Err(bad(
+                    k,
+                    "name",
+                    "must be non-empty and without commas".into(),
+                ));
+            }
+            if self.dimensions[..k].iter().any(|e| e.name == d.name) {
+                return Err(bad(k, "name", format!("`{}` appears twice", d.name)));
+            }
+            if self.dimensions[..k].iter().any(|e| e.target == d.target) {
+                return Err(bad(k, "target", format!("`{}` appears twice", d.target)));
+            }
+        }
+        Ok(())
+    }
+
+    /// Number of dimensions d.
+    pub fn dim(&self) -> usize {
+        self.dimensions.len()
+    }
+
+    /// The targets, in column order.
+    pub fn targets(&self) -> Vec<Target> {
+        self.dimensions
+            .iter()
+            .map(|d| Target::parse(&d.target).expect("validated"))
+            .collect()
+    }
+
+    /// Physical values from unit-cube coordinates u in [0, 1]^d (per dimension
+    /// x = lo + u (hi - lo), or lo (hi / lo)^u for log-uniform).
+    pub fn from_unit(&self, u: &[f64]) -> Vec<f64> {
+        self.dimensions
+            .iter()
+            .zip(u)
+            .map(|(d, &u)| {
+                let [lo, hi] = d.range;
+                match d.distribution {
+                    Distribution::Uniform => lo + u * (hi - lo),
+                    Distribution::LogUniform => lo * (hi / lo).powf(u),
+                }
+            })
+            .collect()
+    }
+
+    /// Unit-cube coordinates of physical values (the inverse of [`Self::from_unit`]).
+    pub fn to_unit(&self, x: &[f64]) -> Vec<f64> {
+        self.dimensions
+            .iter()
+            .zip(x)
+            .map(|(d, &x)| {
+                let [lo, hi] = d.range;
+                match d.distribution {
+                    Distribution::Uniform => (x - lo) / (hi - lo),
+                    Distribution::LogUniform => (x / lo).ln() / (hi / lo).ln(),
+                }
+            })
+            .collect()
+    }
+
+    /// Standard-normal coordinates z = Phi^-1(u) of unit-cube coordinates (the paper's T_N).
+    pub fn unit_to_normal(u: &[f64]) -> Vec<f64> {
+        u.iter().map(|&u| normal_quantile(u)).collect()
+    }
+
+    /// Unit-cube coordinates u = Phi(z) of standard-normal ones.
+    pub fn normal_to_unit(z: &[f64]) -> Vec<f64> {
+        z.iter().map(|&z| normal_cdf(z)).collect()
+    }
+}
