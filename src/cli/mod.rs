@@ -2,6 +2,7 @@
 
 mod args;
 mod detector;
+mod generate;
 mod impurity;
 mod measure;
 mod sensitivity;
@@ -41,6 +42,61 @@ enum Command {
     Measure(MeasureArgs),
     /// Raw-like pulser data from a known C-V curve (for tests, and the shipped stand-in data).
     Synthesize(SynthesizeArgs),
+    /// Training rows: c12 from the exact solver at quasi-random points of a parameter space
+    /// (resumable; shardable over a Slurm job array).
+    Generate(GenerateArgs),
+    /// Merge the shard folders of one `generate` run into one CSV.
+    Merge(MergeArgs),
+}
+
+/// Which low-discrepancy sequence.
+#[derive(Debug, Clone, Copy, clap::ValueEnum)]
+enum SequenceArg {
+    /// The golden R_d sequence (the paper's).
+    Golden,
+    /// Owen-scrambled Sobol (at most 65536 points).
+    Sobol,
+}
+
+#[derive(Debug, clap::Args)]
+struct GenerateArgs {
+    /// Parameter space (TOML), e.g. spaces/super-siegfried-rz.toml.
+    #[arg(long, value_name = "FILE")]
+    space: PathBuf,
+    /// Detector description (TOML).
+    #[arg(long, value_name = "FILE")]
+    detector: PathBuf,
+    /// Number of samples of the whole run (all shards).
+    #[arg(long, value_name = "N")]
+    n: u64,
+    /// Output folder (rows.csv + generate.json); rerun with the same arguments to resume.
+    #[arg(long, value_name = "DIR")]
+    out: PathBuf,
+    /// This process's shard K of M (indices offset + i with i mod M = K).
+    #[arg(long, value_name = "K/M", value_parser = hpge_surrogate::Shard::parse, default_value = "0/1")]
+    shard: hpge_surrogate::Shard,
+    /// First sequence index.
+    #[arg(long, value_name = "O", default_value_t = 0)]
+    offset: u64,
+    /// Worker threads [default: all cores].
+    #[arg(long, value_name = "T")]
+    threads: Option<usize>,
+    /// Sequence seed (golden: 0 starts at 0.5 in every dimension).
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Sequence.
+    #[arg(long, value_enum, default_value = "golden")]
+    sequence: SequenceArg,
+}
+
+#[derive(Debug, clap::Args)]
+struct MergeArgs {
+    /// The merged CSV (a sidecar <stem>.json records the run and the shards).
+    #[arg(long, value_name = "FILE")]
+    out: PathBuf,
+    /// The shard folders.
+    #[arg(value_name = "SHARD_DIRS", required = true)]
+    dirs: Vec<PathBuf>,
 }
 
 #[derive(Debug, clap::Args)]
@@ -331,6 +387,21 @@ pub fn run(cli: Cli) -> Result<()> {
             out: a.out.as_ref(),
             plot: a.plot.as_ref(),
         }),
+        Command::Generate(a) => generate::generate(&generate::GenerateOptions {
+            space: &a.space,
+            detector: &a.detector,
+            n: a.n,
+            out: &a.out,
+            shard: a.shard,
+            offset: a.offset,
+            threads: a.threads,
+            seed: a.seed,
+            sequence: match a.sequence {
+                SequenceArg::Golden => hpge_surrogate::SequenceKind::Golden,
+                SequenceArg::Sobol => hpge_surrogate::SequenceKind::Sobol,
+            },
+        }),
+        Command::Merge(a) => generate::merge_shards(&a.dirs, &a.out),
         Command::Measure(a) => measure::run(&measure::MeasureOptions {
             raw: &a.raw,
             out: &a.out,

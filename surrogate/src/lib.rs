@@ -7,9 +7,14 @@
 //! `hpge-solver` only (data flows solver <- surrogate <- inference).
 
 mod error;
+mod generate;
 mod sequence;
 mod space;
 
 pub use error::{Error, Result};
+pub use generate::{
+    Fingerprint, Generator, MergeReport, RunInfo, RunReport, Sample, Shard, fnv1a, format_row,
+    merge, read_rows, run,
+};
 pub use sequence::{Sequence, SequenceKind, phi_d};
 pub use space::{Dimension, Distribution, ParameterSpace, Target, normal_cdf, normal_quantile};

@@ -1,0 +1,81 @@
+//! `hpge-cv generate` (training rows from quasi-random samples, resumable and sharded) and
+//! `hpge-cv merge` (shard folders into one set).
+
+use std::path::{Path, PathBuf};
+
+use anyhow::Result;
+use hpge_solver::FieldSettings;
+use hpge_surrogate::{Generator, ParameterSpace, SequenceKind, Shard, merge, run};
+use indicatif::{ProgressBar, ProgressStyle};
+
+/// Options of `generate`.
+pub struct GenerateOptions<'a> {
+    pub space: &'a Path,
+    pub detector: &'a Path,
+    pub n: u64,
+    pub out: &'a Path,
+    pub shard: Shard,
+    pub offset: u64,
+    pub threads: Option<usize>,
+    pub seed: u64,
+    pub sequence: SequenceKind,
+}
+
+/// Runs or resumes a generation.
+pub fn generate(o: &GenerateOptions<'_>) -> Result<()> {
+    let space = ParameterSpace::from_file(o.space)?;
+    let g = Generator::new(
+        space,
+        o.detector,
+        FieldSettings::default(),
+        o.sequence,
+        o.seed,
+        o.offset,
+        o.n,
+        o.shard,
+    )?;
+    let bar = ProgressBar::new(0);
+    bar.set_style(
+        ProgressStyle::with_template(
+            "{bar:40} {pos}/{len} samples, {per_sec}, {elapsed} elapsed, eta {eta}",
+        )
+        .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    let start = std::time::Instant::now();
+    let report = run(&g, o.out, o.threads, |done, total| {
+        bar.set_length(total as u64);
+        bar.set_position(done as u64);
+    });
+    bar.finish_and_clear();
+    let report = report?;
+    let seconds = start.elapsed().as_secs_f64();
+    if report.repaired {
+        eprintln!("note: cut off a torn last line left by an interrupted run");
+    }
+    for (i, status) in &report.failed {
+        eprintln!("sample {i}: {status}");
+    }
+    println!(
+        "{}: {} rows ({} from before, {} now in {seconds:.1} s, {:.2} samples/s), {} failed solves",
+        o.out.join("rows.csv").display(),
+        report.total,
+        report.resumed,
+        report.written,
+        report.written as f64 / seconds.max(1e-9),
+        report.failed.len()
+    );
+    Ok(())
+}
+
+/// Merges shard folders.
+pub fn merge_shards(dirs: &[PathBuf], out: &Path) -> Result<()> {
+    let r = merge(dirs, out)?;
+    println!(
+        "{}: {} rows from {} shards ({} failed solves)",
+        out.display(),
+        r.rows,
+        dirs.len(),
+        r.failed
+    );
+    Ok(())
+}

@@ -1,0 +1,303 @@
+//! Running a generation: append-only rows, resumable after any interruption (kill -9 included).
+//!
+//! The output folder holds `generate.json` (the fingerprint, the shard, the header, the
+//! program version) and `rows.csv`. Every row is one `write` of one whole line to a file
+//! opened for appending, in completion order. On a restart with the same arguments the
+//! fingerprint must match (else the run refuses: no mixing of spaces, detectors or settings), a
+//! last line without its newline (a write cut by the kill) is cut off, the indices present are
+//! skipped, and the rest are solved. Sorted by index, the rows equal those of an uninterrupted
+//! run in every column but `seconds` (wall time).
+
+use std::collections::HashSet;
+use std::fs::OpenOptions;
+use std::io::{Read, Seek, SeekFrom, Write};
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use super::setup::{Fingerprint, Generator, Sample, Shard};
+use crate::{Error, Result};
+
+/// The sidecar of a generation folder.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RunInfo {
+    /// What determines the rows.
+    pub fingerprint: Fingerprint,
+    /// This folder's shard.
+    pub shard: Shard,
+    /// The CSV header.
+    pub header: String,
+    /// Space and detector files as given.
+    pub space_file: String,
+    /// Detector file as given.
+    pub detector_file: String,
+    /// Program version that started the run.
+    pub version: String,
+}
+
+/// What a run did.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunReport {
+    /// Rows found from before.
+    pub resumed: usize,
+    /// Rows written now.
+    pub written: usize,
+    /// Rows of this shard in total.
+    pub total: usize,
+    /// Failed solves written now: (index, status).
+    pub failed: Vec<(u64, String)>,
+    /// A torn last line was cut off.
+    pub repaired: bool,
+}
+
+/// One row as CSV (no newline): floats in Rust's shortest round-trip form.
+pub fn format_row(s: &Sample) -> String {
+    let mut line = s.index.to_string();
+    for v in s.u.iter().chain(&s.x) {
+        line.push(',');
+        line.push_str(&v.to_string());
+    }
+    line.push_str(&format!(",{},{},{}", s.c12_pf, s.status, s.seconds));
+    line
+}
+
+fn io<'a>(file: &'a Path, action: &'static str) -> impl Fn(std::io::Error) -> Error + 'a {
+    move |e| Error::Io {
+        file: file.into(),
+        action,
+        source: e,
+    }
+}
+
+/// Reads the rows of a folder: the indices present (checked: whole lines with the header's
+/// field count), and whether a torn last line was cut off (only with `repair`).
+pub fn read_rows(rows: &Path, header: &str, repair: bool) -> Result<(Vec<(u64, String)>, bool)> {
+    let mut f = OpenOptions::new()
+        .read(true)
+        .write(repair)
+        .open(rows)
+        .map_err(io(rows, "cannot open the rows"))?;
+    let mut text = String::new();
+    f.read_to_string(&mut text)
+        .map_err(io(rows, "cannot read the rows (not UTF-8?)"))?;
+    let mut repaired = false;
+    if !text.is_empty() && !text.ends_with('\n') {
+        if !repair {
+            return Err(Error::Invalid {
+                file: rows.into(),
+                key: "last line".into(),
+                message:
+                    "ends without a newline (an interrupted run: resume it with `generate` first)"
+                        .into(),
+            });
+        }
+        let keep = text.rfind('\n').map_or(0, |p| p + 1);
+        f.set_len(keep as u64)
+            .map_err(io(rows, "cannot cut off the torn last line"))?;
+        f.seek(SeekFrom::End(0)).map_err(io(rows, "cannot seek"))?;
+        text.truncate(keep);
+        repaired = true;
+    }
+    let mut lines = text.lines();
+    match lines.next() {
+        None => return Ok((Vec::new(), repaired)),
+        Some(h) if h == header => {}
+        Some(h) => {
+            return Err(Error::Invalid {
+                file: rows.into(),
+                key: "header".into(),
+                message: format!("`{h}` differs from this run's `{header}`"),
+            });
+        }
+    }
+    let fields = header.split(',').count();
+    let mut out = Vec::new();
+    for (k, line) in lines.enumerate() {
+        let bad = |m: String| Error::Invalid {
+            file: rows.into(),
+            key: format!("line {}", k + 2),
+            message: m,
+        };
+        if line.split(',').count() != fields {
+            return Err(bad(format!(
+                "{} fields, the header has {fields}",
+                line.split(',').count()
+            )));
+        }
+        let index: u64 = line
+            .split(',')
+            .next()
+            .unwrap_or("")
+            .parse()
+            .map_err(|e| bad(format!("the index is not a whole number ({e})")))?;
+        out.push((index, line.to_string()));
+    }
+    Ok((out, repaired))
+}
+
+/// Runs (or resumes) the generation of `g` into the folder `out` on `threads` threads
+/// (`None`: all cores); `progress(done, total)` after every row.
+pub fn run(
+    g: &Generator,
+    out: &Path,
+    threads: Option<usize>,
+    progress: impl Fn(usize, usize) + Sync,
+) -> Result<RunReport> {
+    std::fs::create_dir_all(out).map_err(io(out, "cannot create the output folder"))?;
+    let info_path = out.join("generate.json");
+    let rows_path = out.join("rows.csv");
+    let info = RunInfo {
+        fingerprint: g.fingerprint.clone(),
+        shard: g.shard,
+        header: g.header(),
+        space_file: g.space.file.display().to_string(),
+        detector_file: g.detector_file.display().to_string(),
+        version: env!("CARGO_PKG_VERSION").to_string(),
+    };
+    if info_path.exists() {
+        let old: RunInfo = serde_json::from_str(
+            &std::fs::read_to_string(&info_path).map_err(io(&info_path, "cannot read"))?,
+        )
+        .map_err(|e| Error::Parse {
+            file: info_path.clone(),
+            message: e.to_string(),
+        })?;
+        if old.fingerprint != info.fingerprint
+            || old.shard != info.shard
+            || old.header != info.header
+        {
+            return Err(Error::Argument {
+                name: "--out".into(),
+                message: format!(
+                    "{} holds rows of another run (there: {}; here: {}); refusing to mix them, use another folder",
+                    out.display(),
+                    describe(&old),
+                    describe(&info)
+                ),
+            });
+        }
+    } else if rows_path.exists() {
+        return Err(Error::Argument {
+            name: "--out".into(),
+            message: format!(
+                "{} has rows.csv but no generate.json: unknown provenance, refusing to append",
+                out.display()
+            ),
+        });
+    } else {
+        let text = serde_json::to_string_pretty(&info).unwrap_or_default();
+        std::fs::write(&info_path, text + "\n").map_err(io(&info_path, "cannot write"))?;
+    }
+    let (existing, repaired) = if rows_path.exists() {
+        read_rows(&rows_path, &info.header, true)?
+    } else {
+        (Vec::new(), false)
+    };
+    let mut file = OpenOptions::new()
+        .create(true)
+        .append(true)
+        .open(&rows_path)
+        .map_err(io(&rows_path, "cannot open the rows for appending"))?;
+    if existing.is_empty()
+        && std::fs::metadata(&rows_path)
+            .map_err(io(&rows_path, "cannot stat"))?
+            .len()
+            == 0
+    {
+        file.write_all(format!("{}\n", info.header).as_bytes())
+            .map_err(io(&rows_path, "cannot write the header"))?;
+    }
+    let done: HashSet<u64> = existing.iter().map(|r| r.0).collect();
+    let todo: Vec<u64> = g
+        .shard
+        .indices(g.offset, g.n)
+        .filter(|i| !done.contains(i))
+        .collect();
+    let total = done.len() + todo.len();
+    let file = Mutex::new(file);
+    let counter = std::sync::atomic::AtomicUsize::new(done.len());
+    let failed = Mutex::new(Vec::new());
+    let error: Mutex<Option<Error>> = Mutex::new(None);
+    let work = || {
+        todo.par_iter().for_each(|&i| {
+            if error.lock().map(|e| e.is_some()).unwrap_or(true) {
+                return;
+            }
+            let s = g.sample(i);
+            let line = format_row(&s) + "\n";
+            let mut f = file.lock().unwrap_or_else(|e| e.into_inner());
+            if let Err(e) = f.write_all(line.as_bytes()) {
+                *error.lock().unwrap_or_else(|e| e.into_inner()) =
+                    Some(io(&rows_path, "cannot append a row (disk full?)")(e));
+                return;
+            }
+            drop(f);
+            if s.status != "ok" {
+                failed
+                    .lock()
+                    .unwrap_or_else(|e| e.into_inner())
+                    .push((i, s.status.clone()));
+            }
+            let n = counter.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+            progress(n, total);
+        })
+    };
+    match threads {
+        Some(t) => rayon::ThreadPoolBuilder::new()
+            .num_threads(t.max(1))
+            .build()
+            .map_err(|e| Error::Argument {
+                name: "--threads".into(),
+                message: e.to_string(),
+            })?
+            .install(work),
+        None => work(),
+    }
+    if let Some(e) = error.into_inner().unwrap_or_else(|e| e.into_inner()) {
+        return Err(e);
+    }
+    let mut failed = failed.into_inner().unwrap_or_else(|e| e.into_inner());
+    failed.sort();
+    Ok(RunReport {
+        resumed: done.len(),
+        written: todo.len(),
+        total,
+        failed,
+        repaired,
+    })
+}
+
+fn describe(i: &RunInfo) -> String {
+    let f = &i.fingerprint;
+    format!(
+        "space {} {}, detector {} {}, settings {}, {} seed {}, indices {}..{}, shard {}/{}",
+        f.space,
+        f.space_hash,
+        f.detector,
+        f.detector_hash,
+        f.settings_hash,
+        f.sequence,
+        f.seed,
+        f.offset,
+        f.offset + f.n,
+        i.shard.k,
+        i.shard.m
+    )
+}
+
+/// The rows of one folder (its info and lines), for `merge`.
+pub fn read_folder(dir: &Path) -> Result<(RunInfo, Vec<(u64, String)>)> {
+    let info_path = dir.join("generate.json");
+    let info: RunInfo = serde_json::from_str(
+        &std::fs::read_to_string(&info_path).map_err(io(&info_path, "cannot read"))?,
+    )
+    .map_err(|e| Error::Parse {
+        file: info_path.clone(),
+        message: e.to_string(),
+    })?;
+    let rows_path: PathBuf = dir.join("rows.csv");
+    let (rows, _) = read_rows(&rows_path, &info.header, false)?;
+    Ok((info, rows))
+}

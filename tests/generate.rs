@@ -1,0 +1,200 @@
+//! Training-set generation as a user runs it (issue: training sets): determinism, shards and
+//! merge equal one run, kill -9 and resume, refusal to mix runs, bad input.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn bin() -> Command {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_hpge-cv"));
+    c.current_dir(env!("CARGO_MANIFEST_DIR"));
+    c
+}
+
+fn run(args: &[&str]) -> Output {
+    bin().args(args).output().unwrap()
+}
+
+fn temp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("hpge-gen-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn generate(out: &Path, n: &str, extra: &[&str]) -> Output {
+    let mut args = vec![
+        "generate",
+        "--space",
+        "spaces/super-siegfried-rz.toml",
+        "--detector",
+        "detectors/super-siegfried-k1.toml",
+        "--n",
+        n,
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    args.extend_from_slice(extra);
+    run(&args)
+}
+
+/// Rows sorted by index without the `seconds` column (wall time differs between runs).
+fn rows(path: &Path) -> Vec<String> {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut v: Vec<(u64, String)> = text
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let cut = l.rfind(',').unwrap();
+            (
+                l.split(',').next().unwrap().parse().unwrap(),
+                l[..cut].to_string(),
+            )
+        })
+        .collect();
+    v.sort();
+    v.into_iter().map(|r| r.1).collect()
+}
+
+#[test]
+fn shards_merge_to_the_single_run_and_runs_are_deterministic() {
+    let d = temp("shards");
+    let whole = d.join("whole");
+    let o = generate(&whole, "9", &["--threads", "2"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let again = d.join("again");
+    assert!(generate(&again, "9", &["--threads", "1"]).status.success());
+    assert_eq!(rows(&whole.join("rows.csv")), rows(&again.join("rows.csv")));
+    let mut dirs = Vec::new();
+    for k in 0..3 {
+        let s = d.join(format!("s{k}"));
+        let shard = format!("{k}/3");
+        let o = generate(&s, "9", &["--shard", &shard, "--threads", "1"]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        assert_eq!(rows(&s.join("rows.csv")).len(), 3);
+        dirs.push(s);
+    }
+    let merged = d.join("merged.csv");
+    let mut args = vec!["merge", "--out", merged.to_str().unwrap()];
+    args.extend(dirs.iter().map(|p| p.to_str().unwrap()));
+    let o = run(&args);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(rows(&merged), rows(&whole.join("rows.csv")));
+    assert!(d.join("merged.json").is_file());
+    // Incomplete or inconsistent sets are refused.
+    let o = run(&[
+        "merge",
+        "--out",
+        merged.to_str().unwrap(),
+        dirs[0].to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("missing"));
+    let o = run(&[
+        "merge",
+        "--out",
+        merged.to_str().unwrap(),
+        dirs[0].to_str().unwrap(),
+        dirs[0].to_str().unwrap(),
+        dirs[1].to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn kill_and_resume_loses_and_duplicates_nothing() {
+    let d = temp("kill");
+    let reference = d.join("reference");
+    assert!(
+        generate(&reference, "24", &["--threads", "1"])
+            .status
+            .success()
+    );
+    let out = d.join("killed");
+    for delay_ms in [300, 700] {
+        let mut child = bin()
+            .args([
+                "generate",
+                "--space",
+                "spaces/super-siegfried-rz.toml",
+                "--detector",
+                "detectors/super-siegfried-k1.toml",
+                "--n",
+                "24",
+                "--out",
+                out.to_str().unwrap(),
+                "--threads",
+                "1",
+            ])
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::null())
+            .spawn()
+            .unwrap();
+        std::thread::sleep(std::time::Duration::from_millis(delay_ms));
+        let _ = child.kill(); // SIGKILL
+        let _ = child.wait();
+    }
+    // A torn line, as a kill in the middle of a write would leave.
+    let rows_path = out.join("rows.csv");
+    let mut text = std::fs::read_to_string(&rows_path).unwrap();
+    let before = text.lines().count();
+    text.push_str("17,0.25,0.5");
+    std::fs::write(&rows_path, text).unwrap();
+    let o = generate(&out, "24", &["--threads", "2"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let got = rows(&rows_path);
+    assert_eq!(got.len(), 24, "{before} lines before the resume");
+    assert_eq!(got, rows(&reference.join("rows.csv")));
+    // Another space, detector, seed or settings: refused, rows untouched.
+    let size = std::fs::metadata(&rows_path).unwrap().len();
+    let o = generate(&out, "24", &["--seed", "5"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("refusing"));
+    assert_eq!(std::fs::metadata(&rows_path).unwrap().len(), size);
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn bad_input_is_a_clear_error() {
+    let d = temp("bad");
+    let out = d.join("x");
+    for (extra, n, want) in [
+        (vec![], "0", "at least 1"),
+        (vec!["--shard", "3/3"], "5", "K < M"),
+        (vec!["--shard", "a/3"], "5", "not a whole number"),
+        (
+            vec!["--sequence", "sobol", "--offset", "65530"],
+            "10",
+            "exceed",
+        ),
+    ] {
+        let o = generate(&out, n, &extra);
+        assert_eq!(o.status.code(), Some(2), "{extra:?}");
+        let e = String::from_utf8_lossy(&o.stderr);
+        assert!(e.contains(want), "{extra:?}: {e}");
+    }
+    let space = d.join("space.toml");
+    std::fs::write(
+        &space,
+        "name = \"s\"\n[[dimensions]]\nname = \"U_B\"\nunit = \"V\"\nrange = [3000.0, 10.0]\ntarget = \"bias\"\n",
+    )
+    .unwrap();
+    let o = run(&[
+        "generate",
+        "--space",
+        space.to_str().unwrap(),
+        "--detector",
+        "detectors/coax-analytic.toml",
+        "--n",
+        "3",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(e.contains("space.toml") && e.contains("range"), "{e}");
+    let o = generate(Path::new("/proc/hpge-cv-cannot-write"), "3", &[]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("/proc/hpge-cv-cannot-write"));
+    let _ = std::fs::remove_dir_all(&d);
+}
