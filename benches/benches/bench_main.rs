@@ -2,9 +2,16 @@
 
 use criterion::{criterion_group, criterion_main};
 
+mod generate;
 mod gpu;
 mod impurity;
 mod solver;
 
-criterion_group!(benches, impurity::bench, solver::bench, gpu::bench);
+criterion_group!(
+    benches,
+    impurity::bench,
+    solver::bench,
+    gpu::bench,
+    generate::bench
+);
 criterion_main!(benches);

@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# Regenerates the paper's training data for super-siegfried-k1 (issue: training sets) and prints
+# the hashes recorded in data/training/README.md. The sets are not committed (28 MB of CSV): this
+# script and the hashes are. About 20 min on the 2-core machine (measured: see the README).
+#   paper-60000/rows.csv   60000 samples of spaces/super-siegfried-rz.toml, golden sequence, seed 0
+#   train.csv, test.csv    its 80:20 split by index order (0..47999, 48000..59999), as in the paper
+#   heldout-5000/rows.csv  5000 further samples from offset 100000 (never used for training)
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+OUT=${OUT:-data/training}
+cargo build --release -q
+B=target/release/hpge-cv
+S=spaces/super-siegfried-rz.toml
+D=detectors/super-siegfried-k1.toml
+$B generate --space $S --detector $D --n 60000 --out "$OUT/paper-60000"
+$B generate --space $S --detector $D --n 5000 --offset 100000 --out "$OUT/heldout-5000"
+# Rows in index order (generation appends in completion order).
+sorted() { head -n 1 "$1"; tail -n +2 "$1" | sort -t, -k1,1n; }
+sorted "$OUT/paper-60000/rows.csv" | awk -F, 'NR == 1 || $1 < 48000' > "$OUT/train.csv"
+sorted "$OUT/paper-60000/rows.csv" | awk -F, 'NR == 1 || $1 >= 48000' > "$OUT/test.csv"
+sorted "$OUT/heldout-5000/rows.csv" > "$OUT/heldout.csv"
+# Hash of the content that is deterministic: every column but `seconds` (wall time).
+canonical() { tail -n +2 "$1" | sed 's/,[^,]*$//' | sha256sum | cut -c1-64; }
+for f in train test heldout; do
+  echo "$f.csv: $(($(wc -l < "$OUT/$f.csv") - 1)) rows, sha256 (without seconds) $(canonical "$OUT/$f.csv")"
+done
