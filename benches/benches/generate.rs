@@ -27,9 +27,15 @@ pub fn bench(c: &mut Criterion) {
     )
     .expect("valid run");
     let mut group = c.benchmark_group("generate");
-    group.sample_size(10).measurement_time(Duration::from_secs(20));
+    group
+        .sample_size(10)
+        .measurement_time(Duration::from_secs(20));
     group.bench_function("16_samples/one_core", |b| {
-        b.iter(|| (1000..1016).map(|i| g.sample(black_box(i))).collect::<Vec<_>>())
+        b.iter(|| {
+            (1000..1016)
+                .map(|i| g.sample(black_box(i)))
+                .collect::<Vec<_>>()
+        })
     });
     group.bench_function("16_samples/all_cores", |b| {
         b.iter(|| {
