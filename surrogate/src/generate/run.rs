@@ -33,6 +33,9 @@ pub struct RunInfo {
     pub space_file: String,
     /// Detector file as given.
     pub detector_file: String,
+    /// The solver settings in full (their hash is in the fingerprint).
+    #[serde(default)]
+    pub settings: Option<hpge_solver::FieldSettings>,
     /// Program version that started the run.
     pub version: String,
 }
@@ -154,6 +157,7 @@ pub fn run(
         header: g.header(),
         space_file: g.space.file.display().to_string(),
         detector_file: g.detector_file.display().to_string(),
+        settings: Some(g.settings.clone()),
         version: env!("CARGO_PKG_VERSION").to_string(),
     };
     if info_path.exists() {
