@@ -13,13 +13,13 @@ use crate::field::weighting::weighting_potentials;
 use crate::grid::{Grid, GridSettings};
 use crate::{Detector, Error, Parameters};
 
-fn detector_path(name: &str) -> PathBuf {
+pub(super) fn detector_path(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../detectors")
         .join(name)
 }
 
-fn detector(name: &str) -> Detector {
+pub(super) fn detector(name: &str) -> Detector {
     Detector::from_file(&detector_path(name), &Parameters::new()).unwrap()
 }
 
@@ -163,11 +163,9 @@ fn coax_sweep_count() {
     );
 }
 
-/// A floating copper ring in the vacuum outside a coax whose p+ contact covers only the
-/// bottom 4 mm: the ring floats at a potential between ground and the bias, set by the bare
-/// crystal surface next to it.
-#[test]
-fn floating_ring_agrees_with_active_set() {
+/// A coax whose p+ contact covers only the bottom 4 mm, with a floating copper ring in the
+/// vacuum outside (shared with the wgpu tests: it exercises the floating-conductor update).
+pub(super) fn ring_detector() -> Detector {
     let text = std::fs::read_to_string(detector_path("coax-analytic.toml")).unwrap();
     let text = text.replace(
         "geometry = { cylinder_surface = { r_mm = 37.5, z_mm = [0.0, 10.0] } }",
@@ -179,8 +177,14 @@ kind = "floating"
 material = "copper"
 geometry = { tube = { r_mm = [38.5, 39.5], z_mm = [2.0, 8.0] } }
 "#;
-    let det = Detector::from_toml_str(&text, Path::new("floating-ring.toml"), &Parameters::new())
-        .unwrap();
+    Detector::from_toml_str(&text, Path::new("floating-ring.toml"), &Parameters::new()).unwrap()
+}
+
+/// The ring floats at a potential between ground and the bias, set by the bare crystal surface
+/// next to it.
+#[test]
+fn floating_ring_agrees_with_active_set() {
+    let det = ring_detector();
     for gs in [coarse(), GridSettings::default()] {
         let m = mesh(&det, &gs);
         let ring: Vec<usize> = (0..m.kind.len())

@@ -2,9 +2,8 @@
 //! and the converged solves against the CPU `sor` and `fast` methods. Skipped (one line) without
 //! an adapter unless HPGE_REQUIRE_GPU=1.
 
-use std::path::{Path, PathBuf};
-
 use super::stencil::device_problem;
+use super::tests::{detector, ring_detector};
 use super::wgpu::solve_sor_wgpu_with;
 use super::{SorSettings, default_omega, solve_sor, solve_sor_wgpu, weighting_potentials_wgpu};
 use crate::field::depletion::{potential_dofs, solve_fast};
@@ -14,17 +13,7 @@ use crate::field::report::{Backend, Method};
 use crate::field::weighting::weighting_potentials;
 use crate::gpu::{self, Precision, gpu_test_gate};
 use crate::grid::{Grid, GridSettings};
-use crate::{Detector, Error, Parameters};
-
-fn detector_path(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../detectors")
-        .join(name)
-}
-
-fn detector(name: &str) -> Detector {
-    Detector::from_file(&detector_path(name), &Parameters::new()).unwrap()
-}
+use crate::{Detector, Error};
 
 fn coarse_mesh(det: &Detector) -> Mesh {
     let gs = GridSettings {
@@ -33,23 +22,6 @@ fn coarse_mesh(det: &Detector) -> Mesh {
         ..GridSettings::default()
     };
     Mesh::new(det, Grid::initial(det, &gs))
-}
-
-/// A coax whose p+ contact covers the bottom 4 mm only, with a floating copper ring outside:
-/// exercises the floating-conductor kernel.
-fn ring_detector() -> Detector {
-    let text = std::fs::read_to_string(detector_path("coax-analytic.toml")).unwrap();
-    let text = text.replace(
-        "geometry = { cylinder_surface = { r_mm = 37.5, z_mm = [0.0, 10.0] } }",
-        "geometry = { cylinder_surface = { r_mm = 37.5, z_mm = [0.0, 4.0] } }",
-    ) + r#"
-[[passives]]
-name = "floating ring"
-kind = "floating"
-material = "copper"
-geometry = { tube = { r_mm = [38.5, 39.5], z_mm = [2.0, 8.0] } }
-"#;
-    Detector::from_toml_str(&text, Path::new("floating-ring.toml"), &Parameters::new()).unwrap()
 }
 
 fn max_abs_diff(a: &[f64], b: &[f64]) -> f64 {
