@@ -6,12 +6,14 @@ mod generate;
 mod gpu;
 mod impurity;
 mod solver;
+mod surrogate;
 
 criterion_group!(
     benches,
     impurity::bench,
     solver::bench,
     gpu::bench,
-    generate::bench
+    generate::bench,
+    surrogate::bench
 );
 criterion_main!(benches);

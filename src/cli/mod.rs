@@ -7,6 +7,7 @@ mod impurity;
 mod measure;
 mod sensitivity;
 mod simulate;
+mod surrogate;
 
 use std::path::PathBuf;
 
@@ -47,6 +48,82 @@ enum Command {
     Generate(GenerateArgs),
     /// Merge the shard folders of one `generate` run into one CSV.
     Merge(MergeArgs),
+    /// Train a surrogate of c12(p, U_B) on generated rows (the paper's network or a better recipe).
+    Train(TrainArgs),
+    /// Accuracy of a surrogate on a data set it never saw: error histograms, Gaussian sigma,
+    /// quantiles, the worst samples.
+    Evaluate(EvaluateArgs),
+    /// c12 along a curve from a surrogate (optionally with its Jacobian).
+    Predict(PredictArgs),
+}
+
+#[derive(Debug, clap::Args)]
+struct TrainArgs {
+    /// Training rows (the CSV of `generate`, or a split of it, e.g. data/training/train.csv).
+    #[arg(long, value_name = "FILE")]
+    data: PathBuf,
+    /// Test rows (learning curves and sigma_p).
+    #[arg(long, value_name = "FILE")]
+    test: PathBuf,
+    /// The parameter space the rows were generated from.
+    #[arg(
+        long,
+        value_name = "FILE",
+        default_value = "spaces/super-siegfried-rz.toml"
+    )]
+    space: PathBuf,
+    /// Recipe: paper, paper-log, split, split-ensemble, tiny (networks) or poly3 (the
+    /// polynomial baseline).
+    #[arg(long, default_value = "paper")]
+    recipe: String,
+    /// The model file (.safetensors); learning curves go to <stem>.curves.csv beside it.
+    #[arg(long, value_name = "FILE")]
+    out: PathBuf,
+    /// Seed of the initial weights and the batch order.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Folder for the learning curves and the test-set error figures (svg and png).
+    #[arg(long, value_name = "DIR")]
+    plot: Option<PathBuf>,
+}
+
+#[derive(Debug, clap::Args)]
+struct EvaluateArgs {
+    /// The model file.
+    #[arg(long, value_name = "FILE")]
+    model: PathBuf,
+    /// Rows of the model's space (e.g. data/training/heldout.csv).
+    #[arg(long, value_name = "FILE")]
+    data: PathBuf,
+    /// Print exactly one JSON object on stdout.
+    #[arg(long)]
+    json: bool,
+    /// Folder for the scatter plot and the error histograms (svg and png).
+    #[arg(long, value_name = "DIR")]
+    plot: Option<PathBuf>,
+    /// How many of the worst samples to list.
+    #[arg(long, default_value_t = 10)]
+    worst: usize,
+}
+
+#[derive(Debug, clap::Args)]
+struct PredictArgs {
+    /// The model file.
+    #[arg(long, value_name = "FILE")]
+    model: PathBuf,
+    /// Parameters: NAME=VALUE pairs (comma-separated or repeated) or all values in the model's
+    /// order, e.g. --params d_li_mm=2.6,y1_bot=0.5,...
+    #[arg(long, value_name = "LIST", required = true, allow_hyphen_values = true)]
+    params: Vec<String>,
+    /// Bias voltages: START:STOP:STEP (inclusive) or a comma list.
+    #[arg(long, value_name = "LIST", value_parser = parse_voltages, allow_hyphen_values = true)]
+    voltages: args::VoltageList,
+    /// Print exactly one JSON object on stdout.
+    #[arg(long)]
+    json: bool,
+    /// Also give dc12/dp for every parameter (exact derivative of the network).
+    #[arg(long)]
+    jacobian: bool,
 }
 
 /// Which low-discrepancy sequence.
@@ -402,6 +479,30 @@ pub fn run(cli: Cli) -> Result<()> {
             },
         }),
         Command::Merge(a) => generate::merge_shards(&a.dirs, &a.out),
+        Command::Train(a) => surrogate::train(&surrogate::TrainOptions {
+            data: &a.data,
+            test: &a.test,
+            space: &a.space,
+            recipe: &a.recipe,
+            out: &a.out,
+            seed: a.seed,
+            plot: a.plot.as_deref(),
+            quiet: false,
+        }),
+        Command::Evaluate(a) => surrogate::evaluate(&surrogate::EvaluateOptions {
+            model: &a.model,
+            data: &a.data,
+            json: a.json,
+            plot: a.plot.as_deref(),
+            worst: a.worst,
+        }),
+        Command::Predict(a) => surrogate::predict(&surrogate::PredictOptions {
+            model: &a.model,
+            params: &a.params,
+            voltages: &a.voltages.0,
+            json: a.json,
+            jacobian: a.jacobian,
+        }),
         Command::Measure(a) => measure::run(&measure::MeasureOptions {
             raw: &a.raw,
             out: &a.out,

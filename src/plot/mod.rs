@@ -40,6 +40,7 @@ mod cv;
 mod field;
 mod measure;
 mod sensitivity;
+mod surrogate;
 
 use std::path::Path;
 
@@ -48,6 +49,7 @@ pub use cv::cv_curve;
 pub use field::field_map;
 pub use measure::measurement;
 pub use sensitivity::sensitivity;
+pub use surrogate::{learning_curves, surrogate_errors};
 
 /// Output format, chosen by the file extension.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -37,6 +37,25 @@ pub enum Error {
         /// What is wrong.
         message: String,
     },
+    /// A prediction was asked outside the model's training space (the domain guard; inference
+    /// gives such points zero prior mass).
+    #[error("`{name}` = {value} is outside the surrogate's training range [{lo}, {hi}]")]
+    OutsideDomain {
+        /// Dimension name.
+        name: String,
+        /// The value asked for.
+        value: f64,
+        /// Lower end of the range.
+        lo: f64,
+        /// Upper end of the range.
+        hi: f64,
+    },
+    /// Training failed (a non-finite loss, a singular fit, a candle error).
+    #[error("training failed: {message}")]
+    Training {
+        /// What happened.
+        message: String,
+    },
     /// A value given through the API or the command line is invalid.
     #[error("`{name}`: {message}")]
     Argument {

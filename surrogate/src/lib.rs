@@ -2,12 +2,16 @@
 //!
 //! The machine-learning side of hpge-cv (paper, section 7): parameter spaces and their maps to the
 //! unit hypercube and to standard-normal coordinates, quasi-random (golden-sequence) sampling,
-//! training-set generation with the exact solver, the network (p_D -> c12) and its held-out
-//! accuracy. Filled in by the training-set and surrogate issues; this crate depends on
-//! `hpge-solver` only (data flows solver <- surrogate <- inference).
+//! training-set generation with the exact solver, the network (p_D -> c12) trained with candle-nn,
+//! its held-out accuracy, and the prediction path inference uses: [`Surrogate::curve_into`] and
+//! [`Surrogate::curve_jacobian_into`] (a whole curve and its Jacobian with respect to the
+//! physical parameters, plain f64, no allocation per voltage), guarded by the training domain
+//! ([`Error::OutsideDomain`]). This crate depends on `hpge-solver` only (data flows
+//! solver <- surrogate <- inference).
 
 mod error;
 mod generate;
+mod model;
 mod sequence;
 mod space;
 
@@ -15,6 +19,12 @@ pub use error::{Error, Result};
 pub use generate::{
     Fingerprint, Generator, MergeReport, RunInfo, RunReport, Sample, Shard, fnv1a, format_row,
     merge, read_rows, run,
+};
+pub use model::{
+    Architecture, Cycle, DataInfo, DataSet, Dense, EpochRecord, FORMAT, FORMAT_VERSION, Figures,
+    Loss, ModelInfo, Network, OutputTransform, Polynomial, Predictor, RECIPES, Recipe, Surrogate,
+    Trained, U_EDGE, Voltages, candle_outputs, gaussian_fit, initial_network, monomials,
+    network_order, output_transform, physical_to_z, quantile, train, unit_to_z,
 };
 pub use sequence::{Sequence, SequenceKind, phi_d};
 pub use space::{Dimension, Distribution, ParameterSpace, Target, normal_cdf, normal_quantile};

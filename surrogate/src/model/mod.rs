@@ -1,0 +1,25 @@
+//! The surrogate of c12(p, U_B) (paper, section 7): data sets, recipes, candle-nn training, the
+//! plain f64 prediction path with its Jacobian, model files and accuracy figures.
+
+mod dataset;
+mod file;
+mod gelu;
+mod metrics;
+mod network;
+mod polynomial;
+mod recipe;
+mod surrogate;
+mod train;
+mod transform;
+
+#[cfg(test)]
+mod tests;
+
+pub use dataset::{DataSet, network_order};
+pub use metrics::{Figures, gaussian_fit, quantile};
+pub use network::{Dense, Network};
+pub use polynomial::{Polynomial, monomials};
+pub use recipe::{Architecture, Cycle, Loss, OutputTransform, RECIPES, Recipe};
+pub use surrogate::{DataInfo, FORMAT, FORMAT_VERSION, ModelInfo, Predictor, Surrogate, Voltages};
+pub use train::{EpochRecord, Trained, candle_outputs, initial_network, output_transform, train};
+pub use transform::{U_EDGE, physical_to_z, unit_to_z};

@@ -1,0 +1,286 @@
+//! Training recipes: the paper's network and schedule (section 7) and the variants compared with
+//! it. A recipe fixes the architecture, the output transform, the loss and the Adam cycles.
+
+use serde::{Deserialize, Serialize};
+
+use crate::{Error, Result};
+
+/// Layer widths. Inputs are standard-normal coordinates: the model parameters p go through the
+/// `trunk` (none for the paper), then [h(p), z_U] goes through the `head`, then one linear output.
+/// GELU (tanh form, as Flux's `gelu`) follows every hidden layer, none the output.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Architecture {
+    /// Widths of the layers that see only p.
+    pub trunk: Vec<usize>,
+    /// Widths of the layers after the bias joins.
+    pub head: Vec<usize>,
+}
+
+/// What the network's single output y means (a closed set).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case", tag = "kind")]
+pub enum OutputTransform {
+    /// c12 = y pF (the paper).
+    Picofarad,
+    /// c12 = exp(mean + sd y) pF, mean and sd of ln(c12/pF) over the training set.
+    LogStandardised {
+        /// Mean of ln(c12 / pF).
+        mean: f64,
+        /// Standard deviation of ln(c12 / pF).
+        sd: f64,
+    },
+}
+
+/// The loss per sample (a closed set).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case", tag = "kind")]
+pub enum Loss {
+    /// The paper's eq. (DNNLossFunction): h ln(((c_p - c_s)/pF)^2 / h + 1), h = 4.
+    PaperRobust {
+        /// The scale h (pF^2).
+        h: f64,
+    },
+    /// (100 ln(c_p / c_s))^2: the squared relative error in percent (needs a log output).
+    RelativeSquared,
+    /// The paper's robust form on the relative error in percent, r = 100 ln(c_p / c_s):
+    /// h ln(r^2 / h + 1) (quadratic below ~sqrt(h) %, logarithmic beyond: the few samples at
+    /// c12 -> 0 where two regions nearly disconnect do not dominate). Needs a log output.
+    RelativeRobust {
+        /// The scale h (%^2).
+        h: f64,
+    },
+}
+
+/// One Adam cycle: learning rate (decayed by a half cosine to `lr_end` when given), epochs and
+/// batch size.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Cycle {
+    /// Learning rate eta at the start of the cycle.
+    pub lr: f64,
+    /// Learning rate at the end of the cycle (cosine decay); `None`: constant.
+    pub lr_end: Option<f64>,
+    /// Epochs.
+    pub epochs: usize,
+    /// Batch size.
+    pub batch: usize,
+}
+
+/// A complete recipe.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Recipe {
+    /// Name used on the command line.
+    pub name: String,
+    /// Layer widths.
+    pub architecture: Architecture,
+    /// `picofarad` or `log` (the transform's constants are fitted to the training set).
+    pub log_output: bool,
+    /// Loss.
+    pub loss: Loss,
+    /// Adam cycles, run in order, each with a fresh optimiser state.
+    pub cycles: Vec<Cycle>,
+    /// Ensemble members (independently initialised and shuffled networks); the prediction is their
+    /// mean and their spread estimates the error of each prediction.
+    pub members: usize,
+}
+
+/// The recipe names `train --recipe` accepts.
+pub const RECIPES: [&str; 7] = [
+    "paper",
+    "paper-log",
+    "paper-log-ensemble",
+    "split",
+    "split-wide",
+    "split-ensemble",
+    "tiny",
+];
+
+impl Recipe {
+    /// The recipe called `name` (one of [`RECIPES`]).
+    pub fn named(name: &str) -> Result<Self> {
+        let paper_cycles = vec![
+            Cycle {
+                lr: 1e-2,
+                lr_end: None,
+                epochs: 20,
+                batch: 2048,
+            },
+            Cycle {
+                lr: 1e-3,
+                lr_end: None,
+                epochs: 80,
+                batch: 1024,
+            },
+            Cycle {
+                lr: 1e-4,
+                lr_end: None,
+                epochs: 40,
+                batch: 512,
+            },
+        ];
+        let paper_arch = Architecture {
+            trunk: vec![],
+            head: vec![128; 5],
+        };
+        let split_arch = Architecture {
+            trunk: vec![128, 128, 128],
+            head: vec![64, 32],
+        };
+        let split_cycles = vec![
+            Cycle {
+                lr: 3e-3,
+                lr_end: None,
+                epochs: 10,
+                batch: 1024,
+            },
+            Cycle {
+                lr: 3e-3,
+                lr_end: Some(1e-5),
+                epochs: 150,
+                batch: 512,
+            },
+        ];
+        let r = match name {
+            // Section 7 exactly.
+            "paper" => Recipe {
+                name: name.into(),
+                architecture: paper_arch,
+                log_output: false,
+                loss: Loss::PaperRobust { h: 4.0 },
+                cycles: paper_cycles,
+                members: 1,
+            },
+            // The paper's network and schedule, learning ln c12 with the relative error as loss.
+            "paper-log" => Recipe {
+                name: name.into(),
+                architecture: paper_arch.clone(),
+                log_output: true,
+                loss: Loss::RelativeRobust { h: 4.0 },
+                cycles: paper_cycles.clone(),
+                members: 1,
+            },
+            // p through a trunk once per curve, the bias joining late: a whole curve costs one
+            // trunk pass and 60 small head passes (the microsecond path), cosine-decayed Adam.
+            "split" => Recipe {
+                name: name.into(),
+                architecture: split_arch,
+                log_output: true,
+                loss: Loss::RelativeRobust { h: 4.0 },
+                cycles: split_cycles,
+                members: 1,
+            },
+            // Three independently seeded paper-log networks: the mean predicts, the spread
+            // estimates each prediction's error.
+            "paper-log-ensemble" => Recipe {
+                name: name.into(),
+                architecture: paper_arch.clone(),
+                log_output: true,
+                loss: Loss::RelativeRobust { h: 4.0 },
+                cycles: paper_cycles.clone(),
+                members: 3,
+            },
+            // A wider head after the bias joins, with the paper's three cycles.
+            "split-wide" => Recipe {
+                name: name.into(),
+                architecture: Architecture {
+                    trunk: vec![128, 128, 128],
+                    head: vec![128, 64],
+                },
+                log_output: true,
+                loss: Loss::RelativeRobust { h: 4.0 },
+                cycles: paper_cycles.clone(),
+                members: 1,
+            },
+            "split-ensemble" => Recipe {
+                name: name.into(),
+                architecture: split_arch,
+                log_output: true,
+                loss: Loss::RelativeRobust { h: 4.0 },
+                cycles: split_cycles,
+                members: 4,
+            },
+            // For tests and smoke runs: a small network, a few epochs.
+            "tiny" => Recipe {
+                name: name.into(),
+                architecture: Architecture {
+                    trunk: vec![16],
+                    head: vec![16],
+                },
+                log_output: true,
+                loss: Loss::RelativeSquared,
+                cycles: vec![
+                    Cycle {
+                        lr: 1e-2,
+                        lr_end: None,
+                        epochs: 4,
+                        batch: 64,
+                    },
+                    Cycle {
+                        lr: 3e-3,
+                        lr_end: Some(1e-4),
+                        epochs: 8,
+                        batch: 64,
+                    },
+                ],
+                members: 1,
+            },
+            _ => {
+                return Err(Error::Argument {
+                    name: "recipe".into(),
+                    message: format!("unknown recipe `{name}`; known: {}", RECIPES.join(", ")),
+                });
+            }
+        };
+        r.validate()?;
+        Ok(r)
+    }
+
+    /// Checks the recipe's numbers.
+    pub fn validate(&self) -> Result<()> {
+        let bad = |m: String| Error::Argument {
+            name: "recipe".into(),
+            message: m,
+        };
+        if self.cycles.is_empty() || self.members == 0 {
+            return Err(bad("needs at least one cycle and one member".into()));
+        }
+        let widths = self
+            .architecture
+            .trunk
+            .iter()
+            .chain(&self.architecture.head);
+        if self.architecture.head.is_empty() || widths.clone().any(|&w| w == 0) {
+            return Err(bad("needs a non-empty head and non-zero widths".into()));
+        }
+        for c in &self.cycles {
+            let lr_ok = c.lr > 0.0 && c.lr.is_finite() && c.lr_end.is_none_or(|l| l > 0.0);
+            if !lr_ok || c.epochs == 0 || c.batch == 0 {
+                return Err(bad(format!("invalid cycle {c:?}")));
+            }
+        }
+        let relative = matches!(
+            self.loss,
+            Loss::RelativeSquared | Loss::RelativeRobust { .. }
+        );
+        if relative && !self.log_output {
+            return Err(bad("the relative loss needs a log output".into()));
+        }
+        Ok(())
+    }
+
+    /// Total epochs over all cycles.
+    pub fn total_epochs(&self) -> usize {
+        self.cycles.iter().map(|c| c.epochs).sum()
+    }
+
+    /// Learning rate at epoch `e` (0-based) of cycle `c` and step fraction `f` in [0, 1) of the
+    /// epoch: eta_end + (eta - eta_end) (1 + cos(pi t)) / 2, t the fraction of the cycle done.
+    pub fn learning_rate(cycle: &Cycle, epoch: usize, frac: f64) -> f64 {
+        match cycle.lr_end {
+            None => cycle.lr,
+            Some(end) => {
+                let t = (epoch as f64 + frac) / cycle.epochs as f64;
+                end + (cycle.lr - end) * 0.5 * (1.0 + (std::f64::consts::PI * t).cos())
+            }
+        }
+    }
+}

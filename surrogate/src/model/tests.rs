@@ -1,0 +1,269 @@
+//! Unit tests of the prediction path against candle and finite differences, the model file and a
+//! tiny training run.
+
+use std::path::PathBuf;
+
+use super::*;
+use crate::space::ParameterSpace;
+
+fn space() -> ParameterSpace {
+    let mut text = String::from("name = \"test\"\n");
+    for (k, (lo, hi)) in [(0.2, 5.0), (0.02, 1.0), (-1.0, 1.0)].iter().enumerate() {
+        text += &format!(
+            "[[dimensions]]\nname = \"p{k}\"\nunit = \"1\"\nrange = [{lo}, {hi}]\ntarget = \"y_bot[{k}]\"\n"
+        );
+    }
+    text +=
+        "[[dimensions]]\nname = \"U_B\"\nunit = \"V\"\nrange = [10.0, 3000.0]\ntarget = \"bias\"\n";
+    ParameterSpace::from_toml_str(&text, &PathBuf::from("test.toml")).unwrap()
+}
+
+/// A synthetic C-V-like function of (p, U): falls with U, saturates at a p-dependent voltage.
+fn synthetic_c12(x: &[f64]) -> f64 {
+    let ud = 500.0 + 600.0 * x[0] + 400.0 * x[1];
+    let u = x[3].min(ud);
+    40.0 * (1.0 + 0.3 * x[2]) * (1.0 + 3.0 * ((ud - u) / ud).powi(2)) + 5.0 * x[1]
+}
+
+fn write_set(path: &std::path::Path, sp: &ParameterSpace, n: usize, offset: usize) {
+    let g = |i: usize, k: usize| {
+        ((i as f64 + 0.5) * [0.7548776662, 0.5698402910, 0.4301597090, 0.3247179572][k]).fract()
+    };
+    let mut text = String::from("index,u_p0,u_p1,u_p2,u_U_B,p0,p1,p2,U_B,c12_pF,status,seconds\n");
+    for i in offset..offset + n {
+        let u: Vec<f64> = (0..4).map(|k| g(i, k)).collect();
+        let x = sp.from_unit(&u);
+        let row: Vec<String> = u.iter().chain(&x).map(|v| v.to_string()).collect();
+        text += &format!("{i},{},{},ok,0.1\n", row.join(","), synthetic_c12(&x));
+    }
+    std::fs::write(path, text).unwrap();
+}
+
+fn random_network(arch: &Architecture, seed: u64) -> Network {
+    let mut net = initial_network(arch, 3, seed);
+    // Non-zero biases so that every code path matters.
+    for (k, l) in net.trunk.iter_mut().chain(net.head.iter_mut()).enumerate() {
+        for (i, b) in l.b.iter_mut().enumerate() {
+            *b = 0.1 * ((k * 31 + i * 7) as f64).sin();
+        }
+    }
+    net
+}
+
+#[test]
+fn jacobian_matches_central_differences() {
+    for arch in [
+        Architecture {
+            trunk: vec![],
+            head: vec![12, 12],
+        },
+        Architecture {
+            trunk: vec![10, 8],
+            head: vec![6, 5],
+        },
+    ] {
+        let net = random_network(&arch, 3);
+        let zp = [0.3, -1.1, 0.7];
+        let zu = [-1.5, 0.0, 0.4, 2.0];
+        let mut y = [0.0; 4];
+        let mut jac = [0.0; 12];
+        net.curve_jacobian(&zp, &zu, &mut y, &mut jac);
+        let mut y0 = [0.0; 4];
+        net.curve(&zp, &zu, &mut y0);
+        assert_eq!(y, y0, "the Jacobian pass gives the same values");
+        for j in 0..3 {
+            let h = 1e-6;
+            let (mut a, mut b) = (zp, zp);
+            a[j] += h;
+            b[j] -= h;
+            let (mut ya, mut yb) = ([0.0; 4], [0.0; 4]);
+            net.curve(&a, &zu, &mut ya);
+            net.curve(&b, &zu, &mut yb);
+            for k in 0..4 {
+                let fd = (ya[k] - yb[k]) / (2.0 * h);
+                assert!(
+                    (fd - jac[k * 3 + j]).abs() < 1e-7 * (1.0 + fd.abs()),
+                    "{arch:?} k {k} j {j}: {fd} vs {}",
+                    jac[k * 3 + j]
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn plain_path_matches_candle() {
+    let arch = Architecture {
+        trunk: vec![16, 16],
+        head: vec![16, 8],
+    };
+    let net = random_network(&arch, 5);
+    let units: Vec<f64> = (0..40)
+        .map(|i| ((i as f64 + 0.5) * 0.618_033_988_7).fract())
+        .collect();
+    let c = candle_outputs(&net, &units, 4).unwrap();
+    for (i, row) in units.chunks(4).enumerate() {
+        let z: Vec<f64> = row.iter().map(|&u| unit_to_z(u)).collect();
+        let mut y = [0.0];
+        net.curve(&z[..3], &z[3..], &mut y);
+        assert!(
+            (y[0] - c[i]).abs() < 2e-5 * (1.0 + y[0].abs()),
+            "row {i}: {} vs {}",
+            y[0],
+            c[i]
+        );
+    }
+}
+
+#[test]
+fn tiny_training_lowers_the_loss_and_the_file_reloads_identically() {
+    let dir = std::env::temp_dir().join(format!("hpge-surrogate-unit-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let sp = space();
+    let (tr, te) = (dir.join("train.csv"), dir.join("test.csv"));
+    write_set(&tr, &sp, 600, 0);
+    write_set(&te, &sp, 150, 1000);
+    let train_set = DataSet::read(&tr, &sp).unwrap();
+    let test_set = DataSet::read(&te, &sp).unwrap();
+    let recipe = Recipe::named("tiny").unwrap();
+    let mut epochs = 0;
+    let t = train(&recipe, &train_set, &test_set, 11, &mut |_| epochs += 1).unwrap();
+    assert_eq!(epochs, recipe.total_epochs());
+    let first = t.curves.first().unwrap();
+    let last = t.curves.last().unwrap();
+    assert!(
+        last.train_loss < 0.5 * first.train_loss,
+        "{} -> {}",
+        first.train_loss,
+        last.train_loss
+    );
+    assert!(last.test_loss < 0.5 * first.test_loss);
+    // Same seed, same network.
+    let again = train(&recipe, &train_set, &test_set, 11, &mut |_| {}).unwrap();
+    assert_eq!(again.members, t.members);
+
+    let info = ModelInfo {
+        format: FORMAT.into(),
+        format_version: FORMAT_VERSION,
+        program_version: "test".into(),
+        space: sp.clone(),
+        inputs: vec!["p0".into(), "p1".into(), "p2".into(), "U_B".into()],
+        input_map: "z = Phi^-1(u)".into(),
+        output: t.output,
+        recipe_name: "tiny".into(),
+        recipe: Some(recipe),
+        seed: 11,
+        training: DataInfo::of(&train_set),
+        test: DataInfo::of(&test_set),
+        train_seconds: t.seconds,
+        threads: 1,
+        test_figures: Figures::of(&[1.0], &[1.0]),
+        sigma_p: 0.05,
+    };
+    let model = Surrogate::new(info, Predictor::Networks(t.members)).unwrap();
+    let file = dir.join("tiny.safetensors");
+    model.save(&file).unwrap();
+    let back = Surrogate::load(&file).unwrap();
+    assert_eq!(back.predictor, model.predictor);
+    assert_eq!(back.predict_set(&test_set), model.predict_set(&test_set));
+    let volts = [25.0, 1000.0, 2975.0];
+    let p = [2.0, 0.5, 0.1];
+    assert_eq!(
+        back.curve(&p, &volts).unwrap(),
+        model.curve(&p, &volts).unwrap()
+    );
+
+    // The domain guard and NaN inputs.
+    let e = back
+        .curve(&[6.0, 0.5, 0.1], &volts)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("p0") && e.contains("outside"), "{e}");
+    let e = back
+        .curve(&[f64::NAN, 0.5, 0.1], &volts)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("NaN"), "{e}");
+    let e = back.curve(&p, &[5.0]).unwrap_err().to_string();
+    assert!(e.contains("U_B"), "{e}");
+
+    // A file of another format version.
+    let mut other = model.clone();
+    other.info.format_version = FORMAT_VERSION + 1;
+    let f2 = dir.join("other.safetensors");
+    other.save(&f2).unwrap();
+    let e = Surrogate::load(&f2).unwrap_err().to_string();
+    assert!(e.contains("format_version") && e.contains("retrain"), "{e}");
+
+    // A data set of another space.
+    let mut sp2 = sp.clone();
+    sp2.dimensions[0].range = [0.1, 5.0];
+    let e = DataSet::read(&tr, &sp2).unwrap_err().to_string();
+    assert!(e.contains("another space"), "{e}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn physical_jacobian_matches_finite_differences() {
+    let arch = Architecture {
+        trunk: vec![8],
+        head: vec![8],
+    };
+    let net = random_network(&arch, 9);
+    let sp = space();
+    let mut info_space = sp.clone();
+    info_space.name = "test".into();
+    let info = ModelInfo {
+        format: FORMAT.into(),
+        format_version: FORMAT_VERSION,
+        program_version: "test".into(),
+        space: info_space,
+        inputs: vec![],
+        input_map: String::new(),
+        output: OutputTransform::LogStandardised { mean: 4.0, sd: 0.5 },
+        recipe_name: "unit".into(),
+        recipe: None,
+        seed: 0,
+        training: DataInfo {
+            file: String::new(),
+            hash: String::new(),
+            n: 0,
+            excluded: 0,
+        },
+        test: DataInfo {
+            file: String::new(),
+            hash: String::new(),
+            n: 0,
+            excluded: 0,
+        },
+        train_seconds: 0.0,
+        threads: 1,
+        test_figures: Figures::of(&[1.0], &[1.0]),
+        sigma_p: 0.01,
+    };
+    let m = Surrogate::new(
+        info,
+        Predictor::Networks(vec![net.clone(), random_network(&arch, 10)]),
+    )
+    .unwrap();
+    let u = m.voltages(&[25.0, 800.0, 2500.0]).unwrap();
+    let p = [1.7, 0.4, -0.3];
+    let (mut c, mut j) = ([0.0; 3], [0.0; 9]);
+    m.curve_jacobian_into(&p, &u, &mut c, &mut j).unwrap();
+    for k in 0..3 {
+        let h = 1e-6 * (1.0 + p[k].abs());
+        let (mut a, mut b) = (p, p);
+        a[k] += h;
+        b[k] -= h;
+        let ca = m.curve(&a, &u.volts).unwrap();
+        let cb = m.curve(&b, &u.volts).unwrap();
+        for v in 0..3 {
+            let fd = (ca[v] - cb[v]) / (2.0 * h);
+            assert!(
+                (fd - j[v * 3 + k]).abs() < 1e-6 * (1.0 + fd.abs()),
+                "v {v} k {k}: {fd} vs {}",
+                j[v * 3 + k]
+            );
+        }
+    }
+}

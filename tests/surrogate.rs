@@ -1,0 +1,253 @@
+//! The surrogate as a user runs it (issue: neural-network surrogate): a tiny network trained on a
+//! tiny generated set (the loss falls, the model file reloads to identical predictions, evaluate
+//! and predict agree), and bad input (a data set of another space, a model file of another
+//! version, NaN and out-of-range inputs) gives exit code 2 with a clear message.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn run(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_hpge-cv"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+fn ok(o: &Output) -> String {
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+fn bad(o: &Output, needles: &[&str]) {
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    for n in needles {
+        assert!(err.contains(n), "`{n}` not in: {err}");
+    }
+    assert!(!err.contains("panicked"), "{err}");
+}
+
+fn generate(out: &Path, n: &str, offset: &str) {
+    ok(&run(&[
+        "generate",
+        "--space",
+        "spaces/super-siegfried-rz.toml",
+        "--detector",
+        "detectors/super-siegfried-k1.toml",
+        "--n",
+        n,
+        "--offset",
+        offset,
+        "--out",
+        out.to_str().unwrap(),
+    ]));
+}
+
+fn temp() -> PathBuf {
+    let d = std::env::temp_dir().join(format!("hpge-surrogate-cli-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+#[test]
+fn tiny_network_on_a_tiny_generated_set() {
+    let d = temp();
+    let (tr, te) = (d.join("train"), d.join("test"));
+    generate(&tr, "120", "0");
+    generate(&te, "40", "5000");
+    let model = d.join("tiny.safetensors");
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    let out = run(&[
+        "train",
+        "--data",
+        &s(&tr.join("rows.csv")),
+        "--test",
+        &s(&te.join("rows.csv")),
+        "--recipe",
+        "tiny",
+        "--seed",
+        "3",
+        "--out",
+        &s(&model),
+        "--plot",
+        &s(&d.join("plots")),
+    ]);
+    ok(&out);
+    // The learning curves: one line per epoch, the training loss falls.
+    let curves = std::fs::read_to_string(d.join("tiny.curves.csv")).unwrap();
+    let losses: Vec<f64> = curves
+        .lines()
+        .filter(|l| !l.starts_with('#') && !l.starts_with("member"))
+        .map(|l| l.split(',').nth(4).unwrap().parse().unwrap())
+        .collect();
+    assert_eq!(losses.len(), 12);
+    assert!(losses[11] < 0.5 * losses[0], "{losses:?}");
+    for f in [
+        "learning-curves.svg",
+        "learning-curves.png",
+        "test-scatter.png",
+        "test-errors.svg",
+    ] {
+        assert!(d.join("plots").join(f).is_file(), "{f}");
+    }
+    // evaluate --json: the issue's fields, the same numbers twice (the file reloads identically).
+    let eval = || {
+        let text = ok(&run(&[
+            "evaluate",
+            "--model",
+            &s(&model),
+            "--data",
+            &s(&te.join("rows.csv")),
+            "--json",
+        ]));
+        serde_json::from_str::<serde_json::Value>(&text).unwrap()
+    };
+    let (a, b) = (eval(), eval());
+    assert_eq!(a, b);
+    for key in [
+        "n",
+        "rel_sigma",
+        "rel_mean",
+        "abs_rel_q50",
+        "abs_rel_q90",
+        "abs_rel_q99",
+        "abs_rel_max",
+    ] {
+        assert!(a[key].is_number(), "{key} in {a}");
+    }
+    assert!(a["n"].as_u64().unwrap() > 20);
+    // predict at the first test sample equals evaluate's view of it: via the worst list.
+    let w = &a["worst"][0];
+    let inputs = w["inputs"].as_array().unwrap();
+    let params: Vec<String> = inputs[..9]
+        .iter()
+        .map(|p| format!("{}={}", p[0].as_str().unwrap(), p[1]))
+        .collect();
+    let volts = inputs[9][1].to_string();
+    let text = ok(&run(&[
+        "predict",
+        "--model",
+        &s(&model),
+        "--params",
+        &params.join(","),
+        "--voltages",
+        &volts,
+        "--json",
+        "--jacobian",
+    ]));
+    let p: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let c = p["c12_pf"][0].as_f64().unwrap();
+    let expected = w["c12_surrogate_pf"].as_f64().unwrap();
+    assert!((c / expected - 1.0).abs() < 1e-12, "{c} vs {expected}");
+    assert_eq!(p["jacobian_pf"][0].as_array().unwrap().len(), 9);
+
+    // Bad input.
+    let nan: Vec<&str> = vec!["nan"; 9];
+    bad(
+        &run(&[
+            "predict",
+            "--model",
+            &s(&model),
+            "--params",
+            &nan.join(","),
+            "--voltages",
+            "100",
+        ]),
+        &["d_li_mm", "finite"],
+    );
+    let mut outside = params.clone();
+    outside[0] = "d_li_mm=7".into();
+    bad(
+        &run(&[
+            "predict",
+            "--model",
+            &s(&model),
+            "--params",
+            &outside.join(","),
+            "--voltages",
+            "100",
+        ]),
+        &["d_li_mm", "outside"],
+    );
+    bad(
+        &run(&[
+            "predict",
+            "--model",
+            &s(&model),
+            "--params",
+            &params.join(","),
+            "--voltages",
+            "5000",
+        ]),
+        &["U_B", "outside"],
+    );
+    // A data set of another space: the header renamed.
+    let text = std::fs::read_to_string(te.join("rows.csv"))
+        .unwrap()
+        .replacen("u_d_li_mm", "u_r_mm", 1);
+    let other = d.join("other.csv");
+    std::fs::write(&other, text).unwrap();
+    bad(
+        &run(&["evaluate", "--model", &s(&model), "--data", &s(&other)]),
+        &["other.csv", "another space"],
+    );
+    // A model file of another format version (same length, so the header stays valid).
+    let mut bytes = std::fs::read(&model).unwrap();
+    let needle = b"\\\"format_version\\\":1";
+    let at = bytes
+        .windows(needle.len())
+        .position(|w| w == needle)
+        .expect("version in the header");
+    *bytes.get_mut(at + needle.len() - 1).unwrap() = b'7';
+    let future = d.join("future.safetensors");
+    std::fs::write(&future, bytes).unwrap();
+    bad(
+        &run(&[
+            "evaluate",
+            "--model",
+            &s(&future),
+            "--data",
+            &s(&te.join("rows.csv")),
+        ]),
+        &["future.safetensors", "format_version", "retrain"],
+    );
+    bad(
+        &run(&[
+            "evaluate",
+            "--model",
+            &s(&d.join("missing.safetensors")),
+            "--data",
+            &s(&other),
+        ]),
+        &["missing.safetensors"],
+    );
+    bad(
+        &run(&[
+            "train",
+            "--data",
+            &s(&other),
+            "--test",
+            &s(&te.join("rows.csv")),
+            "--out",
+            &s(&d.join("x.safetensors")),
+        ]),
+        &["other.csv", "another space"],
+    );
+    bad(
+        &run(&[
+            "train",
+            "--data",
+            &s(&tr.join("rows.csv")),
+            "--test",
+            &s(&te.join("rows.csv")),
+            "--recipe",
+            "huge",
+            "--out",
+            &s(&d.join("x.safetensors")),
+        ]),
+        &["unknown recipe", "paper"],
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}
