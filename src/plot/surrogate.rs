@@ -218,7 +218,12 @@ fn errors<DB: DrawingBackend>(
         let (values, span, xdesc, title) = if k == 0 {
             (&abs, 1.5 * q95, "c_p - c_s (pF)", "a) absolute")
         } else {
-            (&rel, 1000.0 * f.rel_sigma.max(1e-9), "(c_p - c_s)/c_s (%)", "b) relative")
+            (
+                &rel,
+                1000.0 * f.rel_sigma.max(1e-9),
+                "(c_p - c_s)/c_s (%)",
+                "b) relative",
+            )
         };
         let outside = values.iter().filter(|v| v.abs() > span).count();
         let (lo, hi) = (-span, span);
@@ -227,7 +232,10 @@ fn errors<DB: DrawingBackend>(
         let top = h.iter().copied().fold(1.0_f64, f64::max);
         let mut chart = ChartBuilder::on(area)
             .caption(
-                format!("{title} differences, {label} set (n = {}, {outside} outside)", f.n),
+                format!(
+                    "{title} differences, {label} set (n = {}, {outside} outside)",
+                    f.n
+                ),
                 ("sans-serif", 18),
             )
             .margin(12)
