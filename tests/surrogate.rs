@@ -143,6 +143,49 @@ fn tiny_network_on_a_tiny_generated_set() {
     assert!((c / expected - 1.0).abs() < 1e-12, "{c} vs {expected}");
     assert_eq!(p["jacobian_pf"][0].as_array().unwrap().len(), 9);
 
+    // Resume: a finished member waiting in NAME.partial/ is taken, not retrained, and the result
+    // is the same model; a checkpoint of another run (another seed) is refused.
+    let partial = d.join("tiny.partial");
+    std::fs::create_dir_all(&partial).unwrap();
+    std::fs::copy(&model, partial.join("member-0.safetensors")).unwrap();
+    std::fs::copy(
+        d.join("tiny.curves.csv"),
+        partial.join("member-0.curves.csv"),
+    )
+    .unwrap();
+    let train_args = |seed: &str| {
+        run(&[
+            "train",
+            "--data",
+            &s(&tr.join("rows.csv")),
+            "--test",
+            &s(&te.join("rows.csv")),
+            "--recipe",
+            "tiny",
+            "--seed",
+            seed,
+            "--out",
+            &s(&model),
+        ])
+    };
+    let o = train_args("3");
+    ok(&o);
+    assert!(String::from_utf8_lossy(&o.stderr).contains("resuming: 1 of 1"));
+    assert!(
+        !partial.exists(),
+        "checkpoints are removed once the model is written"
+    );
+    assert_eq!(eval(), a);
+    std::fs::create_dir_all(&partial).unwrap();
+    std::fs::copy(&model, partial.join("member-0.safetensors")).unwrap();
+    std::fs::copy(
+        d.join("tiny.curves.csv"),
+        partial.join("member-0.curves.csv"),
+    )
+    .unwrap();
+    bad(&train_args("4"), &["member-0.safetensors", "another run"]);
+    std::fs::remove_dir_all(&partial).unwrap();
+
     // Bad input.
     let nan: Vec<&str> = vec!["nan"; 9];
     bad(

@@ -5,8 +5,8 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 use hpge_surrogate::{
-    DataInfo, DataSet, EpochRecord, FORMAT, FORMAT_VERSION, Figures, ModelInfo, OutputTransform,
-    ParameterSpace, Polynomial, Predictor, Recipe, Surrogate, Trained, unit_to_z,
+    DataInfo, DataSet, EpochRecord, FORMAT, FORMAT_VERSION, Figures, Member, ModelInfo,
+    OutputTransform, ParameterSpace, Polynomial, Predictor, Recipe, Surrogate, Trained, unit_to_z,
 };
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
@@ -45,6 +45,82 @@ fn write_curves(path: &Path, curves: &[EpochRecord], model: &Path) -> Result<()>
     }
     f.write_all(text.as_bytes())
         .with_context(|| format!("cannot write the learning curves {}", path.display()))
+}
+
+/// Where finished ensemble members of an unfinished run wait: models/NAME.partial/.
+fn partial_dir(model: &Path) -> PathBuf {
+    model.with_extension("partial")
+}
+
+/// Checkpoints member m (a one-member model file plus its learning curves).
+fn save_member(dir: &Path, info: &ModelInfo, m: usize, member: &Member) -> Result<()> {
+    std::fs::create_dir_all(dir)
+        .with_context(|| format!("cannot create the checkpoint folder {}", dir.display()))?;
+    let mut one = info.clone();
+    if let Some(r) = one.recipe.as_mut() {
+        r.members = 1;
+    }
+    let file = dir.join(format!("member-{m}.safetensors"));
+    Surrogate::new(one, Predictor::Networks(vec![member.0.clone()]))?.save(&file)?;
+    write_curves(
+        &dir.join(format!("member-{m}.curves.csv")),
+        &member.1,
+        &file,
+    )
+}
+
+/// Members finished by an interrupted run with the same recipe, seed and data (refuses a
+/// checkpoint folder of other settings).
+fn resume_members(dir: &Path, info: &ModelInfo) -> Result<Vec<Member>> {
+    let mut done = Vec::new();
+    loop {
+        let m = done.len();
+        let file = dir.join(format!("member-{m}.safetensors"));
+        let curves = dir.join(format!("member-{m}.curves.csv"));
+        if !file.is_file() || !curves.is_file() {
+            return Ok(done);
+        }
+        let s = Surrogate::load(&file)?;
+        let same = s.info.recipe_name == info.recipe_name
+            && s.info.seed == info.seed
+            && s.info.training.hash == info.training.hash
+            && s.info.test.hash == info.test.hash
+            && s.info.space.dimensions == info.space.dimensions;
+        if !same {
+            bail!(
+                "{}: a checkpoint of another run (recipe, seed or data differ); remove the folder \
+                 {} or choose another --out",
+                file.display(),
+                dir.display()
+            );
+        }
+        let Predictor::Networks(mut nets) = s.predictor else {
+            bail!("{}: not a network checkpoint", file.display());
+        };
+        let text = std::fs::read_to_string(&curves)
+            .with_context(|| format!("cannot read {}", curves.display()))?;
+        let mut records = Vec::new();
+        for line in text
+            .lines()
+            .filter(|l| !l.starts_with('#') && !l.starts_with("member"))
+        {
+            let v: Vec<f64> = line.split(',').filter_map(|x| x.parse().ok()).collect();
+            if v.len() != 8 {
+                bail!("{}: malformed line `{line}`", curves.display());
+            }
+            records.push(EpochRecord {
+                member: m,
+                epoch: v[1] as usize,
+                cycle: v[2] as usize,
+                lr: v[3],
+                train_loss: v[4],
+                test_loss: v[5],
+                test_rel_rms: v[6],
+                seconds: v[7],
+            });
+        }
+        done.push((nets.remove(0), records));
+    }
 }
 
 /// Trains, evaluates on the test set and writes the model file and its learning curves.
@@ -87,7 +163,35 @@ pub fn train(o: &TrainOptions) -> Result<()> {
         );
     }
     let start = std::time::Instant::now();
-    let (predictor, output, curves, seconds) = match &recipe {
+    let inputs: Vec<String> = {
+        let order = hpge_surrogate::network_order(&space)?;
+        order
+            .iter()
+            .map(|&j| space.dimensions[j].name.clone())
+            .collect()
+    };
+    let log_output = recipe.as_ref().is_none_or(|r| r.log_output);
+    let mut info = ModelInfo {
+        format: FORMAT.into(),
+        format_version: FORMAT_VERSION,
+        program_version: env!("CARGO_PKG_VERSION").into(),
+        space: space.clone(),
+        inputs,
+        input_map: "u = (x - lo)/(hi - lo) per the space's distribution, clamped to \
+                    [1e-6, 1 - 1e-6]; z = Phi^-1(u) (standard-normal coordinates)"
+            .into(),
+        output: hpge_surrogate::output_transform(log_output, &train),
+        recipe_name: o.recipe.into(),
+        recipe: recipe.clone(),
+        seed: o.seed,
+        training: DataInfo::of(&train),
+        test: DataInfo::of(&test),
+        train_seconds: 0.0,
+        threads: std::thread::available_parallelism().map_or(1, |n| n.get()),
+        test_figures: Figures::of(&[], &[]),
+        sigma_p: f64::NAN,
+    };
+    let (predictor, curves, seconds) = match &recipe {
         Some(recipe) => {
             let total = (recipe.total_epochs() * recipe.members) as u64;
             let bar = if o.quiet {
@@ -125,64 +229,67 @@ pub fn train(o: &TrainOptions) -> Result<()> {
                     100.0 * r.test_rel_rms
                 ));
             };
+            let partial = partial_dir(o.out);
+            let finished = resume_members(&partial, &info)?;
+            if !finished.is_empty() && !o.quiet {
+                eprintln!(
+                    "resuming: {} of {} members finished in {}",
+                    finished.len(),
+                    recipe.members,
+                    partial.display()
+                );
+            }
+            bar.inc((finished.len() * recipe.total_epochs()) as u64);
+            let mut checkpoint = |m: usize, member: &Member| -> hpge_surrogate::Result<()> {
+                save_member(&partial, &info, m, member).map_err(|e| {
+                    hpge_surrogate::Error::Training {
+                        message: format!("{e:#}"),
+                    }
+                })
+            };
             let Trained {
                 members,
-                output,
                 curves,
                 seconds,
-            } = hpge_surrogate::train(recipe, &train, &test, o.seed, &mut progress)?;
+                ..
+            } = hpge_surrogate::train_resuming(
+                recipe,
+                &train,
+                &test,
+                o.seed,
+                finished,
+                &mut progress,
+                &mut checkpoint,
+            )?;
             bar.finish_and_clear();
-            (Predictor::Networks(members), output, curves, seconds)
+            (Predictor::Networks(members), curves, seconds)
         }
         None => {
             let z: Vec<f64> = train.unit.iter().map(|&u| unit_to_z(u)).collect();
-            let output = hpge_surrogate::output_transform(true, &train);
-            let OutputTransform::LogStandardised { mean, sd } = output else {
-                unreachable!("log output requested")
+            let OutputTransform::LogStandardised { mean, sd } = info.output else {
+                unreachable!("the polynomial learns ln c12")
             };
             let t: Vec<f64> = train.c12_pf.iter().map(|c| (c.ln() - mean) / sd).collect();
             let p = Polynomial::fit(train.dim, 3, &z, &t)?;
             (
                 Predictor::Polynomial(p),
-                output,
                 Vec::new(),
                 start.elapsed().as_secs_f64(),
             )
         }
     };
-    let inputs = {
-        let order = hpge_surrogate::network_order(&space)?;
-        order
-            .iter()
-            .map(|&j| space.dimensions[j].name.clone())
-            .collect()
-    };
-    let mut info = ModelInfo {
-        format: FORMAT.into(),
-        format_version: FORMAT_VERSION,
-        program_version: env!("CARGO_PKG_VERSION").into(),
-        space: space.clone(),
-        inputs,
-        input_map: "u = (x - lo)/(hi - lo) per the space's distribution, clamped to \
-                    [1e-6, 1 - 1e-6]; z = Phi^-1(u) (standard-normal coordinates)"
-            .into(),
-        output,
-        recipe_name: o.recipe.into(),
-        recipe: recipe.clone(),
-        seed: o.seed,
-        training: DataInfo::of(&train),
-        test: DataInfo::of(&test),
-        train_seconds: seconds,
-        threads: std::thread::available_parallelism().map_or(1, |n| n.get()),
-        test_figures: Figures::of(&[], &[]),
-        sigma_p: f64::NAN,
-    };
+    info.train_seconds = seconds;
     let mut model = Surrogate::new(info.clone(), predictor)?;
     let pred = model.predict_set(&test);
     info.test_figures = Figures::of(&pred, &test.c12_pf);
     info.sigma_p = info.test_figures.rel_sigma;
     model.info = info;
     model.save(o.out)?;
+    let partial = partial_dir(o.out);
+    if partial.is_dir() {
+        std::fs::remove_dir_all(&partial)
+            .with_context(|| format!("cannot remove the checkpoints {}", partial.display()))?;
+    }
     let curves_file = curves_path(o.out);
     if !curves.is_empty() {
         write_curves(&curves_file, &curves, o.out)?;

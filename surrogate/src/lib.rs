@@ -22,9 +22,9 @@ pub use generate::{
 };
 pub use model::{
     Architecture, Cycle, DataInfo, DataSet, Dense, EpochRecord, FORMAT, FORMAT_VERSION, Figures,
-    Loss, ModelInfo, Network, OutputTransform, Polynomial, Predictor, RECIPES, Recipe, Surrogate,
-    Trained, U_EDGE, Voltages, candle_outputs, gaussian_fit, initial_network, monomials,
-    network_order, output_transform, physical_to_z, quantile, train, unit_to_z,
+    Loss, Member, ModelInfo, Network, OutputTransform, Polynomial, Predictor, RECIPES, Recipe,
+    Surrogate, Trained, U_EDGE, Voltages, candle_outputs, gaussian_fit, initial_network, monomials,
+    network_order, output_transform, physical_to_z, quantile, train, train_resuming, unit_to_z,
 };
 pub use sequence::{Sequence, SequenceKind, phi_d};
 pub use space::{Dimension, Distribution, ParameterSpace, Target, normal_cdf, normal_quantile};

@@ -172,6 +172,9 @@ impl Surrogate {
         let n_params = info.space.dim().saturating_sub(1);
         let predictor = match &info.recipe {
             Some(recipe) => {
+                recipe
+                    .validate()
+                    .map_err(|e| bad("metadata.recipe", e.to_string()))?;
                 let mut nets = Vec::new();
                 for m in 0..recipe.members {
                     let dense = |name: String, n_in: usize, n_out: usize| -> Result<Dense> {

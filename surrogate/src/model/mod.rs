@@ -21,5 +21,8 @@ pub use network::{Dense, Network};
 pub use polynomial::{Polynomial, monomials};
 pub use recipe::{Architecture, Cycle, Loss, OutputTransform, RECIPES, Recipe};
 pub use surrogate::{DataInfo, FORMAT, FORMAT_VERSION, ModelInfo, Predictor, Surrogate, Voltages};
-pub use train::{EpochRecord, Trained, candle_outputs, initial_network, output_transform, train};
+pub use train::{
+    EpochRecord, Member, Trained, candle_outputs, initial_network, output_transform, train,
+    train_resuming,
+};
 pub use transform::{U_EDGE, physical_to_z, unit_to_z};

@@ -267,3 +267,53 @@ fn physical_jacobian_matches_finite_differences() {
         }
     }
 }
+
+#[test]
+fn a_resumed_ensemble_equals_an_uninterrupted_one() {
+    let dir = std::env::temp_dir().join(format!("hpge-surrogate-resume-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let sp = space();
+    let (tr, te) = (dir.join("train.csv"), dir.join("test.csv"));
+    write_set(&tr, &sp, 300, 0);
+    write_set(&te, &sp, 80, 1000);
+    let train_set = DataSet::read(&tr, &sp).unwrap();
+    let test_set = DataSet::read(&te, &sp).unwrap();
+    let mut recipe = Recipe::named("tiny").unwrap();
+    recipe.members = 2;
+    recipe.cycles.truncate(1);
+    let mut checkpoints = Vec::new();
+    let whole = train_resuming(
+        &recipe,
+        &train_set,
+        &test_set,
+        5,
+        Vec::new(),
+        &mut |_| {},
+        &mut |m, member| {
+            checkpoints.push((m, member.clone()));
+            Ok(())
+        },
+    )
+    .unwrap();
+    assert_eq!(checkpoints.len(), 2);
+    let first = vec![checkpoints[0].1.clone()];
+    let mut epochs = 0;
+    let resumed = train_resuming(
+        &recipe,
+        &train_set,
+        &test_set,
+        5,
+        first,
+        &mut |_| epochs += 1,
+        &mut |_, _| Ok(()),
+    )
+    .unwrap();
+    assert_eq!(
+        epochs,
+        recipe.total_epochs(),
+        "only the second member is trained"
+    );
+    assert_eq!(resumed.members, whole.members);
+    assert_eq!(resumed.curves.len(), whole.curves.len());
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -273,15 +273,48 @@ pub fn train(
     seed: u64,
     progress: &mut dyn FnMut(&EpochRecord),
 ) -> Result<Trained> {
+    train_resuming(
+        recipe,
+        train,
+        test,
+        seed,
+        Vec::new(),
+        progress,
+        &mut |_, _| Ok(()),
+    )
+}
+
+/// A finished ensemble member: its network and its learning curves.
+pub type Member = (Network, Vec<EpochRecord>);
+
+/// As [`train`], but starting after the members in `finished` (from an interrupted run of the
+/// same recipe, seed and data; the caller checks that), and handing each newly finished member to
+/// `on_member` (to checkpoint it) before the next one starts. Members are independent (member m
+/// uses seed + m), so a resumed run ends with the same networks as an uninterrupted one.
+pub fn train_resuming(
+    recipe: &Recipe,
+    train: &DataSet,
+    test: &DataSet,
+    seed: u64,
+    finished: Vec<Member>,
+    progress: &mut dyn FnMut(&EpochRecord),
+    on_member: &mut dyn FnMut(usize, &Member) -> Result<()>,
+) -> Result<Trained> {
     recipe.validate()?;
     let start = std::time::Instant::now();
     let out = output_transform(recipe.log_output, train);
     let (xt, tt) = tensors(train, out)?;
     let (xs, ts) = tensors(test, out)?;
     let n = train.len();
+    let first = finished.len();
     let mut members = Vec::new();
     let mut curves = Vec::new();
-    for m in 0..recipe.members {
+    for (net, c) in finished {
+        members.push(net);
+        curves.extend(c);
+    }
+    for m in first..recipe.members {
+        let mut member_curves = Vec::new();
         let member_start = std::time::Instant::now();
         let member_seed = seed.wrapping_add(m as u64);
         let net = CandleNet::from_network(&initial_network(
@@ -343,10 +376,13 @@ pub fn train(
                     seconds: member_start.elapsed().as_secs_f64(),
                 };
                 progress(&rec);
-                curves.push(rec);
+                member_curves.push(rec);
             }
         }
-        members.push(net.to_network()?);
+        let member = (net.to_network()?, member_curves);
+        on_member(m, &member)?;
+        members.push(member.0);
+        curves.extend(member.1);
     }
     Ok(Trained {
         members,
