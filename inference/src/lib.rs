@@ -6,9 +6,13 @@
 //! model-discovery workflow. It sees a model only through one narrow trait, implemented by both
 //! the exact solver and the surrogate. Filled in by the measurement and inference issues.
 
+mod diagnostics;
 mod error;
 mod measurement;
 
+pub use diagnostics::{
+    Diagnostics, ess, ess_bulk, ess_tail, fold, rank_normalise, rank_rhat, split_chains, split_rhat,
+};
 pub use error::{Error, Result};
 pub use measurement::{
     Circuit, CvData, Data, MeasureSettings, Measurement, PC_PER_KEV, PeakFit, Problem, PulseSet,

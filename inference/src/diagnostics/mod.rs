@@ -1,0 +1,43 @@
+//! Convergence diagnostics of MCMC draws (Vehtari, Gelman, Simpson, Carpenter, Buerkner 2021,
+//! "Rank-normalization, folding, and localization: an improved R-hat"): split chains, rank
+//! normalisation, folding, the rank-normalised split R-hat, bulk and tail effective sample sizes.
+
+mod ess;
+mod rank;
+mod rhat;
+
+#[cfg(test)]
+mod tests;
+
+pub use ess::{ess, ess_bulk, ess_tail};
+pub use rank::{fold, rank_normalise, split_chains};
+pub use rhat::{rank_rhat, split_rhat};
+
+use serde::Serialize;
+
+/// The diagnostics of one parameter.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Diagnostics {
+    /// max(split R-hat of the rank-normalised draws, of the rank-normalised folded draws).
+    pub rhat: f64,
+    /// Bulk effective sample size (rank-normalised split chains).
+    pub ess_bulk: f64,
+    /// Tail effective sample size (min over the 5% and 95% quantile indicators).
+    pub ess_tail: f64,
+}
+
+impl Diagnostics {
+    /// Diagnostics of `chains` (each one chain's draws of one parameter, equal lengths >= 4).
+    pub fn of(chains: &[Vec<f64>]) -> Diagnostics {
+        Diagnostics {
+            rhat: rank_rhat(chains),
+            ess_bulk: ess_bulk(chains),
+            ess_tail: ess_tail(chains),
+        }
+    }
+
+    /// R-hat <= `rhat_max` and both ESS >= `ess_min`.
+    pub fn converged(&self, rhat_max: f64, ess_min: f64) -> bool {
+        self.rhat <= rhat_max && self.ess_bulk >= ess_min && self.ess_tail >= ess_min
+    }
+}

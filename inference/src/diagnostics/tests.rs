@@ -1,0 +1,104 @@
+//! Diagnostics on chains with known answers: independent draws (R-hat 1, ESS ~ draws), AR(1)
+//! chains (ESS = M N (1 - phi)/(1 + phi)), chains that disagree in location or only in scale.
+
+use rand::SeedableRng;
+use rand::rngs::StdRng;
+use rand_distr::{Distribution, Normal};
+
+use super::*;
+
+fn ar1(m: usize, n: usize, phi: f64, seed: u64, shift: &[f64], scale: &[f64]) -> Vec<Vec<f64>> {
+    let mut rng = StdRng::seed_from_u64(seed);
+    let g = Normal::new(0.0, (1.0 - phi * phi).sqrt()).unwrap();
+    (0..m)
+        .map(|c| {
+            let mut x = Normal::new(0.0, 1.0).unwrap().sample(&mut rng);
+            (0..n)
+                .map(|_| {
+                    x = phi * x + g.sample(&mut rng);
+                    shift[c] + scale[c] * x
+                })
+                .collect()
+        })
+        .collect()
+}
+
+#[test]
+fn independent_draws_give_rhat_one_and_full_ess() {
+    let ones = [1.0; 4];
+    let zeros = [0.0; 4];
+    let mut bulk = Vec::new();
+    for seed in 0..5 {
+        let c = ar1(4, 1000, 0.0, seed, &zeros, &ones);
+        let d = Diagnostics::of(&c);
+        assert!(d.rhat < 1.01, "seed {seed}: {d:?}");
+        assert!(d.ess_tail > 2500.0, "seed {seed}: {d:?}");
+        bulk.push(d.ess_bulk);
+    }
+    let mean = bulk.iter().sum::<f64>() / bulk.len() as f64;
+    assert!((mean / 4000.0 - 1.0).abs() < 0.1, "mean bulk ESS {mean}");
+}
+
+#[test]
+fn ar1_chains_give_the_theoretical_ess() {
+    // ESS = M N (1 - phi) / (1 + phi) for an AR(1) process.
+    for (phi, seed) in [(0.5, 1), (0.9, 2)] {
+        let (m, n) = (4, 20000);
+        let c = ar1(m, n, phi, seed, &[0.0; 4], &[1.0; 4]);
+        let expected = (m * n) as f64 * (1.0 - phi) / (1.0 + phi);
+        let got = ess(&c);
+        assert!(
+            (got / expected - 1.0).abs() < 0.12,
+            "phi {phi}: ESS {got}, expected {expected}"
+        );
+        let bulk = ess_bulk(&c);
+        assert!(
+            (bulk / expected - 1.0).abs() < 0.15,
+            "phi {phi}: bulk {bulk}, expected {expected}"
+        );
+        assert!(rank_rhat(&c) < 1.01);
+    }
+}
+
+#[test]
+fn disagreeing_chains_are_flagged() {
+    // One chain shifted by half a standard deviation.
+    let c = ar1(4, 1000, 0.3, 7, &[0.0, 0.0, 0.0, 0.5], &[1.0; 4]);
+    assert!(rank_rhat(&c) > 1.02, "location: {}", rank_rhat(&c));
+    // Same location, one chain three times as wide: only the folded R-hat sees it.
+    let c = ar1(4, 1000, 0.0, 8, &[0.0; 4], &[1.0, 1.0, 1.0, 3.0]);
+    let bulk_only = split_rhat(&rank_normalise(&split_chains(&c)));
+    assert!(bulk_only < 1.02, "bulk {bulk_only}");
+    assert!(rank_rhat(&c) > 1.05, "scale: {}", rank_rhat(&c));
+    // A trend within each chain: split R-hat sees it.
+    let trend: Vec<Vec<f64>> = ar1(4, 1000, 0.0, 9, &[0.0; 4], &[1.0; 4])
+        .into_iter()
+        .map(|c| {
+            c.iter()
+                .enumerate()
+                .map(|(i, x)| x + 2.0 * i as f64 / 1000.0)
+                .collect()
+        })
+        .collect();
+    assert!(rank_rhat(&trend) > 1.05, "trend: {}", rank_rhat(&trend));
+}
+
+#[test]
+fn ranks_are_normal_scores_and_ties_share_a_rank() {
+    let c = vec![vec![3.0, 1.0, 2.0], vec![2.0, 5.0, 4.0]];
+    let z = rank_normalise(&c);
+    // Ranks 1..6 with the two 2.0 sharing 2.5.
+    assert_eq!(z[0][2], z[1][0]);
+    assert!(z[0][1] < z[0][2] && z[0][2] < z[0][0] && z[1][2] < z[1][1]);
+    let s = 6.0;
+    let expected = hpge_surrogate::normal_quantile((1.0 - 0.375) / (s + 0.25));
+    assert!((z[0][1] - expected).abs() < 1e-12);
+    assert_eq!(
+        split_chains(&[vec![1.0, 2.0, 3.0, 4.0, 5.0]]),
+        vec![vec![1.0, 2.0], vec![4.0, 5.0]]
+    );
+    assert_eq!(
+        fold(&[vec![1.0, 3.0], vec![2.0, 6.0]]),
+        vec![vec![1.5, 0.5], vec![0.5, 3.5]]
+    );
+}
