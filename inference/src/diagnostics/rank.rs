@@ -1,6 +1,6 @@
 //! Split chains, rank normalisation and folding (Vehtari et al. 2021, section 4).
 
-use hpge_surrogate::normal_quantile;
+use hpge_surrogate::{normal_quantile, quantile};
 
 /// Each chain cut into its first and second half (an odd draw in the middle is dropped): 2M
 /// chains of floor(N/2) draws, so that a trend within a chain shows up as between-chain
@@ -47,13 +47,10 @@ pub fn rank_normalise(chains: &[Vec<f64>]) -> Vec<Vec<f64>> {
 pub fn fold(chains: &[Vec<f64>]) -> Vec<Vec<f64>> {
     let mut all: Vec<f64> = chains.iter().flatten().copied().collect();
     all.sort_by(f64::total_cmp);
-    let n = all.len();
-    let median = if n == 0 {
+    let median = if all.is_empty() {
         0.0
-    } else if n % 2 == 1 {
-        all[n / 2]
     } else {
-        0.5 * (all[n / 2 - 1] + all[n / 2])
+        quantile(&all, 0.5)
     };
     chains
         .iter()
