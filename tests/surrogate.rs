@@ -59,21 +59,17 @@ fn tiny_network_on_a_tiny_generated_set() {
     generate(&te, "40", "5000");
     let model = d.join("tiny.safetensors");
     let s = |p: &Path| p.to_str().unwrap().to_string();
-    let out = run(&[
-        "train",
-        "--data",
-        &s(&tr.join("rows.csv")),
-        "--test",
-        &s(&te.join("rows.csv")),
-        "--recipe",
-        "tiny",
-        "--seed",
-        "3",
-        "--out",
-        &s(&model),
-        "--plot",
-        &s(&d.join("plots")),
-    ]);
+    let train = |seed: &str, extra: &[&str]| {
+        let (data, test, out) = (s(&tr.join("rows.csv")), s(&te.join("rows.csv")), s(&model));
+        let mut args = vec![
+            "train", "--data", &data, "--test", &test, "--recipe", "tiny", "--seed", seed, "--out",
+            &out,
+        ];
+        args.extend_from_slice(extra);
+        run(&args)
+    };
+    let plots = s(&d.join("plots"));
+    let out = train("3", &["--plot", &plots]);
     ok(&out);
     // The learning curves: one line per epoch, the training loss falls.
     let curves = std::fs::read_to_string(d.join("tiny.curves.csv")).unwrap();
@@ -146,29 +142,17 @@ fn tiny_network_on_a_tiny_generated_set() {
     // Resume: a finished member waiting in NAME.partial/ is taken, not retrained, and the result
     // is the same model; a checkpoint of another run (another seed) is refused.
     let partial = d.join("tiny.partial");
-    std::fs::create_dir_all(&partial).unwrap();
-    std::fs::copy(&model, partial.join("member-0.safetensors")).unwrap();
-    std::fs::copy(
-        d.join("tiny.curves.csv"),
-        partial.join("member-0.curves.csv"),
-    )
-    .unwrap();
-    let train_args = |seed: &str| {
-        run(&[
-            "train",
-            "--data",
-            &s(&tr.join("rows.csv")),
-            "--test",
-            &s(&te.join("rows.csv")),
-            "--recipe",
-            "tiny",
-            "--seed",
-            seed,
-            "--out",
-            &s(&model),
-        ])
+    let checkpoint = || {
+        std::fs::create_dir_all(&partial).unwrap();
+        std::fs::copy(&model, partial.join("member-0.safetensors")).unwrap();
+        std::fs::copy(
+            d.join("tiny.curves.csv"),
+            partial.join("member-0.curves.csv"),
+        )
+        .unwrap();
     };
-    let o = train_args("3");
+    checkpoint();
+    let o = train("3", &[]);
     ok(&o);
     assert!(String::from_utf8_lossy(&o.stderr).contains("resuming: 1 of 1"));
     assert!(
@@ -176,14 +160,8 @@ fn tiny_network_on_a_tiny_generated_set() {
         "checkpoints are removed once the model is written"
     );
     assert_eq!(eval(), a);
-    std::fs::create_dir_all(&partial).unwrap();
-    std::fs::copy(&model, partial.join("member-0.safetensors")).unwrap();
-    std::fs::copy(
-        d.join("tiny.curves.csv"),
-        partial.join("member-0.curves.csv"),
-    )
-    .unwrap();
-    bad(&train_args("4"), &["member-0.safetensors", "another run"]);
+    checkpoint();
+    bad(&train("4", &[]), &["member-0.safetensors", "another run"]);
     std::fs::remove_dir_all(&partial).unwrap();
 
     // Bad input.

@@ -9,7 +9,7 @@ use hpge_inference::{Measurement, PulseSet, VoltagePoint, negative_slopes};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::{err, log_key_points};
+use super::{err, legend, log_key_points};
 
 /// Writes `pulses`, `spectra`, `peak-fits`, `cv` and `slope` (.svg and .png) into `dir`.
 pub fn measurement(m: &Measurement, sets: &[PulseSet], dir: &Path) -> Result<()> {
@@ -115,13 +115,7 @@ fn pulses<DB: DrawingBackend>(
                 )
             })
             .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], RED));
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::LowerRight)
-            .background_style(WHITE.mix(0.8))
-            .border_style(BLACK)
-            .draw()
-            .map_err(err)?;
+        legend(&mut chart, SeriesLabelPosition::LowerRight)?;
     }
     Ok(())
 }
@@ -203,12 +197,7 @@ fn spectra<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, m: &Measurement) -
         .map_err(err)?
         .label("208Tl 2614.5 keV")
         .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], RED));
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .draw()
-        .map_err(err)?;
+    legend(&mut chart, SeriesLabelPosition::MiddleRight)?;
     Ok(())
 }
 
@@ -320,12 +309,7 @@ fn cv<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, m: &Measurement) -> Res
             .map_err(err)?
             .label(format!("full depletion {u:.0} V"))
             .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], RED));
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.8))
-            .border_style(BLACK)
-            .draw()
-            .map_err(err)?;
+        legend(&mut chart, SeriesLabelPosition::MiddleRight)?;
     }
     Ok(())
 }
@@ -376,12 +360,6 @@ fn slope<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, m: &Measurement) -> 
             .label(format!("U_fd = {u:.0} V"))
             .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], RED.mix(0.5)));
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .draw()
-        .map_err(err)?;
+    legend(&mut chart, SeriesLabelPosition::UpperRight)?;
     Ok(())
 }

@@ -92,6 +92,25 @@ pub fn check_output(path: &Path, flag: &str) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// The legend most figures use: a framed, slightly transparent box at `position`.
+pub(crate) fn legend<
+    'a,
+    DB: plotters::prelude::DrawingBackend + 'a,
+    CT: plotters::coord::CoordTranslate,
+>(
+    chart: &mut plotters::prelude::ChartContext<'a, DB, CT>,
+    position: plotters::prelude::SeriesLabelPosition,
+) -> anyhow::Result<()> {
+    use plotters::prelude::{BLACK, Color, WHITE};
+    chart
+        .configure_series_labels()
+        .position(position)
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()
+        .map_err(err)
+}
+
 /// A plotters drawing error as an anyhow error.
 pub(crate) fn err<E: std::fmt::Debug>(e: E) -> anyhow::Error {
     anyhow::anyhow!("drawing failed: {e:?}")

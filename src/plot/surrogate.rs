@@ -9,7 +9,7 @@ use hpge_surrogate::{EpochRecord, Figures, ModelInfo};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::err;
+use super::{err, legend};
 
 /// `learning-curves.svg/png` in `dir`.
 pub fn learning_curves(curves: &[EpochRecord], info: &ModelInfo, dir: &Path) -> Result<()> {
@@ -101,13 +101,7 @@ fn draw_curves<DB: DrawingBackend>(
                 .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], RED.stroke_width(2)));
         }
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .draw()
-        .map_err(err)?;
+    legend(&mut chart, SeriesLabelPosition::UpperRight)?;
     Ok(())
 }
 
@@ -273,13 +267,7 @@ fn errors<DB: DrawingBackend>(
                 .map_err(err)?
                 .label(format!("Gaussian fit: mean {mu:+.3}%, sigma {s:.3}%"))
                 .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], RED.stroke_width(2)));
-            chart
-                .configure_series_labels()
-                .position(SeriesLabelPosition::UpperRight)
-                .background_style(WHITE.mix(0.8))
-                .border_style(BLACK)
-                .draw()
-                .map_err(err)?;
+            legend(&mut chart, SeriesLabelPosition::UpperRight)?;
         }
     }
     Ok(())

@@ -338,7 +338,8 @@ impl Surrogate {
     }
 
     /// Predictions (pF) for every sample of a data set (whose rows are in network order), in
-    /// parallel. The data set must be of this model's space (checked by [`Self::check_set`]).
+    /// parallel. The data set must have been read with this model's space (`DataSet::read(path,
+    /// &model.info.space)` refuses any other).
     pub fn predict_set(&self, set: &DataSet) -> Vec<f64> {
         let np = self.n_params();
         (0..set.len())
@@ -359,22 +360,5 @@ impl Surrogate {
                 }
             })
             .collect()
-    }
-
-    /// Refuses a data set of another space than the model's.
-    pub fn check_set(&self, set: &DataSet, space: &ParameterSpace) -> Result<()> {
-        let same = space.dimensions == self.info.space.dimensions;
-        if !same || set.dim != self.dims.len() {
-            return Err(Error::Invalid {
-                file: set.file.clone(),
-                key: "space".into(),
-                message: format!(
-                    "the data set is of space `{}`, the model of `{}` (other dimensions or \
-                     ranges)",
-                    space.name, self.info.space.name
-                ),
-            });
-        }
-        Ok(())
     }
 }
