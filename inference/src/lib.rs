@@ -9,6 +9,11 @@
 mod diagnostics;
 mod error;
 mod measurement;
+mod model;
+mod posterior;
+mod prior;
+mod sampler;
+mod summary;
 
 pub use diagnostics::{
     Diagnostics, ess, ess_bulk, ess_tail, fold, rank_normalise, rank_rhat, split_chains, split_rhat,
@@ -20,4 +25,11 @@ pub use measurement::{
     Uncertainties, VoltagePoint, depletion_voltage, fit_peak, fit_tail, load_data, measure,
     measure_voltage, negative_slopes, read_curve, read_pulses, read_raw_dir, synthesize_voltage,
     voltage_seed, write_curve, write_curve_with_comments, write_pulses,
+};
+pub use model::{CvModel, ExactModel, SurrogateModel};
+pub use posterior::{Cholesky, Evaluation, Likelihood, NoiseKind, NoiseSettings, Posterior};
+pub use prior::{ParameterSpec, Prior, PriorDistribution, PriorParameter, PriorSpec};
+pub use sampler::{
+    ChainDraws, GaussianTarget, LogDensity, Phase, SampleSettings, SamplerKind, Samples, Status,
+    StopReason, sample,
 };

@@ -17,8 +17,8 @@ mod space;
 
 pub use error::{Error, Result};
 pub use generate::{
-    Fingerprint, Generator, MergeReport, RunInfo, RunReport, Sample, Shard, fnv1a, format_row,
-    merge, read_rows, run,
+    ExactSolver, Fingerprint, Generator, MergeReport, RunInfo, RunReport, Sample, Shard, fnv1a,
+    format_row, merge, read_rows, run,
 };
 pub use model::{
     Architecture, Cycle, DataInfo, DataSet, Dense, EpochRecord, FORMAT, FORMAT_VERSION, Figures,

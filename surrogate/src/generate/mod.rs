@@ -1,10 +1,12 @@
 //! Training-set generation with the exact solver: one row per quasi-random sample, resumable,
 //! sharded (Slurm job arrays), merged.
 
+mod exact;
 mod merge;
 mod run;
 mod setup;
 
+pub use exact::ExactSolver;
 pub use merge::{MergeReport, merge};
 pub use run::{RunInfo, RunReport, format_row, read_rows, run};
 pub use setup::{Fingerprint, Generator, Sample, Shard, fnv1a};

@@ -3,11 +3,12 @@
 
 use std::path::{Path, PathBuf};
 
-use hpge_solver::{Detector, FieldSettings, ImpuritySpec, Parameters, solve_point};
+use hpge_solver::FieldSettings;
 use serde::{Deserialize, Serialize};
 
+use super::exact::ExactSolver;
 use crate::sequence::{Sequence, SequenceKind};
-use crate::space::{ParameterSpace, Target};
+use crate::space::ParameterSpace;
 use crate::{Error, Result};
 
 /// FNV-1a 64-bit hash (stable across platforms and versions; identifies inputs, not security).
@@ -89,7 +90,6 @@ pub struct Generator {
     pub space: ParameterSpace,
     /// The detector file.
     pub detector_file: PathBuf,
-    detector_text: String,
     /// Solver settings.
     pub settings: FieldSettings,
     /// The sequence.
@@ -102,7 +102,8 @@ pub struct Generator {
     pub shard: Shard,
     /// The fingerprint.
     pub fingerprint: Fingerprint,
-    targets: Vec<Target>,
+    /// The space's points solved with the exact solver.
+    pub exact: ExactSolver,
 }
 
 /// The outcome of one sample.
@@ -164,70 +165,14 @@ impl Generator {
             return Err(arg("--shard", "need 0 <= K < M".into()));
         }
         settings.validate().map_err(|m| arg("solver settings", m))?;
-        let detector_text = std::fs::read_to_string(detector_file).map_err(|e| Error::Io {
-            file: detector_file.into(),
-            action: "cannot read the detector",
-            source: e,
-        })?;
-        // The detector must load, and the y targets must fit its rz knots.
-        let det = Detector::from_toml_str(&detector_text, detector_file, &Parameters::new())?;
-        let targets = space.targets();
-        let ys: Vec<&Target> = targets
-            .iter()
-            .filter(|t| matches!(t, Target::YBot(_) | Target::YTop(_)))
-            .collect();
-        for face in [0, 1] {
-            let mut ks: Vec<usize> = targets
-                .iter()
-                .filter_map(|t| match (t, face) {
-                    (Target::YBot(k), 0) | (Target::YTop(k), 1) => Some(*k),
-                    _ => None,
-                })
-                .collect();
-            ks.sort_unstable();
-            if !ys.is_empty() && ks != (0..ks.len().max(1)).collect::<Vec<_>>() {
-                return Err(Error::Invalid {
-                    file: space.file.clone(),
-                    key: "dimensions".into(),
-                    message: format!(
-                        "the {} targets must be knots 0, 1, ... without gaps, got {ks:?}",
-                        if face == 0 { "y_bot" } else { "y_top" },
-                    ),
-                });
-            }
-        }
-        for t in &targets {
-            if let Target::Parameter(p) = t
-                && det.parameters.get(p).is_none()
-            {
-                return Err(Error::Invalid {
-                    file: space.file.clone(),
-                    key: "dimensions".into(),
-                    message: format!(
-                        "target parameter:{p}: {} declares no parameter `{p}`",
-                        detector_file.display()
-                    ),
-                });
-            }
-        }
-        if !targets.contains(&Target::Bias) {
-            return Err(Error::Invalid {
-                file: space.file.clone(),
-                key: "dimensions".into(),
-                message: "one dimension must have target = \"bias\"".into(),
-            });
-        }
+        let exact = ExactSolver::new(space.clone(), detector_file, settings.clone())?;
         let space_text = toml::to_string(&space).unwrap_or_default();
         let settings_json = toml::to_string(&settings).unwrap_or_default();
-        let mut det_bytes = detector_text.as_bytes().to_vec();
-        if let Ok(imp) = std::fs::read(det.semiconductor.impurity_file()) {
-            det_bytes.extend_from_slice(&imp);
-        }
         let fingerprint = Fingerprint {
             space: space.name.clone(),
             space_hash: format!("{:016x}", fnv1a(space_text.as_bytes())),
             detector: detector_file.display().to_string(),
-            detector_hash: format!("{:016x}", fnv1a(&det_bytes)),
+            detector_hash: exact.detector_hash(),
             settings_hash: format!("{:016x}", fnv1a(settings_json.as_bytes())),
             sequence: kind.as_str().to_string(),
             seed,
@@ -237,18 +182,14 @@ impl Generator {
         let g = Self {
             space,
             detector_file: detector_file.into(),
-            detector_text,
             settings,
             sequence,
             offset,
             n,
             shard,
             fingerprint,
-            targets,
+            exact,
         };
-        // A dry run at the centre of the space: the detector and impurity model build.
-        let centre = g.space.from_unit(&vec![0.5; g.space.dim()]);
-        g.configure(&centre)?;
         Ok(g)
     }
 
@@ -271,7 +212,7 @@ impl Generator {
         let start = std::time::Instant::now();
         let u = self.sequence.point(index);
         let x = self.space.from_unit(&u);
-        let result = self.solve(&x);
+        let result = self.exact.solve(&x);
         let (c12_pf, status) = match result {
             Ok(c) => (c, "ok".to_string()),
             Err(e) => (
@@ -287,45 +228,5 @@ impl Generator {
             status,
             seconds: start.elapsed().as_secs_f64(),
         }
-    }
-
-    fn solve(&self, x: &[f64]) -> Result<f64> {
-        let (det, bias) = self.configure(x)?;
-        Ok(solve_point(&det, bias, &self.settings, None)?.c12_pf)
-    }
-
-    /// The detector with the sample's parameters and impurity model, and the bias (V).
-    fn configure(&self, x: &[f64]) -> Result<(Detector, f64)> {
-        let mut params = Parameters::new();
-        let mut bias = 0.0;
-        let (mut yb, mut yt) = (Vec::new(), Vec::new());
-        for (t, &v) in self.targets.iter().zip(x) {
-            match t {
-                Target::Bias => bias = v,
-                Target::Parameter(p) => params.set(p.clone(), v),
-                Target::YBot(k) => yb.push((*k, v)),
-                Target::YTop(k) => yt.push((*k, v)),
-            }
-        }
-        let mut det = Detector::from_toml_str(&self.detector_text, &self.detector_file, &params)?;
-        if !yb.is_empty() {
-            yb.sort_by_key(|p| p.0);
-            yt.sort_by_key(|p| p.0);
-            let list = |v: &[(usize, f64)]| {
-                v.iter()
-                    .map(|p| format!("{:e}", p.1))
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            };
-            let text = format!(
-                "model = \"rz\"\ny_bot = [{}]\ny_top = [{}]\n",
-                list(&yb),
-                list(&yt)
-            );
-            let name = Path::new("(generated sample)");
-            let spec = ImpuritySpec::from_toml_str(&text, name)?;
-            det.set_impurity(&spec, name)?;
-        }
-        Ok((det, bias))
     }
 }

@@ -1,0 +1,71 @@
+//! The trained surrogate as a [`CvModel`].
+
+use hpge_surrogate::{Surrogate, Voltages};
+
+use super::CvModel;
+use crate::{Error, Result};
+
+/// A surrogate bound to the measured voltages (mapped once).
+#[derive(Debug, Clone)]
+pub struct SurrogateModel {
+    /// The network (or polynomial) and its metadata.
+    pub surrogate: Surrogate,
+    voltages: Voltages,
+    describe: String,
+}
+
+impl SurrogateModel {
+    /// Binds `surrogate` to `volts` (V); each voltage must lie in its training range.
+    pub fn new(surrogate: Surrogate, volts: &[f64], describe: impl Into<String>) -> Result<Self> {
+        let voltages = surrogate.voltages(volts)?;
+        Ok(Self {
+            surrogate,
+            voltages,
+            describe: describe.into(),
+        })
+    }
+}
+
+impl CvModel for SurrogateModel {
+    fn inputs(&self) -> Vec<String> {
+        self.surrogate
+            .parameter_names()
+            .into_iter()
+            .map(String::from)
+            .collect()
+    }
+
+    fn domain(&self) -> Vec<[f64; 2]> {
+        (0..self.surrogate.n_params())
+            .map(|k| self.surrogate.range(k))
+            .collect()
+    }
+
+    fn voltages(&self) -> &[f64] {
+        &self.voltages.volts
+    }
+
+    fn sigma_rel(&self) -> f64 {
+        self.surrogate.sigma_p()
+    }
+
+    fn curve(&self, x: &[f64], c_pf: &mut [f64]) -> Result<()> {
+        self.surrogate
+            .curve_into(x, &self.voltages, c_pf, None)
+            .map_err(Error::from)
+    }
+
+    fn has_jacobian(&self) -> bool {
+        true
+    }
+
+    fn curve_jacobian(&self, x: &[f64], c_pf: &mut [f64], jac: &mut [f64]) -> Result<()> {
+        self.surrogate
+            .curve_jacobian_into(x, &self.voltages, c_pf, jac)
+            .map_err(Error::from)
+    }
+
+    fn describe(&self) -> String {
+        self.describe.clone()
+    }
+}

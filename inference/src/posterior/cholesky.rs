@@ -1,0 +1,96 @@
+//! A dense Cholesky factorisation for the likelihood's N x N covariance (N = the number of
+//! voltages, about 60). Written by hand: one factorisation per posterior evaluation, where a
+//! general dense library's dispatch and allocation cost more than the 60^3/3 flops.
+
+/// L with A = L L^T, row-major lower triangle.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Cholesky {
+    n: usize,
+    l: Vec<f64>,
+}
+
+impl Cholesky {
+    /// Factorises the symmetric positive-definite `a` (row-major n x n); None when a pivot is
+    /// not positive.
+    pub fn new(a: &[f64], n: usize) -> Option<Self> {
+        let mut l = vec![0.0; n * n];
+        for i in 0..n {
+            for j in 0..=i {
+                let mut s = a[i * n + j];
+                for k in 0..j {
+                    s -= l[i * n + k] * l[j * n + k];
+                }
+                if i == j {
+                    if !(s > 0.0) {
+                        return None;
+                    }
+                    l[i * n + i] = s.sqrt();
+                } else {
+                    l[i * n + j] = s / l[j * n + j];
+                }
+            }
+        }
+        Some(Self { n, l })
+    }
+
+    /// L (row-major, zeros above the diagonal).
+    pub fn lower(&self) -> Vec<f64> {
+        self.l.clone()
+    }
+
+    /// ln det A = 2 sum ln L_ii.
+    pub fn ln_det(&self) -> f64 {
+        (0..self.n).map(|i| 2.0 * self.l[i * self.n + i].ln()).sum()
+    }
+
+    /// x = A^-1 b.
+    pub fn solve(&self, b: &[f64]) -> Vec<f64> {
+        let n = self.n;
+        let mut y = b.to_vec();
+        for i in 0..n {
+            let mut s = y[i];
+            for k in 0..i {
+                s -= self.l[i * n + k] * y[k];
+            }
+            y[i] = s / self.l[i * n + i];
+        }
+        for i in (0..n).rev() {
+            let mut s = y[i];
+            for k in i + 1..n {
+                s -= self.l[k * n + i] * y[k];
+            }
+            y[i] = s / self.l[i * n + i];
+        }
+        y
+    }
+
+    /// The diagonal of A^-1: (A^-1)_ii = sum_k (L^-1)_ki^2.
+    pub fn inverse_diagonal(&self) -> Vec<f64> {
+        let n = self.n;
+        // Columns of L^-1 by forward substitution on unit vectors.
+        let mut d = vec![0.0; n];
+        let mut col = vec![0.0; n];
+        for i in 0..n {
+            col.fill(0.0);
+            col[i] = 1.0 / self.l[i * n + i];
+            d[i] += col[i] * col[i];
+            for r in i + 1..n {
+                let mut s = 0.0;
+                for k in i..r {
+                    s -= self.l[r * n + k] * col[k];
+                }
+                col[r] = s / self.l[r * n + r];
+                d[i] += col[r] * col[r];
+            }
+        }
+        d
+    }
+
+    /// L z (a correlated draw from N(0, A) for z ~ N(0, I)).
+    pub fn mul_lower(&self, z: &[f64]) -> Vec<f64> {
+        let n = self.n;
+        (0..n)
+            .map(|i| (0..=i).map(|k| self.l[i * n + k] * z[k]).sum())
+            .collect()
+    }
+}

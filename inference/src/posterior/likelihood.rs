@@ -1,0 +1,234 @@
+//! The likelihood of a measured curve c_m given a predicted one c_p.
+//!
+//! Paper (section 8, eqs. 12-15): independent normals with a standard deviation that depends on
+//! the prediction,
+//!   sigma_c(c_p)^2 = (f_m c_p)^2 + (f_s c_p + a_s)^2 + (sigma_p c_p)^2,
+//! f_m = 3% (measurement), f_s = 1% and a_s = 1 pF (the field solver, eq. 7), sigma_p the
+//! surrogate's relative error (from the model file), and
+//!   ln L = sum_k [ -(c_m,k - c_p,k)^2 / (2 sigma_k^2) - ln sigma_k - ln sqrt(2 pi) ].
+//! sigma depends on the parameters, so the ln sigma term stays.
+//!
+//! Covariance variant: the measured covariance V_m (with its correlated calibration scale)
+//! replaces the diagonal 3% term,
+//!   Sigma(c_p) = V_m + diag((f_s c_p + a_s)^2 + (sigma_p c_p)^2),
+//!   ln L = -r^T Sigma^-1 r / 2 - ln det Sigma / 2 - N ln sqrt(2 pi),  r = c_m - c_p.
+
+use rand::Rng;
+use rand_distr::{Distribution, StandardNormal};
+use serde::{Deserialize, Serialize};
+
+use super::Cholesky;
+use crate::{CvData, Error, Result};
+
+const LN_SQRT_2PI: f64 = 0.918_938_533_204_672_8;
+
+/// Which noise model (a closed set).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum NoiseKind {
+    /// The paper's: independent, 3% of c_p for the measurement.
+    #[default]
+    Paper,
+    /// The measured covariance instead of the 3% term.
+    Covariance,
+}
+
+impl NoiseKind {
+    /// Parses `paper` or `covariance`.
+    pub fn parse(s: &str) -> Option<Self> {
+        match s {
+            "paper" => Some(NoiseKind::Paper),
+            "covariance" => Some(NoiseKind::Covariance),
+            _ => None,
+        }
+    }
+
+    /// The name.
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            NoiseKind::Paper => "paper",
+            NoiseKind::Covariance => "covariance",
+        }
+    }
+}
+
+/// The noise model's constants (defaults: the paper's, section 8).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NoiseSettings {
+    /// Which model.
+    pub kind: NoiseKind,
+    /// f_m: relative measurement uncertainty (paper eq. 14: 3%).
+    pub measurement_rel: f64,
+    /// f_s: relative field-solver uncertainty (paper eq. 7: 1%).
+    pub solver_rel: f64,
+    /// a_s: absolute field-solver uncertainty, pF (paper eq. 7: 1 pF).
+    pub solver_abs_pf: f64,
+}
+
+impl Default for NoiseSettings {
+    fn default() -> Self {
+        Self {
+            kind: NoiseKind::Paper,
+            measurement_rel: 0.03,
+            solver_rel: 0.01,
+            solver_abs_pf: 1.0,
+        }
+    }
+}
+
+/// The likelihood of one measured curve.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Likelihood {
+    /// Measured c12, pF.
+    pub c_m: Vec<f64>,
+    /// Constants.
+    pub noise: NoiseSettings,
+    /// The model's relative uncertainty sigma_p.
+    pub sigma_rel_model: f64,
+    /// V_m (row-major), for the covariance variant.
+    covariance: Option<Vec<f64>>,
+}
+
+impl Likelihood {
+    /// The likelihood of `data` under `noise`, with the model's sigma_p. The covariance variant
+    /// needs the data's covariance.
+    pub fn new(data: &CvData, noise: NoiseSettings, sigma_rel_model: f64) -> Result<Self> {
+        let covariance = match noise.kind {
+            NoiseKind::Paper => None,
+            NoiseKind::Covariance => {
+                let cov = data.covariance_pf2.as_ref().ok_or_else(|| {
+                    Error::invalid(
+                        &data.source,
+                        "covariance",
+                        "the covariance likelihood needs the curve's covariance file (<stem>.covariance.csv)",
+                    )
+                })?;
+                Some(cov.iter().flatten().copied().collect())
+            }
+        };
+        Ok(Self {
+            c_m: data.c12_pf.clone(),
+            noise,
+            sigma_rel_model,
+            covariance,
+        })
+    }
+
+    /// The number of points N.
+    pub fn len(&self) -> usize {
+        self.c_m.len()
+    }
+
+    /// Whether there are no points.
+    pub fn is_empty(&self) -> bool {
+        self.c_m.is_empty()
+    }
+
+    /// The model-side variance at c_p (pF^2): (f_s c + a_s)^2 + (sigma_p c)^2, plus (f_m c)^2
+    /// for the paper's model.
+    fn variance(&self, c: f64) -> f64 {
+        let n = &self.noise;
+        let s = n.solver_rel * c + n.solver_abs_pf;
+        let p = self.sigma_rel_model * c;
+        let m = match n.kind {
+            NoiseKind::Paper => n.measurement_rel * c,
+            NoiseKind::Covariance => 0.0,
+        };
+        s * s + p * p + m * m
+    }
+
+    /// d variance / dc.
+    fn d_variance(&self, c: f64) -> f64 {
+        let n = &self.noise;
+        let s = n.solver_rel * c + n.solver_abs_pf;
+        let mut d = 2.0 * s * n.solver_rel + 2.0 * self.sigma_rel_model.powi(2) * c;
+        if n.kind == NoiseKind::Paper {
+            d += 2.0 * n.measurement_rel.powi(2) * c;
+        }
+        d
+    }
+
+    /// The standard deviation of each point (pF) at c_p: sqrt of the diagonal of Sigma.
+    pub fn sigma(&self, c_p: &[f64]) -> Vec<f64> {
+        let n = self.len();
+        c_p.iter()
+            .enumerate()
+            .map(|(k, &c)| {
+                let v = self.covariance.as_ref().map_or(0.0, |m| m[k * n + k]);
+                (self.variance(c) + v).sqrt()
+            })
+            .collect()
+    }
+
+    /// ln L(c_p) (see the module docs); with `grad`, also d ln L / d c_p.
+    pub fn ln_likelihood(&self, c_p: &[f64], grad: Option<&mut [f64]>) -> f64 {
+        let n = self.len();
+        match &self.covariance {
+            None => {
+                let mut ll = 0.0;
+                let mut g = grad;
+                for k in 0..n {
+                    let var = self.variance(c_p[k]);
+                    let r = self.c_m[k] - c_p[k];
+                    ll -= 0.5 * r * r / var + 0.5 * var.ln() + LN_SQRT_2PI;
+                    if let Some(g) = g.as_deref_mut() {
+                        // d/dc of -r^2/(2v) - ln v / 2, with dr/dc = -1.
+                        g[k] = r / var + 0.5 * (r * r / var - 1.0) / var * self.d_variance(c_p[k]);
+                    }
+                }
+                ll
+            }
+            Some(vm) => {
+                let mut a = vm.clone();
+                for k in 0..n {
+                    a[k * n + k] += self.variance(c_p[k]);
+                }
+                let Some(chol) = Cholesky::new(&a, n) else {
+                    return f64::NEG_INFINITY;
+                };
+                let r: Vec<f64> = (0..n).map(|k| self.c_m[k] - c_p[k]).collect();
+                let alpha = chol.solve(&r);
+                let quad: f64 = r.iter().zip(&alpha).map(|(x, y)| x * y).sum();
+                if let Some(g) = grad {
+                    let inv_diag = chol.inverse_diagonal();
+                    for k in 0..n {
+                        g[k] = alpha[k]
+                            + 0.5 * (alpha[k] * alpha[k] - inv_diag[k]) * self.d_variance(c_p[k]);
+                    }
+                }
+                -0.5 * quad - 0.5 * chol.ln_det() - n as f64 * LN_SQRT_2PI
+            }
+        }
+    }
+
+    /// A simulated measurement: c_p plus noise from this noise model (N(0, Sigma(c_p))).
+    pub fn simulate<R: Rng + ?Sized>(&self, c_p: &[f64], rng: &mut R) -> Vec<f64> {
+        let n = self.len();
+        let z: Vec<f64> = (0..n).map(|_| StandardNormal.sample(rng)).collect();
+        match &self.covariance {
+            None => c_p
+                .iter()
+                .zip(&z)
+                .map(|(&c, &e)| c + self.variance(c).sqrt() * e)
+                .collect(),
+            Some(vm) => {
+                let mut a = vm.clone();
+                for k in 0..n {
+                    a[k * n + k] += self.variance(c_p[k]);
+                }
+                let chol = Cholesky::new(&a, n).expect("a covariance plus a positive diagonal");
+                let e = chol.mul_lower(&z);
+                c_p.iter().zip(e).map(|(&c, e)| c + e).collect()
+            }
+        }
+    }
+
+    /// A copy with other measured values (simulated data for coverage studies).
+    pub fn with_data(&self, c_m: Vec<f64>) -> Self {
+        Self {
+            c_m,
+            ..self.clone()
+        }
+    }
+}

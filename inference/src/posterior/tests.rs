@@ -1,0 +1,147 @@
+//! Likelihood: closed forms, gradients against finite differences, the two noise models against
+//! each other; the Cholesky factorisation against a direct product.
+
+use std::path::PathBuf;
+
+use super::*;
+use crate::CvData;
+
+fn data(cov: Option<Vec<Vec<f64>>>) -> CvData {
+    let voltage_v: Vec<f64> = (0..6).map(|k| 100.0 + 400.0 * k as f64).collect();
+    let c12_pf = vec![300.0, 150.0, 90.0, 60.0, 45.0, 40.0];
+    CvData {
+        sigma_pf: c12_pf.iter().map(|c| 0.03 * c).collect(),
+        voltage_v,
+        c12_pf,
+        covariance_pf2: cov,
+        source: PathBuf::from("test.csv"),
+    }
+}
+
+#[test]
+fn paper_likelihood_matches_its_formula() {
+    let l = Likelihood::new(&data(None), NoiseSettings::default(), 0.015).unwrap();
+    let c_p: Vec<f64> = vec![310.0, 148.0, 91.0, 59.0, 44.0, 41.0];
+    let mut want = 0.0;
+    for (&cp, cm) in c_p.iter().zip(&l.c_m) {
+        let cp: f64 = cp;
+        let s2: f64 = (0.03 * cp).powi(2) + (0.01 * cp + 1.0).powi(2) + (0.015 * cp).powi(2);
+        want += -0.5 * (cm - cp).powi(2) / s2 - 0.5 * (2.0 * std::f64::consts::PI * s2).ln();
+    }
+    assert!((l.ln_likelihood(&c_p, None) - want).abs() < 1e-10);
+}
+
+fn gradient_check(l: &Likelihood) {
+    let c_p = vec![310.0, 148.0, 91.0, 59.0, 44.0, 41.0];
+    let mut g = vec![0.0; 6];
+    l.ln_likelihood(&c_p, Some(&mut g));
+    for k in 0..6 {
+        let h = 1e-4 * c_p[k];
+        let mut a = c_p.clone();
+        let mut b = c_p.clone();
+        a[k] += h;
+        b[k] -= h;
+        let fd = (l.ln_likelihood(&a, None) - l.ln_likelihood(&b, None)) / (2.0 * h);
+        assert!(
+            (fd - g[k]).abs() < 1e-6 * (1.0 + g[k].abs()),
+            "k {k}: {fd} vs {}",
+            g[k]
+        );
+    }
+}
+
+fn covariance() -> Vec<Vec<f64>> {
+    // A correlated calibration scale (3%, fully correlated) plus 1% independent.
+    let c = data(None).c12_pf;
+    (0..6)
+        .map(|i| {
+            (0..6)
+                .map(|j| {
+                    0.03 * c[i] * 0.03 * c[j] + if i == j { (0.01 * c[i]).powi(2) } else { 0.0 }
+                })
+                .collect()
+        })
+        .collect()
+}
+
+#[test]
+fn gradients_match_finite_differences() {
+    gradient_check(&Likelihood::new(&data(None), NoiseSettings::default(), 0.015).unwrap());
+    let noise = NoiseSettings {
+        kind: NoiseKind::Covariance,
+        ..NoiseSettings::default()
+    };
+    gradient_check(&Likelihood::new(&data(Some(covariance())), noise, 0.015).unwrap());
+}
+
+#[test]
+fn covariance_model_with_diagonal_covariance_equals_independent_normals() {
+    // V_m = 0: Sigma is the model-side diagonal, as in the paper's form with f_m = 0.
+    let zero = vec![vec![0.0; 6]; 6];
+    let cov = NoiseSettings {
+        kind: NoiseKind::Covariance,
+        ..NoiseSettings::default()
+    };
+    let paper = NoiseSettings {
+        measurement_rel: 0.0,
+        ..NoiseSettings::default()
+    };
+    let a = Likelihood::new(&data(Some(zero)), cov, 0.01).unwrap();
+    let b = Likelihood::new(&data(None), paper, 0.01).unwrap();
+    let c_p = vec![305.0, 151.0, 89.0, 61.0, 45.5, 39.0];
+    assert!((a.ln_likelihood(&c_p, None) - b.ln_likelihood(&c_p, None)).abs() < 1e-9);
+}
+
+#[test]
+fn covariance_model_needs_a_covariance() {
+    let noise = NoiseSettings {
+        kind: NoiseKind::Covariance,
+        ..NoiseSettings::default()
+    };
+    let e = Likelihood::new(&data(None), noise, 0.01)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("test.csv") && e.contains("covariance"), "{e}");
+}
+
+#[test]
+fn cholesky_solves_and_inverts() {
+    let a = [4.0, 2.0, 0.4, 2.0, 5.0, 1.0, 0.4, 1.0, 3.0];
+    let c = Cholesky::new(&a, 3).unwrap();
+    let x = c.solve(&[1.0, 2.0, 3.0]);
+    for i in 0..3 {
+        let ax: f64 = (0..3).map(|j| a[i * 3 + j] * x[j]).sum();
+        assert!((ax - [1.0, 2.0, 3.0][i]).abs() < 1e-12);
+    }
+    // Diagonal of the inverse: column i of A^-1 from solve(e_i).
+    let d = c.inverse_diagonal();
+    for i in 0..3 {
+        let mut e = [0.0; 3];
+        e[i] = 1.0;
+        assert!((c.solve(&e)[i] - d[i]).abs() < 1e-12);
+    }
+    // det by cofactors.
+    let det = 4.0 * (15.0 - 1.0) - 2.0 * (6.0 - 0.4) + 0.4 * (2.0 - 2.0);
+    assert!((c.ln_det() - f64::ln(det)).abs() < 1e-12);
+    assert!(Cholesky::new(&[1.0, 2.0, 2.0, 1.0], 2).is_none());
+}
+
+#[test]
+fn simulated_data_have_the_model_spread() {
+    use rand::SeedableRng;
+    let l = Likelihood::new(&data(None), NoiseSettings::default(), 0.0).unwrap();
+    let c_p = l.c_m.clone();
+    let s = l.sigma(&c_p);
+    let mut rng = rand::rngs::StdRng::seed_from_u64(3);
+    let n = 20000;
+    let mut sum2 = [0.0; 6];
+    for _ in 0..n {
+        let d = l.simulate(&c_p, &mut rng);
+        for k in 0..6 {
+            sum2[k] += ((d[k] - c_p[k]) / s[k]).powi(2) / n as f64;
+        }
+    }
+    for v in sum2 {
+        assert!((v - 1.0).abs() < 0.05, "{v}");
+    }
+}

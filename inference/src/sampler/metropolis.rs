@@ -1,0 +1,238 @@
+//! Adaptive Metropolis in the way of BAT.jl's default sampler (Haario et al. 2001, as tuned by
+//! BAT.jl's `AdaptiveMHTuning`): multivariate-normal random-walk proposals z' = z + sqrt(c) L e,
+//! e ~ N(0, I), L L^T = Sigma. In tuning cycles of `cycle_draws` steps per chain,
+//!   Sigma <- (1 - a) Sigma + a S,  a = (n + 1)^-1/2 for cycle n (S the cycle's pooled draw
+//!   covariance), and per chain c <- c * 1.25 when the cycle's acceptance is above the window,
+//!   c / 1.25 below it,
+//! until every chain's acceptance lies in the window and the rank-normalised R-hat of the cycle's
+//! draws is below `burnin_rhat` (BAT.jl: 1.1). The starting scale is Gelman et al.'s
+//! c = 2.38^2 / d.
+
+use std::time::Instant;
+
+use rand::RngExt;
+use rand::SeedableRng;
+use rand::rngs::StdRng;
+use rand_distr::{Distribution, StandardNormal};
+use rayon::prelude::*;
+
+use super::LogDensity;
+use super::run::{Draw, Engine, Phase, SampleSettings, Status, Tuned};
+use crate::posterior::Cholesky;
+use crate::{Error, Result, rank_rhat};
+
+/// Factor of the scale update per cycle.
+const SCALE_STEP: f64 = 1.25;
+
+struct Chain<'a> {
+    target: &'a dyn LogDensity,
+    z: Vec<f64>,
+    ln_p: f64,
+    /// Lower Cholesky factor of Sigma (row-major).
+    l: Vec<f64>,
+    /// c.
+    scale: f64,
+    rng: StdRng,
+    evaluations: u64,
+}
+
+impl Chain<'_> {
+    fn step(&mut self) -> Draw {
+        let d = self.z.len();
+        let e: Vec<f64> = (0..d)
+            .map(|_| StandardNormal.sample(&mut self.rng))
+            .collect();
+        let s = self.scale.sqrt();
+        let proposal: Vec<f64> = (0..d)
+            .map(|i| self.z[i] + s * (0..=i).map(|k| self.l[i * d + k] * e[k]).sum::<f64>())
+            .collect();
+        self.evaluations += 1;
+        let ln_q = self
+            .target
+            .ln_density(&proposal, None)
+            .unwrap_or(f64::NEG_INFINITY);
+        let u: f64 = self.rng.random();
+        let accepted = ln_q.is_finite() && u.ln() < ln_q - self.ln_p;
+        if accepted {
+            self.z = proposal;
+            self.ln_p = ln_q;
+        }
+        Draw {
+            z: self.z.clone(),
+            ln_density: self.ln_p,
+            accept: f64::from(u8::from(accepted)),
+            divergent: false,
+        }
+    }
+}
+
+impl Engine for Chain<'_> {
+    fn draw(&mut self) -> Result<Draw> {
+        Ok(self.step())
+    }
+
+    fn evaluations(&self) -> u64 {
+        self.evaluations
+    }
+
+    fn scale(&self) -> f64 {
+        self.scale
+    }
+}
+
+/// A seeded generator per chain (and per purpose).
+pub(super) fn chain_rng(seed: u64, chain: usize) -> StdRng {
+    StdRng::seed_from_u64(seed ^ (chain as u64).wrapping_add(1).wrapping_mul(0x9E37_79B9_7F4A_7C15))
+}
+
+/// A dispersed start with a finite density.
+pub(super) fn start_point(target: &dyn LogDensity, rng: &mut StdRng) -> Result<(Vec<f64>, f64)> {
+    for _ in 0..1000 {
+        let z = target.initial(rng);
+        if let Ok(l) = target.ln_density(&z, None)
+            && l.is_finite()
+        {
+            return Ok((z, l));
+        }
+    }
+    Err(Error::Numerical {
+        what: "starting points".into(),
+        message: "1000 draws from the prior all have zero posterior density (outside the model's domain, or the model fails there)".into(),
+    })
+}
+
+/// Burn-in and tuning.
+pub(super) fn tune<'a>(
+    target: &'a dyn LogDensity,
+    s: &SampleSettings,
+    start: Instant,
+    progress: &(dyn Fn(&Status) + Sync),
+) -> Result<Tuned<'a>> {
+    let d = target.dim();
+    // Sigma_0: the prior's spread in z, scaled down by 10 (a first step well inside it).
+    let mut rng = chain_rng(s.seed, usize::MAX);
+    let probe: Vec<Vec<f64>> = (0..200).map(|_| target.initial(&mut rng)).collect();
+    let mut sigma = vec![0.0; d * d];
+    for j in 0..d {
+        let m = probe.iter().map(|p| p[j]).sum::<f64>() / probe.len() as f64;
+        let v = probe.iter().map(|p| (p[j] - m).powi(2)).sum::<f64>() / probe.len() as f64;
+        sigma[j * d + j] = (0.01 * v).max(1e-8);
+    }
+    let l0 = factor(&sigma, d);
+    let mut chains: Vec<Chain<'a>> = (0..s.chains)
+        .map(|c| {
+            let mut rng = chain_rng(s.seed, c);
+            let (z, ln_p) = start_point(target, &mut rng)?;
+            Ok(Chain {
+                target,
+                z,
+                ln_p,
+                l: l0.clone(),
+                scale: 2.38 * 2.38 / d as f64,
+                rng,
+                evaluations: 1,
+            })
+        })
+        .collect::<Result<_>>()?;
+    let mut tuned = false;
+    let mut cycle = 0;
+    while cycle < s.max_cycles {
+        cycle += 1;
+        let runs: Vec<(Vec<Vec<f64>>, f64)> = chains
+            .par_iter_mut()
+            .map(|ch| {
+                let mut zs = Vec::with_capacity(s.cycle_draws);
+                let mut acc = 0.0;
+                for _ in 0..s.cycle_draws {
+                    let dr = ch.step();
+                    acc += dr.accept;
+                    zs.push(dr.z);
+                }
+                (zs, acc / s.cycle_draws as f64)
+            })
+            .collect();
+        // Pooled covariance of the cycle's draws.
+        let all: Vec<&Vec<f64>> = runs.iter().flat_map(|r| r.0.iter()).collect();
+        let n = all.len() as f64;
+        let mean: Vec<f64> = (0..d)
+            .map(|j| all.iter().map(|z| z[j]).sum::<f64>() / n)
+            .collect();
+        let mut cov = vec![0.0; d * d];
+        for z in &all {
+            for i in 0..d {
+                for j in 0..=i {
+                    cov[i * d + j] += (z[i] - mean[i]) * (z[j] - mean[j]) / (n - 1.0);
+                }
+            }
+        }
+        let a = 1.0 / ((cycle + 1) as f64).sqrt();
+        for i in 0..d {
+            for j in 0..=i {
+                let v = (1.0 - a) * sigma[i * d + j] + a * cov[i * d + j];
+                sigma[i * d + j] = v;
+                sigma[j * d + i] = v;
+            }
+            sigma[i * d + i] = sigma[i * d + i].max(1e-12);
+        }
+        let l = factor(&sigma, d);
+        let mut in_window = true;
+        let mut mean_acc = 0.0;
+        for (ch, run) in chains.iter_mut().zip(&runs) {
+            let acc = run.1;
+            mean_acc += acc / s.chains as f64;
+            if acc > s.acceptance[1] {
+                ch.scale *= SCALE_STEP;
+                in_window = false;
+            } else if acc < s.acceptance[0] {
+                ch.scale /= SCALE_STEP;
+                in_window = false;
+            }
+            ch.l = l.clone();
+        }
+        let rhat = (0..d)
+            .map(|j| {
+                let per: Vec<Vec<f64>> = runs
+                    .iter()
+                    .map(|r| r.0.iter().map(|z| z[j]).collect())
+                    .collect();
+                rank_rhat(&per)
+            })
+            .fold(0.0, f64::max);
+        progress(&Status {
+            phase: Phase::Tuning,
+            cycle,
+            draws: 0,
+            rhat_max: rhat,
+            ess_min: f64::NAN,
+            acceptance: mean_acc,
+            seconds: start.elapsed().as_secs_f64(),
+        });
+        if in_window && rhat <= s.burnin_rhat {
+            tuned = true;
+            break;
+        }
+    }
+    Ok(Tuned {
+        engines: chains
+            .into_iter()
+            .map(|c| Box::new(c) as Box<dyn Engine + 'a>)
+            .collect(),
+        tuned,
+        cycles: cycle,
+    })
+}
+
+/// Cholesky factor of a covariance, with growing diagonal jitter if it is not positive definite.
+fn factor(sigma: &[f64], d: usize) -> Vec<f64> {
+    let mut a = sigma.to_vec();
+    let mut jitter = 1e-12;
+    loop {
+        if let Some(c) = Cholesky::new(&a, d) {
+            return c.lower();
+        }
+        for i in 0..d {
+            a[i * d + i] += jitter * (1.0 + sigma[i * d + i]);
+        }
+        jitter *= 10.0;
+    }
+}

@@ -1,0 +1,87 @@
+//! Every sampler recovers a known correlated Gaussian (mean and covariance).
+
+use super::*;
+
+fn target() -> GaussianTarget {
+    // 3-d, correlations 0.8 and -0.5, scales 1, 2 and 0.1.
+    let s = [1.0, 2.0, 0.1];
+    let r = [[1.0, 0.8, 0.0], [0.8, 1.0, -0.5], [0.0, -0.5, 1.0]];
+    let mut cov = vec![0.0; 9];
+    for i in 0..3 {
+        for j in 0..3 {
+            cov[i * 3 + j] = r[i][j] * s[i] * s[j];
+        }
+    }
+    GaussianTarget::new(vec![1.0, -2.0, 0.5], cov).expect("positive definite")
+}
+
+fn check(kind: SamplerKind) {
+    let t = target();
+    let mut s = SampleSettings::for_sampler(kind);
+    s.seed = 7;
+    s.ess_min = 2000.0;
+    let samples = sample(&t, &s, &|_| {}).expect("sampling");
+    assert!(samples.converged(), "{kind:?}: {:?}", samples.diagnostics);
+    let all = samples.all();
+    let n = all.len() as f64;
+    let mean: Vec<f64> = (0..3)
+        .map(|j| all.iter().map(|x| x[j]).sum::<f64>() / n)
+        .collect();
+    for j in 0..3 {
+        let sd = t.cov[j * 3 + j].sqrt();
+        // Monte Carlo error of the mean: sd / sqrt(ESS) with ESS >= 2000; allow 4 of them.
+        let tol = 4.0 * sd / samples.diagnostics[j].ess_bulk.sqrt();
+        assert!(
+            (mean[j] - t.mean[j]).abs() < tol,
+            "{kind:?} mean[{j}] {} vs {}",
+            mean[j],
+            t.mean[j]
+        );
+        for k in 0..3 {
+            let c = all
+                .iter()
+                .map(|x| (x[j] - mean[j]) * (x[k] - mean[k]))
+                .sum::<f64>()
+                / (n - 1.0);
+            let sk = t.cov[k * 3 + k].sqrt();
+            // Covariances to 10% of sd_j sd_k (the ESS-limited error is ~2-3%).
+            assert!(
+                (c - t.cov[j * 3 + k]).abs() < 0.1 * sd * sk,
+                "{kind:?} cov[{j}][{k}] {c} vs {}",
+                t.cov[j * 3 + k]
+            );
+        }
+    }
+    // Reproducible: the same seed gives the same draws.
+    let again = sample(&t, &s, &|_| {}).expect("sampling");
+    assert_eq!(again.chains[0].theta[..50], samples.chains[0].theta[..50]);
+}
+
+#[test]
+fn metropolis_recovers_a_gaussian() {
+    check(SamplerKind::Metropolis);
+    // Tuning reached the acceptance window.
+    let mut s = SampleSettings::for_sampler(SamplerKind::Metropolis);
+    s.ess_min = 400.0;
+    let r = sample(&target(), &s, &|_| {}).expect("sampling");
+    assert!(r.tuned);
+    for c in &r.chains {
+        assert!(
+            c.acceptance > 0.1 && c.acceptance < 0.45,
+            "{}",
+            c.acceptance
+        );
+    }
+}
+
+#[test]
+fn nuts_recovers_a_gaussian() {
+    check(SamplerKind::Nuts);
+}
+
+#[test]
+fn settings_are_checked() {
+    let mut s = SampleSettings::default();
+    s.chains = 1;
+    assert!(s.validate().is_err());
+}

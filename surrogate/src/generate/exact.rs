@@ -1,0 +1,188 @@
+//! The exact solver at points of a parameter space: the space's values set on the detector
+//! (its `[parameters]` and the rz model's y knots), then a field solve per bias. Training rows
+//! come from here, and so does the exact model inference checks the surrogate against.
+
+use std::path::{Path, PathBuf};
+
+use hpge_solver::{Detector, FieldSettings, ImpuritySpec, Parameters, cv_curve, solve_point};
+
+use super::setup::fnv1a;
+use crate::space::{ParameterSpace, Target};
+use crate::{Error, Result};
+
+/// A detector whose parameters and impurity model are set from points of a parameter space.
+#[derive(Debug, Clone)]
+pub struct ExactSolver {
+    /// The space.
+    pub space: ParameterSpace,
+    /// The detector file.
+    pub detector_file: PathBuf,
+    detector_text: String,
+    detector_hash: String,
+    /// Solver settings.
+    pub settings: FieldSettings,
+    targets: Vec<Target>,
+}
+
+impl ExactSolver {
+    /// Checks the space against the detector (every `parameter:` target declared, the y targets
+    /// knots 0, 1, ... of its rz model, one bias dimension) and builds the detector once at the
+    /// centre of the space.
+    pub fn new(
+        space: ParameterSpace,
+        detector_file: &Path,
+        settings: FieldSettings,
+    ) -> Result<Self> {
+        let detector_text = std::fs::read_to_string(detector_file).map_err(|e| Error::Io {
+            file: detector_file.into(),
+            action: "cannot read the detector",
+            source: e,
+        })?;
+        // The detector must load, and the y targets must fit its rz knots.
+        let det = Detector::from_toml_str(&detector_text, detector_file, &Parameters::new())?;
+        let targets = space.targets();
+        let ys: Vec<&Target> = targets
+            .iter()
+            .filter(|t| matches!(t, Target::YBot(_) | Target::YTop(_)))
+            .collect();
+        for face in [0, 1] {
+            let mut ks: Vec<usize> = targets
+                .iter()
+                .filter_map(|t| match (t, face) {
+                    (Target::YBot(k), 0) | (Target::YTop(k), 1) => Some(*k),
+                    _ => None,
+                })
+                .collect();
+            ks.sort_unstable();
+            if !ys.is_empty() && ks != (0..ks.len().max(1)).collect::<Vec<_>>() {
+                return Err(Error::Invalid {
+                    file: space.file.clone(),
+                    key: "dimensions".into(),
+                    message: format!(
+                        "the {} targets must be knots 0, 1, ... without gaps, got {ks:?}",
+                        if face == 0 { "y_bot" } else { "y_top" },
+                    ),
+                });
+            }
+        }
+        for t in &targets {
+            if let Target::Parameter(p) = t
+                && det.parameters.get(p).is_none()
+            {
+                return Err(Error::Invalid {
+                    file: space.file.clone(),
+                    key: "dimensions".into(),
+                    message: format!(
+                        "target parameter:{p}: {} declares no parameter `{p}`",
+                        detector_file.display()
+                    ),
+                });
+            }
+        }
+        if !targets.contains(&Target::Bias) {
+            return Err(Error::Invalid {
+                file: space.file.clone(),
+                key: "dimensions".into(),
+                message: "one dimension must have target = \"bias\"".into(),
+            });
+        }
+        let mut det_bytes = detector_text.as_bytes().to_vec();
+        if let Ok(imp) = std::fs::read(det.semiconductor.impurity_file()) {
+            det_bytes.extend_from_slice(&imp);
+        }
+        let exact = Self {
+            space,
+            detector_file: detector_file.into(),
+            detector_text,
+            detector_hash: format!("{:016x}", fnv1a(&det_bytes)),
+            settings,
+            targets,
+        };
+        // A dry run at the centre of the space: the detector and impurity model build.
+        let centre = exact.space.from_unit(&vec![0.5; exact.space.dim()]);
+        exact.configure(&centre)?;
+        Ok(exact)
+    }
+
+    /// FNV-1a hash (hex) of the detector file's text followed by its impurity file's bytes (the
+    /// `detector_hash` of a generation run's fingerprint).
+    pub fn detector_hash(&self) -> String {
+        self.detector_hash.clone()
+    }
+
+    /// c12 (pF) at one point `x` of the space (physical values in the space's column order,
+    /// the bias included).
+    pub fn solve(&self, x: &[f64]) -> Result<f64> {
+        let (det, bias) = self.configure(x)?;
+        Ok(solve_point(&det, bias, &self.settings, None)?.c12_pf)
+    }
+
+    /// c12 (pF) along a C-V curve: `params` are the space's non-bias values in column order (a
+    /// surrogate's network order), `volts` the biases (V, increasing). Each point is seeded from
+    /// its neighbour ([`cv_curve`]).
+    pub fn curve(&self, params: &[f64], volts: &[f64]) -> Result<Vec<f64>> {
+        let nb = self.targets.len() - 1;
+        if params.len() != nb {
+            return Err(Error::Argument {
+                name: "params".into(),
+                message: format!(
+                    "{} values given, the space has {nb} besides the bias",
+                    params.len()
+                ),
+            });
+        }
+        let mut x = Vec::with_capacity(nb + 1);
+        let mut it = params.iter();
+        for t in &self.targets {
+            x.push(if *t == Target::Bias {
+                volts.first().copied().unwrap_or(1.0)
+            } else {
+                *it.next().unwrap_or(&0.0)
+            });
+        }
+        let (det, _) = self.configure(&x)?;
+        let curve = cv_curve(&det, volts, &self.settings, |_, _| {})?;
+        if curve.points.len() != volts.len() {
+            return Err(Error::Argument {
+                name: "volts".into(),
+                message: "the voltages must be positive, increasing and distinct".into(),
+            });
+        }
+        Ok(curve.points.iter().map(|p| p.c12_pf).collect())
+    }
+
+    /// The detector with the sample's parameters and impurity model, and the bias (V).
+    fn configure(&self, x: &[f64]) -> Result<(Detector, f64)> {
+        let mut params = Parameters::new();
+        let mut bias = 0.0;
+        let (mut yb, mut yt) = (Vec::new(), Vec::new());
+        for (t, &v) in self.targets.iter().zip(x) {
+            match t {
+                Target::Bias => bias = v,
+                Target::Parameter(p) => params.set(p.clone(), v),
+                Target::YBot(k) => yb.push((*k, v)),
+                Target::YTop(k) => yt.push((*k, v)),
+            }
+        }
+        let mut det = Detector::from_toml_str(&self.detector_text, &self.detector_file, &params)?;
+        if !yb.is_empty() {
+            yb.sort_by_key(|p| p.0);
+            yt.sort_by_key(|p| p.0);
+            let list = |v: &[(usize, f64)]| {
+                v.iter()
+                    .map(|p| format!("{:e}", p.1))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            };
+            let text = format!(
+                "model = \"rz\"\ny_bot = [{}]\ny_top = [{}]\n",
+                list(&yb),
+                list(&yt)
+            );
+            let name = Path::new("(generated sample)");
+            let spec = ImpuritySpec::from_toml_str(&text, name)?;
+            det.set_impurity(&spec, name)?;
+        }
+        Ok((det, bias))
+    }
+}
