@@ -15,6 +15,7 @@ fi
 cargo build --release -q
 B=target/release/hpge-cv
 $B train --data data/training/train.csv --test data/training/test.csv --space spaces/super-siegfried-rz.toml \
-  --recipe "$RECIPE" --seed "$SEED" --out "$NAME.safetensors" --plot "models/figures/$RECIPE"
+  --detector detectors/super-siegfried-k1.toml --recipe "$RECIPE" --seed "$SEED" --out "$NAME.safetensors" \
+  --plot "models/figures/$RECIPE"
 $B evaluate --model "$NAME.safetensors" --data data/training/heldout.csv --json > "$NAME.heldout.json"
 $B evaluate --model "$NAME.safetensors" --data data/training/heldout.csv --plot "models/figures/$RECIPE"

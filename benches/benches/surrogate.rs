@@ -42,6 +42,7 @@ fn model(recipe: &str) -> Surrogate {
         train_seconds: 0.0,
         threads: 1,
         test_figures: Figures::of(&[1.0], &[1.0]),
+        detector: None,
         sigma_p: 0.01,
     };
     Surrogate::new(info, Predictor::Networks(nets)).expect("valid model")

@@ -8,6 +8,7 @@
 
 mod diagnostics;
 mod error;
+mod fit;
 mod measurement;
 mod model;
 mod posterior;
@@ -19,6 +20,10 @@ pub use diagnostics::{
     Diagnostics, ess, ess_bulk, ess_tail, fold, rank_normalise, rank_rhat, split_chains, split_rhat,
 };
 pub use error::{Error, Result};
+pub use fit::{
+    ExactCheck, Fit, FitSettings, FitSummary, LEVELS, ModeSummary, ParameterShift,
+    ParameterSummary, Predictive, exact_check, fit, nelder_mead, predictive,
+};
 pub use measurement::{
     Circuit, CvData, Data, MeasureSettings, Measurement, PC_PER_KEV, PeakFit, Problem, PulseSet,
     RawProblem, RawRun, Sidecar, SynthSettings, SynthVoltage, TailFailure, TailFit, TailSettings,
@@ -32,4 +37,8 @@ pub use prior::{ParameterSpec, Prior, PriorDistribution, PriorParameter, PriorSp
 pub use sampler::{
     ChainDraws, GaussianTarget, LogDensity, Phase, SampleSettings, SamplerKind, Samples, Status,
     StopReason, sample,
+};
+pub use summary::{
+    Component, Mixture, Psis, find_modes, fit_mixture, gpd_fit, interval_contains, marginal_mode,
+    psis, smallest_intervals,
 };

@@ -21,6 +21,24 @@ pub struct TrainOptions<'a> {
     pub seed: u64,
     pub plot: Option<&'a Path>,
     pub quiet: bool,
+    pub detector: Option<&'a Path>,
+}
+
+/// The detector record of a model: the file and the hash a generation run's fingerprint gives
+/// it (the detector is checked against the space on the way).
+pub fn detector_info(
+    space: &hpge_surrogate::ParameterSpace,
+    detector: &Path,
+) -> Result<hpge_surrogate::DetectorInfo> {
+    let exact = hpge_surrogate::ExactSolver::new(
+        space.clone(),
+        detector,
+        hpge_solver::FieldSettings::default(),
+    )?;
+    Ok(hpge_surrogate::DetectorInfo {
+        file: detector.display().to_string(),
+        hash: exact.detector_hash(),
+    })
 }
 
 /// The learning-curve CSV beside a model: models/NAME.safetensors -> models/NAME.curves.csv.
@@ -189,6 +207,10 @@ pub fn train(o: &TrainOptions) -> Result<()> {
         train_seconds: 0.0,
         threads: std::thread::available_parallelism().map_or(1, |n| n.get()),
         test_figures: Figures::of(&[], &[]),
+        detector: match o.detector {
+            Some(d) => Some(detector_info(&space, d)?),
+            None => None,
+        },
         sigma_p: f64::NAN,
     };
     let (predictor, curves, seconds) = match &recipe {

@@ -21,10 +21,11 @@ pub use generate::{
     format_row, merge, read_rows, run,
 };
 pub use model::{
-    Architecture, Cycle, DataInfo, DataSet, Dense, EpochRecord, FORMAT, FORMAT_VERSION, Figures,
-    Loss, Member, ModelInfo, Network, OutputTransform, Polynomial, Predictor, RECIPES, Recipe,
-    Surrogate, Trained, U_EDGE, Voltages, candle_outputs, gaussian_fit, initial_network, monomials,
-    network_order, output_transform, physical_to_z, quantile, train, train_resuming, unit_to_z,
+    Architecture, Cycle, DataInfo, DataSet, Dense, DetectorInfo, EpochRecord, FORMAT,
+    FORMAT_VERSION, Figures, Loss, Member, ModelInfo, Network, OutputTransform, Polynomial,
+    Predictor, RECIPES, Recipe, Surrogate, Trained, U_EDGE, Voltages, candle_outputs, gaussian_fit,
+    initial_network, monomials, network_order, output_transform, physical_to_z, quantile, train,
+    train_resuming, unit_to_z,
 };
 pub use sequence::{Sequence, SequenceKind, phi_d};
 pub use space::{Dimension, Distribution, ParameterSpace, Target, normal_cdf, normal_quantile};

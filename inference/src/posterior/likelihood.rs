@@ -202,6 +202,47 @@ impl Likelihood {
         }
     }
 
+    /// chi^2 = r^T Sigma(c_p)^-1 r with r = c_m - c_p (the sum of squared pulls for the paper's
+    /// independent model).
+    pub fn chi2(&self, c_p: &[f64]) -> f64 {
+        let n = self.len();
+        match &self.covariance {
+            None => c_p
+                .iter()
+                .zip(&self.c_m)
+                .map(|(&c, &m)| (m - c).powi(2) / self.variance(c))
+                .sum(),
+            Some(vm) => {
+                let mut a = vm.clone();
+                for k in 0..n {
+                    a[k * n + k] += self.variance(c_p[k]);
+                }
+                let Some(chol) = Cholesky::new(&a, n) else {
+                    return f64::INFINITY;
+                };
+                let r: Vec<f64> = (0..n).map(|k| self.c_m[k] - c_p[k]).collect();
+                let alpha = chol.solve(&r);
+                r.iter().zip(&alpha).map(|(x, y)| x * y).sum()
+            }
+        }
+    }
+
+    /// Pulls (c_p - c_m) / sigma per point, sigma the square root of Sigma's diagonal.
+    pub fn pulls(&self, c_p: &[f64]) -> Vec<f64> {
+        let s = self.sigma(c_p);
+        (0..self.len())
+            .map(|k| (c_p[k] - self.c_m[k]) / s[k])
+            .collect()
+    }
+
+    /// A copy for another model's relative uncertainty (the exact solver: 0).
+    pub fn with_sigma_rel(&self, sigma_rel_model: f64) -> Self {
+        Self {
+            sigma_rel_model,
+            ..self.clone()
+        }
+    }
+
     /// A simulated measurement: c_p plus noise from this noise model (N(0, Sigma(c_p))).
     pub fn simulate<R: Rng + ?Sized>(&self, c_p: &[f64], rng: &mut R) -> Vec<f64> {
         let n = self.len();

@@ -82,7 +82,11 @@ impl Engine for Chain<'_> {
 
 /// A seeded generator per chain (and per purpose).
 pub(super) fn chain_rng(seed: u64, chain: usize) -> StdRng {
-    StdRng::seed_from_u64(seed ^ (chain as u64).wrapping_add(1).wrapping_mul(0x9E37_79B9_7F4A_7C15))
+    StdRng::seed_from_u64(
+        seed ^ (chain as u64)
+            .wrapping_add(1)
+            .wrapping_mul(0x9E37_79B9_7F4A_7C15),
+    )
 }
 
 /// A dispersed start with a finite density.

@@ -117,10 +117,9 @@ impl ExactSolver {
         Ok(solve_point(&det, bias, &self.settings, None)?.c12_pf)
     }
 
-    /// c12 (pF) along a C-V curve: `params` are the space's non-bias values in column order (a
-    /// surrogate's network order), `volts` the biases (V, increasing). Each point is seeded from
-    /// its neighbour ([`cv_curve`]).
-    pub fn curve(&self, params: &[f64], volts: &[f64]) -> Result<Vec<f64>> {
+    /// The detector with the space's non-bias values `params` (column order, a surrogate's
+    /// network order) set: its parameters and its rz model's y knots.
+    pub fn detector(&self, params: &[f64]) -> Result<Detector> {
         let nb = self.targets.len() - 1;
         if params.len() != nb {
             return Err(Error::Argument {
@@ -134,13 +133,18 @@ impl ExactSolver {
         let mut x = Vec::with_capacity(nb + 1);
         let mut it = params.iter();
         for t in &self.targets {
-            x.push(if *t == Target::Bias {
-                volts.first().copied().unwrap_or(1.0)
-            } else {
-                *it.next().unwrap_or(&0.0)
+            x.push(match t {
+                Target::Bias => 1.0,
+                _ => *it.next().unwrap_or(&0.0),
             });
         }
-        let (det, _) = self.configure(&x)?;
+        Ok(self.configure(&x)?.0)
+    }
+
+    /// c12 (pF) along a C-V curve: `params` as for [`ExactSolver::detector`], `volts` the biases
+    /// (V, increasing). Each point is seeded from its neighbour ([`cv_curve`]).
+    pub fn curve(&self, params: &[f64], volts: &[f64]) -> Result<Vec<f64>> {
+        let det = self.detector(params)?;
         let curve = cv_curve(&det, volts, &self.settings, |_, _| {})?;
         if curve.points.len() != volts.len() {
             return Err(Error::Argument {

@@ -20,7 +20,9 @@ pub use metrics::{Figures, gaussian_fit, quantile};
 pub use network::{Dense, Network};
 pub use polynomial::{Polynomial, monomials};
 pub use recipe::{Architecture, Cycle, Loss, OutputTransform, RECIPES, Recipe};
-pub use surrogate::{DataInfo, FORMAT, FORMAT_VERSION, ModelInfo, Predictor, Surrogate, Voltages};
+pub use surrogate::{
+    DataInfo, DetectorInfo, FORMAT, FORMAT_VERSION, ModelInfo, Predictor, Surrogate, Voltages,
+};
 pub use train::{
     EpochRecord, Member, Trained, candle_outputs, initial_network, output_transform, train,
     train_resuming,

@@ -44,6 +44,16 @@ impl DataInfo {
     }
 }
 
+/// The detector a model's training rows were simulated for.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct DetectorInfo {
+    /// The detector file as given.
+    pub file: String,
+    /// FNV-1a hash (hex) of its text followed by its impurity file's bytes (as in a generation
+    /// run's fingerprint, `ExactSolver::detector_hash`).
+    pub hash: String,
+}
+
 /// Everything a model file records besides its weights.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ModelInfo {
@@ -77,6 +87,10 @@ pub struct ModelInfo {
     pub threads: usize,
     /// Figures on the test set.
     pub test_figures: Figures,
+    /// The detector the training rows were simulated for (`train --detector`); a fit checks it
+    /// against the detector it is given. Absent in files trained without it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub detector: Option<DetectorInfo>,
     /// sigma_p: the relative surrogate uncertainty inference uses (sigma_c^p = sigma_p c_p, the
     /// paper's eq. CapUncertaintyDNN): the Gaussian sigma on the test set.
     pub sigma_p: f64,

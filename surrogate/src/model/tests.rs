@@ -158,6 +158,7 @@ fn tiny_training_lowers_the_loss_and_the_file_reloads_identically() {
         train_seconds: t.seconds,
         threads: 1,
         test_figures: Figures::of(&[1.0], &[1.0]),
+        detector: None,
         sigma_p: 0.05,
     };
     let model = Surrogate::new(info, Predictor::Networks(t.members)).unwrap();
@@ -239,6 +240,7 @@ fn physical_jacobian_matches_finite_differences() {
         train_seconds: 0.0,
         threads: 1,
         test_figures: Figures::of(&[1.0], &[1.0]),
+        detector: None,
         sigma_p: 0.01,
     };
     let m = Surrogate::new(

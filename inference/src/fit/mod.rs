@@ -1,0 +1,14 @@
+//! A whole fit: sampling, the posterior summary (means, modes, smallest intervals, diagnostics),
+//! the posterior predictive, the modes of a multimodal posterior, and the exact-solver check.
+
+mod exact_check;
+mod optimise;
+mod predictive;
+mod run;
+mod summary;
+
+pub use exact_check::{ExactCheck, ParameterShift, exact_check};
+pub use optimise::nelder_mead;
+pub use predictive::{Predictive, predictive};
+pub use run::{Fit, FitSettings, fit};
+pub use summary::{FitSummary, LEVELS, ModeSummary, ParameterSummary};

@@ -1,0 +1,173 @@
+//! A fit from start to summary.
+
+use std::collections::BTreeMap;
+use std::time::Instant;
+
+use serde::{Deserialize, Serialize};
+
+use super::nelder_mead;
+use super::predictive::{Predictive, predictive, thin_indices};
+use super::summary::{FitSummary, LEVELS, ModeSummary, ParameterSummary};
+use crate::summary::{find_modes, marginal_mode, smallest_intervals};
+use crate::{
+    LogDensity, NoiseSettings, Posterior, Result, SampleSettings, Samples, Status, sample,
+};
+
+/// Settings of a fit.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FitSettings {
+    /// Sampling.
+    pub sample: SampleSettings,
+    /// The likelihood's noise model.
+    pub noise: NoiseSettings,
+    /// Histogram bins over each parameter's support (marginal modes, smallest intervals; BAT.jl
+    /// plots use 200, 100 suffices for intervals at 1e4+ draws).
+    pub bins: usize,
+    /// Draws for the posterior predictive.
+    pub predictive_draws: usize,
+    /// Most modes to look for (Gaussian mixtures with 1..=max_modes components).
+    pub max_modes: usize,
+    /// Draws the mixture is fitted to (thinned).
+    pub mode_draws: usize,
+}
+
+impl Default for FitSettings {
+    fn default() -> Self {
+        Self {
+            sample: SampleSettings::default(),
+            noise: NoiseSettings::default(),
+            bins: 100,
+            predictive_draws: 1000,
+            max_modes: 3,
+            mode_draws: 4000,
+        }
+    }
+}
+
+/// A finished fit.
+#[derive(Debug, Clone)]
+pub struct Fit {
+    /// The draws.
+    pub samples: Samples,
+    /// The summary (`summary.json`).
+    pub summary: FitSummary,
+    /// The posterior predictive.
+    pub predictive: Predictive,
+    /// theta at the global mode.
+    pub mode: Vec<f64>,
+}
+
+/// Samples the posterior and summarises it. `inputs` (file names and hashes) go into the
+/// summary as given.
+pub fn fit(
+    posterior: &Posterior,
+    settings: &FitSettings,
+    inputs: BTreeMap<String, String>,
+    progress: &(dyn Fn(&Status) + Sync),
+) -> Result<Fit> {
+    let start = Instant::now();
+    let samples = sample(posterior, &settings.sample, progress)?;
+    let prior = posterior.prior;
+    let d = prior.dim();
+    // Global mode: the best draw, refined by Nelder-Mead in the unconstrained coordinates.
+    let (best, _) = samples.best();
+    let mut z0 = vec![0.0; d];
+    prior.to_unconstrained(&best, &mut z0);
+    let f = |z: &[f64]| {
+        posterior
+            .ln_density_z(z, None)
+            .map(|(l, _)| posterior.output(z, l).1)
+            .unwrap_or(f64::NEG_INFINITY)
+    };
+    let (z_mode, _) = nelder_mead(&f, &z0, 0.05, 200 * d + 400, 1e-10);
+    let mut mode = vec![0.0; d];
+    prior.from_unconstrained(&z_mode, &mut mode);
+    let at_mode = posterior.evaluate(&mode)?;
+    let chi2 = posterior.likelihood.chi2(&at_mode.c_p);
+    let max_abs_pull = posterior
+        .likelihood
+        .pulls(&at_mode.c_p)
+        .iter()
+        .fold(0.0f64, |m, p| m.max(p.abs()));
+    let mut parameters = Vec::with_capacity(d);
+    for (j, p) in prior.parameters.iter().enumerate() {
+        let per = samples.parameter(j);
+        let all: Vec<f64> = per.iter().flatten().copied().collect();
+        let n = all.len() as f64;
+        let mean = all.iter().sum::<f64>() / n;
+        let std = (all.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
+        let si = smallest_intervals(&all, None, p.support, settings.bins, &LEVELS);
+        let dg = samples.diagnostics[j];
+        parameters.push(ParameterSummary {
+            name: p.name.clone(),
+            mean,
+            std,
+            global_mode: mode[j],
+            marginal_mode: marginal_mode(&all, None, p.support, settings.bins),
+            smallest_intervals: LEVELS
+                .iter()
+                .zip(si)
+                .map(|(l, v)| (format!("{l}"), v))
+                .collect(),
+            rhat: dg.rhat,
+            ess_bulk: dg.ess_bulk,
+            ess_tail: dg.ess_tail,
+            unit: p.unit.clone(),
+            prior: p.distribution,
+            support: p.support,
+        });
+    }
+    let all = samples.all();
+    let points: Vec<Vec<f64>> = thin_indices(all.len(), settings.mode_draws)
+        .into_iter()
+        .map(|i| all[i].to_vec())
+        .collect();
+    let mixture = find_modes(&points, settings.max_modes, settings.sample.seed);
+    let modes = mixture
+        .components
+        .iter()
+        .map(|c| ModeSummary {
+            weight: c.weight,
+            location: c.mean.clone(),
+            std: (0..d).map(|j| c.cov[j * d + j].max(0.0).sqrt()).collect(),
+        })
+        .collect();
+    let predictive = predictive(
+        posterior,
+        &samples,
+        settings.predictive_draws,
+        &at_mode.c_p,
+        &LEVELS,
+    )?;
+    let summary = FitSummary {
+        converged: samples.converged(),
+        seconds: start.elapsed().as_secs_f64(),
+        chi2,
+        ndf: posterior.likelihood.len().saturating_sub(d),
+        parameters,
+        modes,
+        exact_check: None,
+        program_version: env!("CARGO_PKG_VERSION").into(),
+        inputs,
+        likelihood: settings.noise,
+        settings: settings.sample,
+        stop: samples.stop,
+        tuned: samples.tuned,
+        tuning_cycles: samples.cycles,
+        tuning_seconds: samples.tuning_seconds,
+        draws_per_chain: samples.chains[0].theta.len(),
+        acceptance: samples.chains.iter().map(|c| c.acceptance).collect(),
+        divergences: samples.chains.iter().map(|c| c.divergences).sum(),
+        evaluations: samples.evaluations(),
+        ess_bulk_per_second: samples.ess_per_second(),
+        ln_posterior_at_mode: at_mode.ln_posterior,
+        max_abs_pull,
+    };
+    Ok(Fit {
+        samples,
+        summary,
+        predictive,
+        mode,
+    })
+}

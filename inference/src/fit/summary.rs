@@ -1,0 +1,103 @@
+//! What a fit reports (`summary.json`): the fields first, then provenance and
+//! diagnostics.
+
+use std::collections::BTreeMap;
+
+use serde::Serialize;
+
+use super::ExactCheck;
+use crate::{NoiseSettings, PriorDistribution, SampleSettings, StopReason};
+
+/// Probability contents of the smallest intervals (1, 2 and 3 sigma of a normal).
+pub const LEVELS: [f64; 3] = [0.683, 0.955, 0.997];
+
+/// One parameter's marginal posterior.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ParameterSummary {
+    /// Name.
+    pub name: String,
+    /// Mean.
+    pub mean: f64,
+    /// Standard deviation.
+    pub std: f64,
+    /// The parameter's value at the global mode (the maximum of the joint posterior).
+    pub global_mode: f64,
+    /// The maximum of the 1D marginal (fullest histogram bin).
+    pub marginal_mode: f64,
+    /// Smallest intervals per level ("0.683", "0.955", "0.997"), each a list of disjoint
+    /// [lo, hi] (several for a multimodal marginal).
+    pub smallest_intervals: BTreeMap<String, Vec<[f64; 2]>>,
+    /// Rank-normalised split R-hat.
+    pub rhat: f64,
+    /// Bulk ESS.
+    pub ess_bulk: f64,
+    /// Tail ESS.
+    pub ess_tail: f64,
+    /// Unit.
+    pub unit: String,
+    /// The prior.
+    pub prior: PriorDistribution,
+    /// Where the prior is positive.
+    pub support: [f64; 2],
+}
+
+/// One mode of the posterior (a component of a Gaussian mixture over the draws).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ModeSummary {
+    /// Probability mass.
+    pub weight: f64,
+    /// Location (the component's mean), in parameter order.
+    pub location: Vec<f64>,
+    /// The component's standard deviations.
+    pub std: Vec<f64>,
+}
+
+/// The summary of a fit.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FitSummary {
+    /// R-hat and ESS targets reached.
+    pub converged: bool,
+    /// Wall time of sampling and summary (the exact check's time is in its own record), s.
+    pub seconds: f64,
+    /// chi^2 at the global mode (see `likelihood`).
+    pub chi2: f64,
+    /// Degrees of freedom: voltages minus parameters.
+    pub ndf: usize,
+    /// Per parameter.
+    pub parameters: Vec<ParameterSummary>,
+    /// The modes found (one for a unimodal posterior).
+    pub modes: Vec<ModeSummary>,
+    /// The exact-solver check (absent with --no-exact-check).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub exact_check: Option<ExactCheck>,
+    /// hpge-cv version.
+    pub program_version: String,
+    /// Inputs: the data, model and prior files (with hashes where known).
+    pub inputs: BTreeMap<String, String>,
+    /// The noise model.
+    pub likelihood: NoiseSettings,
+    /// Sampler settings (sampler, chains, seed, targets).
+    pub settings: SampleSettings,
+    /// Why sampling stopped.
+    pub stop: StopReason,
+    /// Whether the tuning met its criterion.
+    pub tuned: bool,
+    /// Tuning cycles (Metropolis).
+    pub tuning_cycles: usize,
+    /// Tuning wall time, s.
+    pub tuning_seconds: f64,
+    /// Kept draws per chain.
+    pub draws_per_chain: usize,
+    /// Acceptance per chain (NUTS: fraction of non-divergent transitions).
+    pub acceptance: Vec<f64>,
+    /// Divergent transitions (NUTS).
+    pub divergences: usize,
+    /// Log-density evaluations.
+    pub evaluations: u64,
+    /// Smallest bulk ESS per second of sampling.
+    pub ess_bulk_per_second: f64,
+    /// ln p(theta | data) at the global mode (up to the evidence).
+    pub ln_posterior_at_mode: f64,
+    /// Largest |pull| at the global mode.
+    pub max_abs_pull: f64,
+}

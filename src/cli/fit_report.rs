@@ -1,0 +1,226 @@
+//! The Markdown report of a fit (`report.md` in the output folder).
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result};
+use hpge_inference::{CvModel, Fit};
+
+use super::fit::{FitOptions, Setup};
+
+/// The largest |median of c_p - c_m| / sigma over the voltages below and from `split_v`.
+fn misfit(fit: &Fit, split_v: f64) -> (f64, f64) {
+    let p = &fit.predictive;
+    let mut lo = 0.0f64;
+    let mut hi = 0.0f64;
+    for k in 0..p.voltage_v.len() {
+        let z = (p.median_pf[k] / p.sigma_pf[k]).abs();
+        if p.voltage_v[k] < split_v {
+            lo = lo.max(z);
+        } else {
+            hi = hi.max(z);
+        }
+    }
+    (lo, hi)
+}
+
+fn intervals(v: &[[f64; 2]]) -> String {
+    v.iter()
+        .map(|[a, b]| format!("[{a:.4}, {b:.4}]"))
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+/// Writes the report.
+pub fn write_report(
+    path: &Path,
+    o: &FitOptions,
+    s: &Setup,
+    fit: &Fit,
+    figures: &[PathBuf],
+    truth: Option<Vec<(String, f64, bool, bool)>>,
+) -> Result<()> {
+    let sm = &fit.summary;
+    let mut r = String::new();
+    let _ = writeln!(r, "# Fit `{}` of `{}`\n", s.prior.name, o.data.display());
+    let _ = writeln!(
+        r,
+        "hpge-cv {}; model {}; prior `{}`; detector `{}`; likelihood `{}`; sampler `{}` with {} chains, seed {}.\n",
+        sm.program_version,
+        s.surrogate.describe(),
+        o.prior.display(),
+        o.detector.display(),
+        o.likelihood,
+        sm.settings.sampler.as_str(),
+        sm.settings.chains,
+        sm.settings.seed
+    );
+    let _ = writeln!(
+        r,
+        "Reproduce: `hpge-cv fit --data {} --model {} --prior {} --detector {} --sampler {} --seed {} --likelihood {} --out {}`\n",
+        o.data.display(),
+        o.model.display(),
+        o.prior.display(),
+        o.detector.display(),
+        o.sampler,
+        o.seed,
+        o.likelihood,
+        o.out.display()
+    );
+    let _ = writeln!(r, "## Convergence\n");
+    let _ = writeln!(
+        r,
+        "**{}** after {:.1} s ({:.1} s tuning, {} cycles{}): {} kept draws per chain, stop reason `{:?}`; targets R-hat <= {} and bulk and tail ESS >= {}. Acceptance per chain: {}. Divergent transitions: {}. Log-density evaluations: {}. Smallest bulk ESS per second: {:.0}.\n",
+        if sm.converged {
+            "Converged"
+        } else {
+            "Not converged"
+        },
+        sm.seconds,
+        sm.tuning_seconds,
+        sm.tuning_cycles,
+        if sm.tuned {
+            ""
+        } else {
+            ", tuning criterion not met"
+        },
+        sm.draws_per_chain,
+        sm.stop,
+        sm.settings.rhat_max,
+        sm.settings.ess_min,
+        sm.acceptance
+            .iter()
+            .map(|a| format!("{a:.3}"))
+            .collect::<Vec<_>>()
+            .join(", "),
+        sm.divergences,
+        sm.evaluations,
+        sm.ess_bulk_per_second
+    );
+    let _ = writeln!(r, "## Parameters\n");
+    let _ = writeln!(
+        r,
+        "| parameter | prior | mean | std | global mode | marginal mode | 68.3% smallest | 95.5% smallest | R-hat | ESS bulk | ESS tail |"
+    );
+    let _ = writeln!(r, "|---|---|---|---|---|---|---|---|---|---|---|");
+    for p in &sm.parameters {
+        let prior = match p.prior {
+            hpge_inference::PriorDistribution::Uniform { lo, hi } => format!("U({lo}, {hi})"),
+            hpge_inference::PriorDistribution::Normal { mean, sd } => format!("N({mean}, {sd})"),
+            hpge_inference::PriorDistribution::TruncatedNormal { mean, sd, .. } => {
+                format!(
+                    "N_t({mean}, {sd}) on [{:.4}, {}]",
+                    p.support[0], p.support[1]
+                )
+            }
+        };
+        let _ = writeln!(
+            r,
+            "| {} | {} | {:.4} | {:.4} | {:.4} | {:.4} | {} | {} | {:.4} | {:.0} | {:.0} |",
+            p.name,
+            prior,
+            p.mean,
+            p.std,
+            p.global_mode,
+            p.marginal_mode,
+            intervals(&p.smallest_intervals["0.683"]),
+            intervals(&p.smallest_intervals["0.955"]),
+            p.rhat,
+            p.ess_bulk,
+            p.ess_tail
+        );
+    }
+    let _ = writeln!(r);
+    if sm.modes.len() > 1 {
+        let _ = writeln!(
+            r,
+            "**The posterior has {} modes** (a Gaussian mixture over the draws, chosen by BIC):\n",
+            sm.modes.len()
+        );
+        for (i, m) in sm.modes.iter().enumerate() {
+            let loc: Vec<String> = sm
+                .parameters
+                .iter()
+                .zip(&m.location)
+                .zip(&m.std)
+                .map(|((p, v), sd)| format!("{} = {v:.4} +- {sd:.4}", p.name))
+                .collect();
+            let _ = writeln!(r, "- mode {i}, weight {:.3}: {}", m.weight, loc.join(", "));
+        }
+        let _ = writeln!(r);
+    } else {
+        let _ = writeln!(
+            r,
+            "One mode (a Gaussian mixture over the draws prefers one component).\n"
+        );
+    }
+    let _ = writeln!(r, "## Goodness of fit\n");
+    let (lo, hi) = misfit(fit, 1000.0);
+    let _ = writeln!(
+        r,
+        "chi^2 / ndf at the global mode: {:.1} / {} (with the likelihood's sigma, which includes the 3% measurement, 1% + 1 pF solver and sigma_p surrogate terms); max |pull| {:.2}. The median of the posterior predictive of c_p - c_m, in units of sigma_c, reaches {:.2} below 1000 V and {:.2} from 1000 V on (the paper's B_Z misfit sits below 1000 V).\n",
+        sm.chi2, sm.ndf, sm.max_abs_pull, lo, hi
+    );
+    if let Some(c) = &sm.exact_check {
+        let _ = writeln!(r, "## Exact-solver check\n");
+        let _ = writeln!(
+            r,
+            "{} posterior draws re-weighted with the exact field solver ({} failed solves) in {:.1} s: Pareto k-hat {:.2} ({}), weights' ESS {:.0}; |c_exact - c_surrogate| / c_exact at the global mode up to {:.2}%; chi^2 of the exact curve at the mode {:.1}. **{}**.\n",
+            c.draws,
+            c.failed,
+            c.seconds,
+            c.pareto_k,
+            if c.pareto_k < 0.5 {
+                "reliable"
+            } else if c.pareto_k < 0.7 {
+                "usable"
+            } else {
+                "the surrogate posterior is too far from the exact one for re-weighting"
+            },
+            c.ess,
+            100.0 * c.max_rel_diff_at_mode,
+            c.chi2_exact_at_mode,
+            if c.pass { "Pass" } else { "Fail" }
+        );
+        let _ = writeln!(r, "| parameter | re-weighted mean | shift / posterior sd |");
+        let _ = writeln!(r, "|---|---|---|");
+        for p in &c.parameters {
+            let _ = writeln!(
+                r,
+                "| {} | {:.4} | {:+.2} |",
+                p.name, p.exact_mean, p.shift_sd
+            );
+        }
+        let _ = writeln!(r);
+    }
+    if let Some(t) = truth {
+        let _ = writeln!(r, "## Against the known truth\n");
+        let _ = writeln!(r, "| parameter | truth | in 68.3% | in 95.5% |");
+        let _ = writeln!(r, "|---|---|---|---|");
+        for (n, v, a, b) in &t {
+            let _ = writeln!(
+                r,
+                "| {n} | {v:.4} | {} | {} |",
+                if *a { "yes" } else { "no" },
+                if *b { "yes" } else { "no" }
+            );
+        }
+        let _ = writeln!(r);
+    }
+    if !figures.is_empty() {
+        let _ = writeln!(r, "## Figures\n");
+        let base = path.parent().unwrap_or(Path::new("."));
+        for f in figures
+            .iter()
+            .filter(|f| f.extension().is_some_and(|e| e == "png"))
+        {
+            let rel = f.strip_prefix(base).unwrap_or(f);
+            let _ = writeln!(r, "![{}]({})\n", rel.display(), rel.display());
+        }
+    }
+    let _ = writeln!(
+        r,
+        "Files: `samples.csv` (chain, draw, parameters, ln posterior), `summary.json`, `predictive.csv` (c_p - c_m bands per voltage), `zeta-mode.csv` (zeta at the global mode), `figures/`."
+    );
+    std::fs::write(path, r).with_context(|| format!("cannot write {}", path.display()))
+}
