@@ -5,6 +5,7 @@ use criterion::{criterion_group, criterion_main};
 mod generate;
 mod gpu;
 mod impurity;
+mod inference;
 mod solver;
 mod surrogate;
 
@@ -14,6 +15,7 @@ criterion_group!(
     solver::bench,
     gpu::bench,
     generate::bench,
-    surrogate::bench
+    surrogate::bench,
+    inference::bench
 );
 criterion_main!(benches);

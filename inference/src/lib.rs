@@ -35,8 +35,8 @@ pub use model::{CvModel, ExactModel, SurrogateModel};
 pub use posterior::{Cholesky, Evaluation, Likelihood, NoiseKind, NoiseSettings, Posterior};
 pub use prior::{ParameterSpec, Prior, PriorDistribution, PriorParameter, PriorSpec};
 pub use sampler::{
-    ChainDraws, GaussianTarget, LogDensity, Phase, SampleSettings, SamplerKind, Samples, Status,
-    StopReason, sample,
+    ChainDraws, GaussianTarget, LocalMode, LogDensity, Phase, SampleSettings, SamplerKind, Samples,
+    Status, StopReason, sample,
 };
 pub use summary::{
     Component, Mixture, Psis, find_modes, fit_mixture, gpd_fit, interval_contains, marginal_mode,

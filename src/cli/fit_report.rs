@@ -154,6 +154,30 @@ pub fn write_report(
             "One mode (a Gaussian mixture over the draws prefers one component).\n"
         );
     }
+    if !sm.local_modes.is_empty() {
+        let _ = writeln!(
+            r,
+            "Before sampling, Nelder-Mead from {} dispersed starts found {} local maxima (Laplace weights; the sampler adds mode-jump proposals when there are several):\n",
+            sm.settings.mode_starts,
+            sm.local_modes.len()
+        );
+        for m in &sm.local_modes {
+            let loc: Vec<String> = sm
+                .parameters
+                .iter()
+                .zip(&m.theta)
+                .map(|(p, v)| format!("{} = {v:.4}", p.name))
+                .collect();
+            let _ = writeln!(
+                r,
+                "- weight {:.3}, ln p {:.2}: {}",
+                m.weight,
+                m.ln_posterior,
+                loc.join(", ")
+            );
+        }
+        let _ = writeln!(r);
+    }
     let _ = writeln!(r, "## Goodness of fit\n");
     let (lo, hi) = misfit(fit, 1000.0);
     let _ = writeln!(

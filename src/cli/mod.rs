@@ -10,6 +10,7 @@ mod measure;
 mod sensitivity;
 mod simulate;
 mod surrogate;
+mod validate;
 
 use std::path::PathBuf;
 
@@ -62,6 +63,75 @@ enum Command {
     /// surrogate, checked with the exact solver). With no arguments: the shipped data, model and
     /// the B_RZ prior.
     Fit(FitArgs),
+    /// Validation studies of the inference (simulation-based calibration).
+    Validate(ValidateArgs),
+}
+
+#[derive(Debug, clap::Args)]
+struct ValidateArgs {
+    #[command(subcommand)]
+    study: ValidateStudy,
+}
+
+#[derive(Debug, Subcommand)]
+enum ValidateStudy {
+    /// Simulation-based calibration: truths from the prior, data simulated through the model
+    /// plus the noise model, fitted; rank uniformity (KS) and the coverage of the 68.3% and
+    /// 95.5% smallest intervals. Exit code 1 when the study fails.
+    Coverage(CoverageArgs),
+}
+
+#[derive(Debug, clap::Args)]
+struct CoverageArgs {
+    /// Number of truths.
+    #[arg(long)]
+    truths: usize,
+    /// Print the result as one JSON object on stdout.
+    #[arg(long)]
+    json: bool,
+    /// The prior (truths are drawn from it).
+    #[arg(long, value_name = "FILE", default_value = "priors/b-rz.toml")]
+    prior: PathBuf,
+    /// The surrogate that is fitted.
+    #[arg(long, value_name = "FILE", default_value = DEFAULT_MODEL)]
+    model: PathBuf,
+    /// A measured curve: its voltages (and covariance, for --likelihood covariance) are used.
+    #[arg(
+        long,
+        value_name = "FILE",
+        default_value = "data/super-siegfried-k1/cv.csv"
+    )]
+    data: PathBuf,
+    /// The detector (for --exact and the model check).
+    #[arg(
+        long,
+        value_name = "FILE",
+        default_value = "detectors/super-siegfried-k1.toml"
+    )]
+    detector: PathBuf,
+    /// Simulate the data with the exact field solver instead of the surrogate (what surrogate
+    /// error does to coverage; about 2 CPU-seconds per truth more).
+    #[arg(long)]
+    exact: bool,
+    /// Likelihood: paper or covariance.
+    #[arg(long, default_value = "paper")]
+    likelihood: String,
+    /// Sampler: metropolis or nuts.
+    #[arg(long, default_value = "metropolis")]
+    sampler: String,
+    /// Seed of the truths, the noise and the fits.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Target bulk and tail ESS of each fit.
+    #[arg(long, default_value_t = 300.0)]
+    ess: f64,
+    /// Posterior draws each truth is ranked among.
+    #[arg(long, default_value_t = 99)]
+    ranks: usize,
+    /// Output folder for coverage.json, ranks.csv and the figures
+    /// [default: reports/coverage/<prior>[-exact]].
+    #[arg(long, value_name = "DIR")]
+    out: Option<PathBuf>,
 }
 
 #[derive(Debug, clap::Args)]
@@ -604,6 +674,36 @@ pub fn run(cli: Cli) -> Result<()> {
                 no_plots: a.no_plots,
             })
         }
+        Command::Validate(v) => match v.study {
+            ValidateStudy::Coverage(a) => {
+                let stem = a
+                    .prior
+                    .file_stem()
+                    .map_or("coverage".into(), |s| s.to_string_lossy().to_string());
+                let out = a.out.clone().unwrap_or_else(|| {
+                    PathBuf::from("reports/coverage").join(if a.exact {
+                        format!("{stem}-exact")
+                    } else {
+                        stem
+                    })
+                });
+                validate::coverage(&validate::CoverageOptions {
+                    truths: a.truths,
+                    json: a.json,
+                    prior: &a.prior,
+                    model: &a.model,
+                    data: &a.data,
+                    detector: &a.detector,
+                    exact: a.exact,
+                    likelihood: &a.likelihood,
+                    sampler: &a.sampler,
+                    seed: a.seed,
+                    ess: a.ess,
+                    ranks: a.ranks,
+                    out: &out,
+                })
+            }
+        },
         Command::Evaluate(a) => surrogate::evaluate(&surrogate::EvaluateOptions {
             model: &a.model,
             data: &a.data,

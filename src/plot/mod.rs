@@ -35,6 +35,7 @@ macro_rules! render {
 }
 
 mod colormap;
+mod coverage;
 mod cross_section;
 mod cv;
 mod field;
@@ -45,6 +46,7 @@ mod surrogate;
 
 use std::path::Path;
 
+pub use coverage::coverage_figures;
 pub use cross_section::cross_section;
 pub use cv::cv_curve;
 pub use field::field_map;

@@ -16,6 +16,9 @@ pub enum Error {
     /// A solver-side failure.
     #[error(transparent)]
     Solver(#[from] hpge_solver::Error),
+    /// An inference-side failure (a fit in a coverage study).
+    #[error(transparent)]
+    Inference(#[from] hpge_inference::Error),
 }
 
 /// Result alias of the validation crate.

@@ -6,11 +6,16 @@
 //! solver crate against them.
 
 mod coax;
+mod coverage;
 mod error;
 mod planar;
 mod radial1d;
 
 pub use coax::{COAX_REFERENCE_TABLE, LongCoax};
+pub use coverage::{
+    COVERAGE_LEVELS, CoverageReport, CoverageSettings, ParameterCoverage, binomial_interval,
+    coverage, ks_uniform,
+};
 pub use error::{Error, Result};
 pub use planar::PlanarPn;
 pub use radial1d::{DEFAULT_NODES, MIN_NODES, RadialReference, RadialSolution};

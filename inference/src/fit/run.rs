@@ -58,6 +58,19 @@ pub struct Fit {
     pub mode: Vec<f64>,
 }
 
+/// Joins neighbouring intervals separated by at most `gap` (histogram noise splits a smooth
+/// marginal's smallest interval at single empty-looking bins; two bins is the tolerance).
+fn close_gaps(v: Vec<[f64; 2]>, gap: f64) -> Vec<[f64; 2]> {
+    let mut out: Vec<[f64; 2]> = Vec::with_capacity(v.len());
+    for iv in v {
+        match out.last_mut() {
+            Some(last) if iv[0] - last[1] <= gap * (1.0 + 1e-9) => last[1] = last[1].max(iv[1]),
+            _ => out.push(iv),
+        }
+    }
+    out
+}
+
 /// Samples the posterior and summarises it. `inputs` (file names and hashes) go into the
 /// summary as given.
 pub fn fit(
@@ -98,6 +111,8 @@ pub fn fit(
         let mean = all.iter().sum::<f64>() / n;
         let std = (all.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
         let si = smallest_intervals(&all, None, p.support, settings.bins, &LEVELS);
+        let width = (p.support[1] - p.support[0]) / settings.bins as f64;
+        let si: Vec<Vec<[f64; 2]>> = si.into_iter().map(|v| close_gaps(v, 2.0 * width)).collect();
         let dg = samples.diagnostics[j];
         parameters.push(ParameterSummary {
             name: p.name.clone(),
@@ -147,6 +162,7 @@ pub fn fit(
         ndf: posterior.likelihood.len().saturating_sub(d),
         parameters,
         modes,
+        local_modes: samples.local_modes.clone(),
         exact_check: None,
         program_version: env!("CARGO_PKG_VERSION").into(),
         inputs,

@@ -6,7 +6,7 @@ use std::collections::BTreeMap;
 use serde::Serialize;
 
 use super::ExactCheck;
-use crate::{NoiseSettings, PriorDistribution, SampleSettings, StopReason};
+use crate::{LocalMode, NoiseSettings, PriorDistribution, SampleSettings, StopReason};
 
 /// Probability contents of the smallest intervals (1, 2 and 3 sigma of a normal).
 pub const LEVELS: [f64; 3] = [0.683, 0.955, 0.997];
@@ -67,6 +67,8 @@ pub struct FitSummary {
     pub parameters: Vec<ParameterSummary>,
     /// The modes found (one for a unimodal posterior).
     pub modes: Vec<ModeSummary>,
+    /// The local maxima found before sampling (Metropolis' mode search), best weight first.
+    pub local_modes: Vec<LocalMode>,
     /// The exact-solver check (absent with --no-exact-check).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub exact_check: Option<ExactCheck>,

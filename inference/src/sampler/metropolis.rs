@@ -16,16 +16,26 @@ use rand::rngs::StdRng;
 use rand_distr::{Distribution, StandardNormal};
 use rayon::prelude::*;
 
+use std::sync::Arc;
+
 use super::LogDensity;
-use super::run::{Draw, Engine, Phase, SampleSettings, Status, Tuned};
+use super::modes::{Modes, search};
+use super::run::{Draw, Engine, LocalMode, Phase, SampleSettings, Status, Tuned};
 use crate::posterior::Cholesky;
 use crate::{Error, Result, rank_rhat};
 
 /// Factor of the scale update per cycle.
 const SCALE_STEP: f64 = 1.25;
+/// Probability of a mode-jump proposal per step (when several modes were found).
+const JUMP_PROBABILITY: f64 = 0.1;
 
 struct Chain<'a> {
     target: &'a dyn LogDensity,
+    /// Mode-jump proposals (when the search found several modes).
+    jumps: Option<Arc<Modes>>,
+    /// Random-walk proposals and acceptances since the last reset (the tuning's acceptance).
+    rw_tried: u64,
+    rw_accepted: u64,
     z: Vec<f64>,
     ln_p: f64,
     /// Lower Cholesky factor of Sigma (row-major).
@@ -38,6 +48,29 @@ struct Chain<'a> {
 
 impl Chain<'_> {
     fn step(&mut self) -> Draw {
+        if let Some(m) = &self.jumps
+            && self.rng.random::<f64>() < JUMP_PROBABILITY
+        {
+            let proposal = m.sample(&mut self.rng);
+            self.evaluations += 1;
+            let ln_q = self
+                .target
+                .ln_density(&proposal, None)
+                .unwrap_or(f64::NEG_INFINITY);
+            let ln_a = ln_q - self.ln_p + m.ln_q(&self.z) - m.ln_q(&proposal);
+            let u: f64 = self.rng.random();
+            let accepted = ln_q.is_finite() && u.ln() < ln_a;
+            if accepted {
+                self.z = proposal;
+                self.ln_p = ln_q;
+            }
+            return Draw {
+                z: self.z.clone(),
+                ln_density: self.ln_p,
+                accept: f64::from(u8::from(accepted)),
+                divergent: false,
+            };
+        }
         let d = self.z.len();
         let e: Vec<f64> = (0..d)
             .map(|_| StandardNormal.sample(&mut self.rng))
@@ -53,7 +86,9 @@ impl Chain<'_> {
             .unwrap_or(f64::NEG_INFINITY);
         let u: f64 = self.rng.random();
         let accepted = ln_q.is_finite() && u.ln() < ln_q - self.ln_p;
+        self.rw_tried += 1;
         if accepted {
+            self.rw_accepted += 1;
             self.z = proposal;
             self.ln_p = ln_q;
         }
@@ -113,22 +148,45 @@ pub(super) fn tune<'a>(
     progress: &(dyn Fn(&Status) + Sync),
 ) -> Result<Tuned<'a>> {
     let d = target.dim();
-    // Sigma_0: the prior's spread in z, scaled down by 10 (a first step well inside it).
-    let mut rng = chain_rng(s.seed, usize::MAX);
-    let probe: Vec<Vec<f64>> = (0..200).map(|_| target.initial(&mut rng)).collect();
+    let modes = if s.mode_starts > 0 {
+        search(target, s.mode_starts, s.seed)
+    } else {
+        Modes {
+            modes: Vec::new(),
+            evaluations: 0,
+        }
+    };
+    // Sigma_0: the best mode's Laplace covariance, or the prior's spread in z scaled down by 10.
     let mut sigma = vec![0.0; d * d];
-    for j in 0..d {
-        let m = probe.iter().map(|p| p[j]).sum::<f64>() / probe.len() as f64;
-        let v = probe.iter().map(|p| (p[j] - m).powi(2)).sum::<f64>() / probe.len() as f64;
-        sigma[j * d + j] = (0.01 * v).max(1e-8);
+    if let Some(m) = modes.modes.first() {
+        sigma.copy_from_slice(&m.cov);
+    } else {
+        let mut rng = chain_rng(s.seed, usize::MAX);
+        let probe: Vec<Vec<f64>> = (0..200).map(|_| target.initial(&mut rng)).collect();
+        for j in 0..d {
+            let m = probe.iter().map(|p| p[j]).sum::<f64>() / probe.len() as f64;
+            let v = probe.iter().map(|p| (p[j] - m).powi(2)).sum::<f64>() / probe.len() as f64;
+            sigma[j * d + j] = (0.01 * v).max(1e-8);
+        }
     }
     let l0 = factor(&sigma, d);
+    let several = modes.modes.len() > 1;
+    let jumps = several.then(|| Arc::new(modes.clone()));
     let mut chains: Vec<Chain<'a>> = (0..s.chains)
         .map(|c| {
             let mut rng = chain_rng(s.seed, c);
-            let (z, ln_p) = start_point(target, &mut rng)?;
+            // Several modes: chains start in them in turn; otherwise from dispersed prior draws.
+            let (z, ln_p) = if several {
+                let m = &modes.modes[c % modes.modes.len()];
+                (m.z.clone(), m.ln_p)
+            } else {
+                start_point(target, &mut rng)?
+            };
             Ok(Chain {
                 target,
+                jumps: jumps.clone(),
+                rw_tried: 0,
+                rw_accepted: 0,
                 z,
                 ln_p,
                 l: l0.clone(),
@@ -138,8 +196,10 @@ pub(super) fn tune<'a>(
             })
         })
         .collect::<Result<_>>()?;
+    chains[0].evaluations += modes.evaluations;
     let mut tuned = false;
     let mut cycle = 0;
+    let mut previous: Vec<Vec<Vec<f64>>> = vec![Vec::new(); s.chains];
     while cycle < s.max_cycles {
         cycle += 1;
         let runs: Vec<(Vec<Vec<f64>>, f64)> = chains
@@ -193,15 +253,18 @@ pub(super) fn tune<'a>(
             }
             ch.l = l.clone();
         }
+        // R-hat over this cycle and the previous one.
         let rhat = (0..d)
             .map(|j| {
                 let per: Vec<Vec<f64>> = runs
                     .iter()
-                    .map(|r| r.0.iter().map(|z| z[j]).collect())
+                    .zip(&previous)
+                    .map(|(r, p)| p.iter().chain(&r.0).map(|z| z[j]).collect())
                     .collect();
                 rank_rhat(&per)
             })
             .fold(0.0, f64::max);
+        previous = runs.into_iter().map(|r| r.0).collect();
         progress(&Status {
             phase: Phase::Tuning,
             cycle,
@@ -217,6 +280,18 @@ pub(super) fn tune<'a>(
         }
     }
     Ok(Tuned {
+        modes: modes
+            .modes
+            .iter()
+            .map(|m| {
+                let (theta, ln_posterior) = target.output(&m.z, m.ln_p);
+                LocalMode {
+                    weight: m.weight,
+                    theta,
+                    ln_posterior,
+                }
+            })
+            .collect(),
         engines: chains
             .into_iter()
             .map(|c| Box::new(c) as Box<dyn Engine + 'a>)

@@ -4,12 +4,13 @@
 //! when rank-normalised split R-hat and bulk and tail ESS reach their targets, or at a budget.
 
 mod metropolis;
+mod modes;
 mod nuts;
 mod run;
 mod target;
 
 pub use run::{
-    ChainDraws, Phase, SampleSettings, SamplerKind, Samples, Status, StopReason, sample,
+    ChainDraws, LocalMode, Phase, SampleSettings, SamplerKind, Samples, Status, StopReason, sample,
 };
 pub use target::{GaussianTarget, LogDensity};
 

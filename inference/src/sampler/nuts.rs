@@ -9,9 +9,12 @@ use nuts_rs::{
     Chain, CpuLogpFunc, CpuMath, CpuMathError, DiagNutsSettings, HasDims, LogpError, Settings,
 };
 
+use rand_distr::{Distribution, StandardNormal};
+
 use super::LogDensity;
 use super::metropolis::{chain_rng, start_point};
-use super::run::{Draw, Engine, Phase, SampleSettings, Samples, Status, Tuned, finish};
+use super::modes::search;
+use super::run::{Draw, Engine, LocalMode, Phase, SampleSettings, Samples, Status, Tuned, finish};
 use crate::{Error, Result};
 
 /// A failed evaluation: a divergence for NUTS, never the end of the run.
@@ -157,10 +160,12 @@ impl Engine for Proxy {
 }
 
 /// One chain's thread: set up, tune, then draw whenever asked until the handle is dropped.
+#[allow(clippy::too_many_arguments)]
 fn worker(
     target: &dyn LogDensity,
     s: &SampleSettings,
     c: usize,
+    start: Option<Vec<f64>>,
     ask: mpsc::Receiver<()>,
     answer: mpsc::Sender<Reply>,
     evaluations: Arc<Mutex<u64>>,
@@ -177,8 +182,11 @@ fn worker(
     };
     let mut rng = chain_rng(s.seed, c);
     let seen: Seen = Arc::default();
-    let mut setup = || -> Result<_> {
-        let (z0, _) = start_point(target, &mut rng)?;
+    let setup = || -> Result<_> {
+        let z0 = match start {
+            Some(z) => z,
+            None => start_point(target, &mut rng)?.0,
+        };
         let func = Func {
             target,
             seen: seen.clone(),
@@ -230,15 +238,50 @@ pub(super) fn run(
     start: Instant,
     progress: &(dyn Fn(&Status) + Sync),
 ) -> Result<Samples> {
+    // Starts: the modes of the search (weight >= 1%) in turn, jittered by a tenth of each mode's
+    // Laplace standard deviation; dispersed prior draws without a search. NUTS does not jump
+    // between modes: chains started in different ones make R-hat report it.
+    let found = if s.mode_starts > 0 {
+        search(target, s.mode_starts, s.seed).modes
+    } else {
+        Vec::new()
+    };
+    let significant: Vec<_> = found.iter().filter(|m| m.weight >= 0.01).collect();
+    let d = target.dim();
+    let starts: Vec<Option<Vec<f64>>> = (0..s.chains)
+        .map(|c| {
+            let m = significant.get(c % significant.len().max(1))?;
+            let mut rng = chain_rng(s.seed ^ 0x6a69_7474, c);
+            Some(
+                (0..d)
+                    .map(|j| {
+                        let e: f64 = StandardNormal.sample(&mut rng);
+                        m.z[j] + 0.1 * m.cov[j * d + j].sqrt() * e
+                    })
+                    .collect(),
+            )
+        })
+        .collect();
+    let local_modes: Vec<LocalMode> = found
+        .iter()
+        .map(|m| {
+            let (theta, ln_posterior) = target.output(&m.z, m.ln_p);
+            LocalMode {
+                weight: m.weight,
+                theta,
+                ln_posterior,
+            }
+        })
+        .collect();
     std::thread::scope(|scope| {
         let mut proxies = Vec::with_capacity(s.chains);
-        for c in 0..s.chains {
+        for (c, start) in starts.into_iter().enumerate() {
             let (ask_tx, ask_rx) = mpsc::channel();
             let (ans_tx, ans_rx) = mpsc::channel();
             let evaluations = Arc::new(Mutex::new(0));
             let step_size = Arc::new(Mutex::new(0.0));
             let (e2, s2) = (evaluations.clone(), step_size.clone());
-            scope.spawn(move || worker(target, s, c, ask_rx, ans_tx, e2, s2));
+            scope.spawn(move || worker(target, s, c, start, ask_rx, ans_tx, e2, s2));
             proxies.push(Proxy {
                 ask: ask_tx,
                 answer: ans_rx,
@@ -273,6 +316,7 @@ pub(super) fn run(
                 .collect(),
             tuned: true,
             cycles: 0,
+            modes: local_modes,
         };
         finish(target, s, start, progress, tuned)
     })

@@ -62,8 +62,12 @@ pub struct SampleSettings {
     pub max_cycles: usize,
     /// Metropolis: the acceptance window of the tuning (BAT.jl: [0.15, 0.35]).
     pub acceptance: [f64; 2],
-    /// Metropolis: burn-in ends when R-hat over a cycle is below this (BAT.jl: 1.1).
+    /// Metropolis: burn-in ends when R-hat over the last two cycles is below this (BAT.jl: 1.1).
     pub burnin_rhat: f64,
+    /// Nelder-Mead starts of the mode search before tuning (0: no search; chains then start at
+    /// dispersed prior draws). Metropolis starts chains in the modes found and jumps between
+    /// them; NUTS starts chains in the modes of weight >= 1%.
+    pub mode_starts: usize,
     /// NUTS: tuning draws per chain.
     pub nuts_tune: usize,
     /// NUTS: maximum tree depth.
@@ -98,11 +102,12 @@ impl SampleSettings {
             max_cycles: 40,
             acceptance: [0.15, 0.35],
             burnin_rhat: 1.1,
+            mode_starts: 24,
             nuts_tune: 600,
             nuts_max_depth: 8,
             batch_draws: if metropolis { 2000 } else { 200 },
             thin: if metropolis { 4 } else { 1 },
-            max_draws: 50_000,
+            max_draws: 100_000,
             max_seconds: 600.0,
         }
     }
@@ -172,6 +177,17 @@ pub struct Status {
     pub seconds: f64,
 }
 
+/// A local maximum of the posterior found before sampling.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LocalMode {
+    /// Laplace weight: p(z_k) sqrt(det Sigma_k), normalised over the modes found.
+    pub weight: f64,
+    /// Location (parameters).
+    pub theta: Vec<f64>,
+    /// ln p(theta | data) there (up to the evidence).
+    pub ln_posterior: f64,
+}
+
 /// Why sampling stopped.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
@@ -219,6 +235,9 @@ pub struct Samples {
     pub tuned: bool,
     /// Tuning cycles run (Metropolis), 0 for NUTS.
     pub cycles: usize,
+    /// The local maxima the pre-tuning search found, with their Laplace weights (Metropolis;
+    /// empty when it did not run).
+    pub local_modes: Vec<LocalMode>,
     /// Wall time of the tuning, s.
     pub tuning_seconds: f64,
     /// Wall time in all, s.
@@ -295,6 +314,8 @@ pub(super) trait Engine: Send {
 /// The result of a tuning phase.
 pub(super) struct Tuned<'a> {
     pub engines: Vec<Box<dyn Engine + 'a>>,
+    /// Modes the search found (empty when it did not run).
+    pub modes: Vec<LocalMode>,
     pub tuned: bool,
     pub cycles: usize,
 }
@@ -339,6 +360,7 @@ pub(super) fn finish(
         mut engines,
         tuned,
         cycles,
+        modes,
     } = tuned;
     let d = target.dim();
     let m = engines.len();
@@ -428,6 +450,7 @@ pub(super) fn finish(
         stop,
         tuned,
         cycles,
+        local_modes: modes,
         tuning_seconds,
         seconds: start.elapsed().as_secs_f64(),
     })

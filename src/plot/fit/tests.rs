@@ -88,6 +88,7 @@ fn synthetic_fit(d: usize, chains: usize) -> Fit {
         stop: StopReason::Converged,
         tuned: true,
         cycles: 3,
+        local_modes: Vec::new(),
         tuning_seconds: 1.0,
         seconds: 2.0,
     };
@@ -140,6 +141,7 @@ fn synthetic_fit(d: usize, chains: usize) -> Fit {
         ndf: 9,
         parameters,
         modes: Vec::new(),
+        local_modes: Vec::new(),
         exact_check: None,
         program_version: "test".into(),
         inputs: BTreeMap::new(),

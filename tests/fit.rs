@@ -1,0 +1,215 @@
+//! The fit as a user runs it (issue: Bayesian inference): the B_Z fit on the shipped data with
+//! both samplers (outputs, JSON fields, figures), the exit code of an unconverged fit, the
+//! exact-solver check on a few draws, and bad input: a prior outside the model's domain, a curve
+//! with fewer voltages than parameters, a model trained for another detector.
+
+mod common;
+
+use common::{bad, fails_with, ok, run, temp};
+
+fn fit_args<'a>(out: &'a str, extra: &[&'a str]) -> Vec<&'a str> {
+    let mut a = vec![
+        "fit",
+        "--prior",
+        "priors/b-z.toml",
+        "--out",
+        out,
+        "--ess",
+        "300",
+        "--json",
+    ];
+    a.extend_from_slice(extra);
+    a
+}
+
+#[test]
+fn b_z_fit_writes_every_output() {
+    let d = temp("fit-bz");
+    let out = d.join("bz");
+    let o = out.to_str().unwrap();
+    let stdout = ok(&run(&fit_args(o, &["--no-exact-check"])));
+    let v: serde_json::Value = serde_json::from_str(stdout.trim()).expect("one JSON object");
+    assert_eq!(v["converged"], true);
+    for key in ["seconds", "chi2", "ndf", "parameters", "modes"] {
+        assert!(!v[key].is_null(), "{key} missing: {v}");
+    }
+    assert_eq!(v["ndf"], 57);
+    let params = v["parameters"].as_array().unwrap();
+    let names: Vec<&str> = params.iter().map(|p| p["name"].as_str().unwrap()).collect();
+    assert_eq!(names, ["d_li_mm", "y_bot", "y_top"]);
+    for p in params {
+        for key in [
+            "mean",
+            "std",
+            "global_mode",
+            "marginal_mode",
+            "rhat",
+            "ess_bulk",
+            "ess_tail",
+        ] {
+            assert!(p[key].is_number(), "{key}: {p}");
+        }
+        for level in ["0.683", "0.955", "0.997"] {
+            let iv = p["smallest_intervals"][level].as_array().unwrap();
+            assert!(!iv.is_empty());
+        }
+        assert!(p["rhat"].as_f64().unwrap() <= 1.01);
+        assert!(p["ess_bulk"].as_f64().unwrap() >= 300.0);
+    }
+    // The paper's finding on B_Z: the misfit sits at low voltages.
+    let pred = std::fs::read_to_string(out.join("predictive.csv")).unwrap();
+    let mut rows = pred.lines().filter(|l| !l.starts_with('#')).skip(1);
+    let first: Vec<f64> = rows
+        .next()
+        .unwrap()
+        .split(',')
+        .map(|x| x.parse().unwrap())
+        .collect();
+    assert!(first[4].abs() > 3.0, "pull at 25 V {}", first[4]);
+    for f in [
+        "samples.csv",
+        "summary.json",
+        "predictive.csv",
+        "zeta-mode.csv",
+        "report.md",
+    ] {
+        assert!(out.join(f).metadata().unwrap().len() > 100, "{f}");
+    }
+    for f in [
+        "marginals",
+        "predictive",
+        "zeta-z",
+        "zeta-r",
+        "traces",
+        "posterior-2d-y_bot-y_top",
+    ] {
+        for ext in ["png", "svg"] {
+            let p = out.join("figures").join(format!("{f}.{ext}"));
+            assert!(
+                p.metadata().map(|m| m.len() > 1000).unwrap_or(false),
+                "{}",
+                p.display()
+            );
+        }
+    }
+    let samples = std::fs::read_to_string(out.join("samples.csv")).unwrap();
+    assert!(samples.starts_with("# hpge-cv"));
+    assert!(samples.lines().nth(1).unwrap() == "chain,draw,d_li_mm,y_bot,y_top,ln_posterior");
+}
+
+#[test]
+fn nuts_and_the_covariance_likelihood_run() {
+    let d = temp("fit-nuts");
+    let o = d.join("nuts");
+    let stdout = ok(&run(&fit_args(
+        o.to_str().unwrap(),
+        &[
+            "--no-exact-check",
+            "--no-plots",
+            "--sampler",
+            "nuts",
+            "--likelihood",
+            "covariance",
+        ],
+    )));
+    let v: serde_json::Value = serde_json::from_str(stdout.trim()).unwrap();
+    assert_eq!(v["converged"], true);
+    assert_eq!(v["settings"]["sampler"], "nuts");
+    assert_eq!(v["likelihood"]["kind"], "covariance");
+}
+
+#[test]
+fn unconverged_fit_exits_with_3_unless_allowed() {
+    let d = temp("fit-unconverged");
+    let o = d.join("u");
+    let o = o.to_str().unwrap();
+    let args = fit_args(
+        o,
+        &[
+            "--no-exact-check",
+            "--no-plots",
+            "--ess",
+            "1e9",
+            "--max-seconds",
+            "0.5",
+        ],
+    );
+    fails_with(&run(&args), 3, &["did not converge", "--allow-unconverged"]);
+    assert!(
+        d.join("u/summary.json").exists(),
+        "outputs are written anyway"
+    );
+    args.push("--allow-unconverged");
+    let stdout = ok(&run(&args));
+    assert!(stdout.contains("\"converged\":false"));
+}
+
+#[test]
+fn exact_check_reweights_a_few_draws() {
+    let d = temp("fit-exact");
+    let o = d.join("x");
+    let stdout = ok(&run(&fit_args(
+        o.to_str().unwrap(),
+        &["--no-plots", "--exact-draws", "12"],
+    )));
+    let v: serde_json::Value = serde_json::from_str(stdout.trim()).unwrap();
+    let c = &v["exact_check"];
+    assert_eq!(c["draws"], 12);
+    assert!(c["pareto_k"].is_number() || c["pareto_k"].is_null());
+    assert_eq!(c["parameters"].as_array().unwrap().len(), 3);
+    assert!(c["max_rel_diff_at_mode"].as_f64().unwrap() < 0.5);
+}
+
+#[test]
+fn bad_input_is_refused_clearly() {
+    let d = temp("fit-bad");
+    let out = d.join("o");
+    let o = out.to_str().unwrap();
+    // A prior reaching outside the model's domain.
+    let prior = d.join("wide.toml");
+    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/priors/b-z.toml"))
+        .unwrap()
+        .replace("lo = 0.2, hi = 5.0", "lo = 0.1, hi = 6.0");
+    std::fs::write(&prior, text).unwrap();
+    bad(
+        &run(&["fit", "--prior", prior.to_str().unwrap(), "--out", o]),
+        &["wide.toml", "d_li_mm", "outside the model's domain"],
+    );
+    // Fewer voltages than parameters.
+    let data = d.join("short.csv");
+    std::fs::write(&data, "voltage_V,c12_pF,sigma_pF\n500,130,4\n2000,43,1.3\n").unwrap();
+    bad(
+        &run(&[
+            "fit",
+            "--prior",
+            "priors/b-z.toml",
+            "--data",
+            data.to_str().unwrap(),
+            "--out",
+            o,
+        ]),
+        &["2 voltages", "3 parameters"],
+    );
+    // A model trained for another detector (any change of the file changes its hash).
+    let det = d.join("other-detector.toml");
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/detectors/super-siegfried-k1.toml"
+    ))
+    .unwrap();
+    std::fs::write(&det, text + "\n# another detector\n").unwrap();
+    bad(
+        &run(&["fit", "--detector", det.to_str().unwrap(), "--out", o]),
+        &["trained for the detector", "other-detector.toml"],
+    );
+    // Unknown sampler and likelihood, a missing data file.
+    bad(&run(&["fit", "--sampler", "gibbs", "--out", o]), &["gibbs"]);
+    bad(
+        &run(&["fit", "--likelihood", "student", "--out", o]),
+        &["student"],
+    );
+    bad(
+        &run(&["fit", "--data", "nope.csv", "--out", o]),
+        &["nope.csv"],
+    );
+}
