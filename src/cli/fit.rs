@@ -44,6 +44,7 @@ pub struct FitOptions<'a> {
     pub max_seconds: f64,
     pub truth: Option<&'a Path>,
     pub no_plots: bool,
+    pub mode_starts: usize,
 }
 
 /// Everything a fit was set up from.
@@ -251,6 +252,7 @@ pub fn run(o: &FitOptions) -> Result<()> {
     sample.ess_min = o.ess;
     sample.rhat_max = o.rhat;
     sample.max_seconds = o.max_seconds;
+    sample.mode_starts = o.mode_starts;
     sample.validate()?;
     let settings = FitSettings {
         sample,

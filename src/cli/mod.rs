@@ -128,6 +128,9 @@ struct CoverageArgs {
     /// Posterior draws each truth is ranked among.
     #[arg(long, default_value_t = 99)]
     ranks: usize,
+    /// Nelder-Mead starts of each fit's mode search.
+    #[arg(long, default_value_t = 24)]
+    mode_starts: usize,
     /// Output folder for coverage.json, ranks.csv and the figures
     /// [default: reports/coverage/<prior>[-exact]].
     #[arg(long, value_name = "DIR")]
@@ -203,6 +206,9 @@ struct FitArgs {
     /// Write no figures.
     #[arg(long)]
     no_plots: bool,
+    /// Nelder-Mead starts of the mode search before sampling (0: none).
+    #[arg(long, default_value_t = 24)]
+    mode_starts: usize,
 }
 
 /// The shipped surrogate `fit` uses by default.
@@ -672,6 +678,7 @@ pub fn run(cli: Cli) -> Result<()> {
                 max_seconds: a.max_seconds,
                 truth: a.truth.as_deref(),
                 no_plots: a.no_plots,
+                mode_starts: a.mode_starts,
             })
         }
         Command::Validate(v) => match v.study {
@@ -700,6 +707,7 @@ pub fn run(cli: Cli) -> Result<()> {
                     seed: a.seed,
                     ess: a.ess,
                     ranks: a.ranks,
+                    mode_starts: a.mode_starts,
                     out: &out,
                 })
             }

@@ -24,6 +24,7 @@ pub struct CoverageOptions<'a> {
     pub seed: u64,
     pub ess: f64,
     pub ranks: usize,
+    pub mode_starts: usize,
     pub out: &'a Path,
 }
 
@@ -46,6 +47,7 @@ pub fn coverage(o: &CoverageOptions) -> Result<()> {
     let mut sample = SampleSettings::for_sampler(kind);
     sample.ess_min = o.ess;
     sample.max_seconds = 120.0;
+    sample.mode_starts = o.mode_starts;
     sample.validate()?;
     let settings = CoverageSettings {
         n_truths: o.truths,

@@ -62,8 +62,8 @@ pub fn nelder_mead(
             } else {
                 let best = simplex[0].0.clone();
                 for p in simplex.iter_mut().skip(1) {
-                    for j in 0..d {
-                        p.0[j] = best[j] + 0.5 * (p.0[j] - best[j]);
+                    for (x, b) in p.0.iter_mut().zip(&best) {
+                        *x = b + 0.5 * (*x - b);
                     }
                     p.1 = g(&p.0);
                     evals += 1;

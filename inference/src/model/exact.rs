@@ -24,7 +24,10 @@ impl ExactModel {
             .iter()
             .map(|&j| solver.space.dimensions[j].clone())
             .collect();
-        if volts.windows(2).any(|w| !(w[1] > w[0])) {
+        if volts
+            .windows(2)
+            .any(|w| w[1].partial_cmp(&w[0]) != Some(std::cmp::Ordering::Greater))
+        {
             return Err(Error::Argument {
                 name: "voltages".into(),
                 message: "the exact model needs strictly increasing voltages".into(),

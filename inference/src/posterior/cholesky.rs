@@ -21,7 +21,7 @@ impl Cholesky {
                     s -= l[i * n + k] * l[j * n + k];
                 }
                 if i == j {
-                    if !(s > 0.0) {
+                    if s.is_nan() || s <= 0.0 {
                         return None;
                     }
                     l[i * n + i] = s.sqrt();
@@ -48,17 +48,12 @@ impl Cholesky {
         let n = self.n;
         let mut y = b.to_vec();
         for i in 0..n {
-            let mut s = y[i];
-            for k in 0..i {
-                s -= self.l[i * n + k] * y[k];
-            }
+            let row = &self.l[i * n..i * n + i];
+            let s = y[i] - row.iter().zip(&y[..i]).map(|(a, b)| a * b).sum::<f64>();
             y[i] = s / self.l[i * n + i];
         }
         for i in (0..n).rev() {
-            let mut s = y[i];
-            for k in i + 1..n {
-                s -= self.l[k * n + i] * y[k];
-            }
+            let s = y[i] - (i + 1..n).map(|k| self.l[k * n + i] * y[k]).sum::<f64>();
             y[i] = s / self.l[i * n + i];
         }
         y
@@ -75,10 +70,11 @@ impl Cholesky {
             col[i] = 1.0 / self.l[i * n + i];
             d[i] += col[i] * col[i];
             for r in i + 1..n {
-                let mut s = 0.0;
-                for k in i..r {
-                    s -= self.l[r * n + k] * col[k];
-                }
+                let s: f64 = -self.l[r * n + i..r * n + r]
+                    .iter()
+                    .zip(&col[i..r])
+                    .map(|(a, b)| a * b)
+                    .sum::<f64>();
                 col[r] = s / self.l[r * n + r];
                 d[i] += col[r] * col[r];
             }

@@ -2,12 +2,12 @@
 //! measured covariance) and the posterior the samplers see.
 
 mod cholesky;
+mod density;
 mod likelihood;
-mod posterior;
 
 pub use cholesky::Cholesky;
+pub use density::{Evaluation, Posterior};
 pub use likelihood::{Likelihood, NoiseKind, NoiseSettings};
-pub use posterior::{Evaluation, Posterior};
 
 #[cfg(test)]
 mod tests;

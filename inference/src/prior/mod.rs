@@ -3,12 +3,12 @@
 //! the four knots of a face); inputs no parameter sets are fixed. Bound to a model, a prior knows
 //! each parameter's support and maps it to an unconstrained coordinate for the samplers.
 
+mod bound;
 mod distribution;
-mod prior;
 mod spec;
 
+pub use bound::{Prior, PriorParameter};
 pub use distribution::PriorDistribution;
-pub use prior::{Prior, PriorParameter};
 pub use spec::{ParameterSpec, PriorSpec};
 
 #[cfg(test)]

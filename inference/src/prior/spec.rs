@@ -108,7 +108,7 @@ impl PriorSpec {
                         ));
                     }
                     if let (Some(a), Some(b)) = (lo, hi)
-                        && !(a < b)
+                        && a.partial_cmp(&b) != Some(std::cmp::Ordering::Less)
                     {
                         return Err(bad(
                             key,

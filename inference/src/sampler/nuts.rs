@@ -171,11 +171,13 @@ fn worker(
     evaluations: Arc<Mutex<u64>>,
     step_size: Arc<Mutex<f64>>,
 ) {
-    let mut settings = DiagNutsSettings::default();
-    settings.num_tune = s.nuts_tune as u64;
-    settings.num_draws = u64::MAX / 4;
-    settings.maxdepth = s.nuts_max_depth;
-    settings.seed = s.seed;
+    let settings = DiagNutsSettings {
+        num_tune: s.nuts_tune as u64,
+        num_draws: u64::MAX / 4,
+        maxdepth: s.nuts_max_depth,
+        seed: s.seed,
+        ..DiagNutsSettings::default()
+    };
     let fail = |message: String| Error::Numerical {
         what: "NUTS".into(),
         message,

@@ -81,7 +81,9 @@ fn nuts_recovers_a_gaussian() {
 
 #[test]
 fn settings_are_checked() {
-    let mut s = SampleSettings::default();
-    s.chains = 1;
+    let s = SampleSettings {
+        chains: 1,
+        ..SampleSettings::default()
+    };
     assert!(s.validate().is_err());
 }

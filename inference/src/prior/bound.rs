@@ -80,7 +80,7 @@ impl Prior {
                 dom = [dom[0].max(domain[k][0]), dom[1].min(domain[k][1])];
                 idx.push(k);
             }
-            if !(dom[0] < dom[1]) {
+            if dom[0].partial_cmp(&dom[1]) != Some(std::cmp::Ordering::Less) {
                 return Err(Error::invalid(
                     file,
                     &key,

@@ -1,0 +1,21 @@
+#!/usr/bin/env bash
+# Regenerates the fits of reports/inference.md on the shipped stand-in data (issue: Bayesian
+# inference): B_Z and B_RZ with the paper's likelihood, B_RZ with the measured covariance, each
+# with the exact-solver check, and NUTS on B_Z for the sampler comparison. About 10 min on 2 cores.
+# The samples (samples.csv, tens of MB) are not committed; everything else in reports/fits/ is.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+cargo build --release -q
+B=target/release/hpge-cv
+T=data/super-siegfried-k1/truth-b-rz.toml
+$B fit --prior priors/b-z.toml --out reports/fits/b-z
+$B fit --prior priors/b-rz.toml --truth $T --out reports/fits/b-rz
+$B fit --prior priors/b-rz.toml --truth $T --likelihood covariance --out reports/fits/b-rz-covariance
+$B fit --prior priors/b-z.toml --sampler nuts --no-exact-check --out reports/fits/b-z-nuts
+# NUTS cannot cross between B_RZ's modes: it runs to its time limit and reports it (exit 3).
+$B fit --prior priors/b-rz.toml --truth $T --sampler nuts --no-exact-check --max-seconds 120 \
+  --out reports/fits/b-rz-nuts || true
+# The coverage studies (reports/coverage/): about 15 min (B_Z), 60 min (B_RZ), 10 min (exact data).
+#   $B validate coverage --truths 200 --prior priors/b-z.toml
+#   $B validate coverage --truths 200 --prior priors/b-rz.toml --ess 200 --mode-starts 12
+#   $B validate coverage --truths 24 --prior priors/b-rz.toml --exact --ess 200 --mode-starts 12
