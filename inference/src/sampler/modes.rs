@@ -88,9 +88,16 @@ fn laplace_cov(neg_h: &[f64], d: usize) -> Vec<f64> {
                     inv[i * d + j] = col[i];
                 }
             }
-            // Never wider than the prior's unit scale in z by much: cap the variances at 4.
+            // Never much wider than the prior's unit scale in z: variances above 4 are scaled
+            // down to 4 by D Sigma D with D diagonal (a congruence, so it stays positive
+            // definite).
+            let scale: Vec<f64> = (0..d)
+                .map(|i| (4.0 / inv[i * d + i]).sqrt().min(1.0))
+                .collect();
             for i in 0..d {
-                inv[i * d + i] = inv[i * d + i].min(4.0);
+                for j in 0..d {
+                    inv[i * d + j] *= scale[i] * scale[j];
+                }
             }
             return inv;
         }
@@ -162,7 +169,24 @@ pub(super) fn search(target: &dyn LogDensity, starts: usize, seed: u64) -> Modes
         let nh = neg_hessian(&f, &z, 1e-3);
         evaluations += (2 * d * d + 1) as u64;
         let cov = laplace_cov(&nh, d);
-        let chol = Cholesky::new(&cov, d).expect("a loaded inverse is positive definite");
+        // The inverse of a positive-definite matrix, congruence-scaled: positive definite up to
+        // rounding; a diagonal fallback otherwise.
+        let (cov, chol) = match Cholesky::new(&cov, d) {
+            Some(c) => (cov, c),
+            None => {
+                let diag: Vec<f64> = (0..d * d)
+                    .map(|k| {
+                        if k % (d + 1) == 0 {
+                            cov[k].abs().clamp(1e-12, 4.0)
+                        } else {
+                            0.0
+                        }
+                    })
+                    .collect();
+                let c = Cholesky::new(&diag, d).expect("a positive diagonal");
+                (diag, c)
+            }
+        };
         modes.push(Mode {
             z,
             ln_p: lp,

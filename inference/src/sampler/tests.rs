@@ -87,3 +87,78 @@ fn settings_are_checked() {
     };
     assert!(s.validate().is_err());
 }
+
+/// 0.7 N((-5, 0), I) + 0.3 N((5, 2), 0.5^2 I): two modes 10 sd apart.
+struct TwoModes;
+
+impl LogDensity for TwoModes {
+    fn dim(&self) -> usize {
+        2
+    }
+
+    fn names(&self) -> Vec<String> {
+        vec!["a".into(), "b".into()]
+    }
+
+    fn ln_density(&self, z: &[f64], grad: Option<&mut [f64]>) -> crate::Result<f64> {
+        let l1 = 0.7f64.ln() - 0.5 * ((z[0] + 5.0).powi(2) + z[1].powi(2));
+        let l2 = 0.3f64.ln() - 0.5 * ((z[0] - 5.0).powi(2) + (z[1] - 2.0).powi(2)) / 0.25
+            + 2.0f64.ln() * 2.0;
+        let m = l1.max(l2);
+        let (w1, w2) = ((l1 - m).exp(), (l2 - m).exp());
+        if let Some(g) = grad {
+            let s = w1 + w2;
+            g[0] = (w1 * -(z[0] + 5.0) + w2 * -(z[0] - 5.0) / 0.25) / s;
+            g[1] = (w1 * -z[1] + w2 * -(z[1] - 2.0) / 0.25) / s;
+        }
+        Ok(m + (w1 + w2).ln())
+    }
+
+    fn has_gradient(&self) -> bool {
+        true
+    }
+
+    fn initial(&self, rng: &mut dyn rand::Rng) -> Vec<f64> {
+        use rand_distr::{Distribution, Uniform};
+        let u = Uniform::new(-10.0, 10.0).expect("range");
+        vec![u.sample(rng), u.sample(rng)]
+    }
+
+    fn output(&self, z: &[f64], ln_density_z: f64) -> (Vec<f64>, f64) {
+        (z.to_vec(), ln_density_z)
+    }
+}
+
+#[test]
+fn metropolis_finds_both_modes_with_their_weights() {
+    let s = SampleSettings {
+        ess_min: 2000.0,
+        seed: 3,
+        ..SampleSettings::for_sampler(SamplerKind::Metropolis)
+    };
+    let r = sample(&TwoModes, &s, &|_| {}).expect("sampling");
+    assert!(r.converged(), "{:?}", r.diagnostics);
+    assert_eq!(r.local_modes.len(), 2, "{:?}", r.local_modes);
+    // Laplace weights of the search: exact for Gaussian modes.
+    assert!(
+        (r.local_modes[0].weight - 0.7).abs() < 0.01,
+        "{:?}",
+        r.local_modes
+    );
+    let all = r.all();
+    let left = all.iter().filter(|x| x[0] < 0.0).count() as f64 / all.len() as f64;
+    assert!((left - 0.7).abs() < 0.03, "weight of the left mode {left}");
+}
+
+#[test]
+fn nuts_reports_modes_it_cannot_cross() {
+    let s = SampleSettings {
+        ess_min: 400.0,
+        max_seconds: 3.0,
+        ..SampleSettings::for_sampler(SamplerKind::Nuts)
+    };
+    let r = sample(&TwoModes, &s, &|_| {}).expect("sampling");
+    // Chains start in both modes and stay there: R-hat sees it.
+    assert!(!r.converged());
+    assert!(r.diagnostics[0].rhat > 1.1, "{:?}", r.diagnostics);
+}
