@@ -184,12 +184,15 @@ fn read_truth(path: &Path, prior: &Prior) -> Result<Vec<Option<f64>>> {
         .collect())
 }
 
-/// The fitted zeta at the global mode along z at five radii and along r at three heights.
+/// The fitted zeta at the global mode along z at five radii and along r at three heights,
+/// inside the semiconductor only (a borehole or groove is left out).
 fn zeta_at_mode(exact: &ExactSolver, prior: &Prior, mode: &[f64]) -> Result<ZetaAtMode> {
     let mut x = vec![0.0; prior.input_names.len()];
     prior.expand(mode, &mut x);
     let det = exact.detector(&x)?;
     let b = det.semiconductor.geometry.bbox();
+    // Strictly inside (a negative tolerance), so the axis of a borehole does not count.
+    let inside = |r: f64, z: f64| det.semiconductor.geometry.contains(r, z, -1e-6);
     let model = det.impurity();
     let n = 141;
     let lin = |a: f64, c: f64| -> Vec<f64> {
@@ -197,29 +200,46 @@ fn zeta_at_mode(exact: &ExactSolver, prior: &Prior, mode: &[f64]) -> Result<Zeta
             .map(|i| a + (c - a) * i as f64 / (n - 1) as f64)
             .collect()
     };
+    // The radii the semiconductor spans at mid-height.
+    let z_mid = 0.5 * (b.z_min_mm + b.z_max_mm);
+    let rs_mid: Vec<f64> = lin(b.r_min_mm, b.r_max_mm)
+        .into_iter()
+        .filter(|&r| inside(r, z_mid))
+        .collect();
+    let (r_lo, r_hi) = (
+        rs_mid.first().copied().unwrap_or(b.r_min_mm),
+        rs_mid.last().copied().unwrap_or(b.r_max_mm),
+    );
+    let profile = |label: String, pts: Vec<(f64, f64, f64)>| ZetaProfile {
+        label,
+        x_mm: pts.iter().map(|p| p.0).collect(),
+        zeta_cm3: pts.iter().map(|p| model.density_cm3(p.1, p.2)).collect(),
+    };
     let along_z = [0.02, 0.25, 0.5, 0.75, 0.98]
         .iter()
         .map(|f| {
-            let r = b.r_min_mm + f * (b.r_max_mm - b.r_min_mm);
-            let zs = lin(b.z_min_mm, b.z_max_mm);
-            ZetaProfile {
-                label: format!("r = {r:.1} mm"),
-                zeta_cm3: zs.iter().map(|&z| model.density_cm3(r, z)).collect(),
-                x_mm: zs,
-            }
+            let r = r_lo + f * (r_hi - r_lo);
+            let pts = lin(b.z_min_mm, b.z_max_mm)
+                .into_iter()
+                .filter(|&z| inside(r, z))
+                .map(|z| (z, r, z))
+                .collect();
+            profile(format!("r = {r:.1} mm"), pts)
         })
+        .filter(|p| !p.x_mm.is_empty())
         .collect();
     let along_r = [0.02, 0.5, 0.98]
         .iter()
         .map(|f| {
             let z = b.z_min_mm + f * (b.z_max_mm - b.z_min_mm);
-            let rs = lin(b.r_min_mm, b.r_max_mm);
-            ZetaProfile {
-                label: format!("z = {z:.1} mm"),
-                zeta_cm3: rs.iter().map(|&r| model.density_cm3(r, z)).collect(),
-                x_mm: rs,
-            }
+            let pts = lin(b.r_min_mm, b.r_max_mm)
+                .into_iter()
+                .filter(|&r| inside(r, z))
+                .map(|r| (r, r, z))
+                .collect();
+            profile(format!("z = {z:.1} mm"), pts)
         })
+        .filter(|p| !p.x_mm.is_empty())
         .collect();
     Ok(ZetaAtMode { along_z, along_r })
 }
