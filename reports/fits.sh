@@ -10,7 +10,7 @@ B=target/release/hpge-cv
 T=data/super-siegfried-k1/truth-b-rz.toml
 $B fit --prior priors/b-z.toml --out reports/fits/b-z
 $B fit --prior priors/b-rz.toml --truth $T --out reports/fits/b-rz
-$B fit --prior priors/b-rz.toml --truth $T --likelihood covariance --out reports/fits/b-rz-covariance
+$B fit --prior priors/b-rz.toml --truth $T --likelihood covariance --max-seconds 900 --out reports/fits/b-rz-covariance
 $B fit --prior priors/b-z.toml --sampler nuts --no-exact-check --out reports/fits/b-z-nuts
 # NUTS cannot cross between B_RZ's modes: it runs to its time limit and reports it (exit 3).
 $B fit --prior priors/b-rz.toml --truth $T --sampler nuts --no-exact-check --max-seconds 120 \

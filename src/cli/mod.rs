@@ -3,6 +3,7 @@
 mod args;
 mod detector;
 mod fit;
+mod fit_outputs;
 mod fit_report;
 mod generate;
 mod impurity;

@@ -46,7 +46,10 @@ pub fn coverage(o: &CoverageOptions) -> Result<()> {
     let s = setup(o.data, o.model, o.prior, o.detector, noise)?;
     let mut sample = SampleSettings::for_sampler(kind);
     sample.ess_min = o.ess;
-    sample.max_seconds = 120.0;
+    // A study needs many fits: a fit that has not reached its ESS after 20 000 kept draws per
+    // chain (or a minute) stops there and is counted as unconverged.
+    sample.max_seconds = 60.0;
+    sample.max_draws = 20_000;
     sample.mode_starts = o.mode_starts;
     sample.validate()?;
     let settings = CoverageSettings {
