@@ -22,7 +22,7 @@ pub use diagnostics::{
 pub use error::{Error, Result};
 pub use fit::{
     ExactCheck, Fit, FitSettings, FitSummary, LEVELS, ModeSummary, ParameterShift,
-    ParameterSummary, Predictive, exact_check, fit, nelder_mead, predictive,
+    ParameterSummary, Predictive, draw_range, exact_check, fit, nelder_mead, predictive,
 };
 pub use measurement::{
     Circuit, CvData, Data, MeasureSettings, Measurement, PC_PER_KEV, PeakFit, Problem, PulseSet,

@@ -9,7 +9,8 @@
 use std::time::Instant;
 
 use hpge_inference::{
-    CvModel, FitSettings, Likelihood, Posterior, Prior, fit, interval_contains, smallest_intervals,
+    CvModel, FitSettings, Likelihood, Posterior, Prior, draw_range, fit, interval_contains,
+    smallest_intervals,
 };
 use rand::RngExt;
 use rand::SeedableRng;
@@ -230,7 +231,8 @@ pub fn coverage(
                 ranks.push(idx.iter().filter(|&&k| all[k][j] < truth[j]).count());
                 jitter.push(rng.random::<f64>());
                 let draws: Vec<f64> = all.iter().map(|t| t[j]).collect();
-                let si = smallest_intervals(&draws, None, p.support, fs.bins, &COVERAGE_LEVELS);
+                let range = draw_range(&draws, p.support);
+                let si = smallest_intervals(&draws, None, range, fs.bins, &COVERAGE_LEVELS);
                 inside.push(
                     si.iter()
                         .map(|iv| interval_contains(iv, truth[j]))

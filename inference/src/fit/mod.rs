@@ -10,5 +10,5 @@ mod summary;
 pub use exact_check::{ExactCheck, ParameterShift, exact_check};
 pub use optimise::nelder_mead;
 pub use predictive::{Predictive, predictive};
-pub use run::{Fit, FitSettings, fit};
+pub use run::{Fit, FitSettings, draw_range, fit};
 pub use summary::{FitSummary, LEVELS, ModeSummary, ParameterSummary};

@@ -58,6 +58,23 @@ pub struct Fit {
     pub mode: Vec<f64>,
 }
 
+/// The histogram range of a marginal: the draws' [min, max] (inside the support). Binning the
+/// whole support instead makes a posterior narrower than a bin look one bin wide, and its smallest
+/// intervals over-cover (seen in the B_Z coverage study: y_top's 68.3% intervals covered 82.5%).
+pub fn draw_range(draws: &[f64], support: [f64; 2]) -> [f64; 2] {
+    let lo = draws
+        .iter()
+        .copied()
+        .fold(f64::INFINITY, f64::min)
+        .max(support[0]);
+    let hi = draws
+        .iter()
+        .copied()
+        .fold(f64::NEG_INFINITY, f64::max)
+        .min(support[1]);
+    if lo < hi { [lo, hi] } else { support }
+}
+
 /// Joins neighbouring intervals separated by at most `gap` (histogram noise splits a smooth
 /// marginal's smallest interval at single empty-looking bins; two bins is the tolerance).
 fn close_gaps(v: Vec<[f64; 2]>, gap: f64) -> Vec<[f64; 2]> {
@@ -110,8 +127,9 @@ pub fn fit(
         let n = all.len() as f64;
         let mean = all.iter().sum::<f64>() / n;
         let std = (all.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
-        let si = smallest_intervals(&all, None, p.support, settings.bins, &LEVELS);
-        let width = (p.support[1] - p.support[0]) / settings.bins as f64;
+        let range = draw_range(&all, p.support);
+        let si = smallest_intervals(&all, None, range, settings.bins, &LEVELS);
+        let width = (range[1] - range[0]) / settings.bins as f64;
         let si: Vec<Vec<[f64; 2]>> = si.into_iter().map(|v| close_gaps(v, 2.0 * width)).collect();
         let dg = samples.diagnostics[j];
         parameters.push(ParameterSummary {
@@ -119,7 +137,7 @@ pub fn fit(
             mean,
             std,
             global_mode: mode[j],
-            marginal_mode: marginal_mode(&all, None, p.support, settings.bins),
+            marginal_mode: marginal_mode(&all, None, range, settings.bins),
             smallest_intervals: LEVELS
                 .iter()
                 .zip(si)
