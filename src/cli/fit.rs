@@ -169,15 +169,20 @@ pub fn progress_printer(quiet: bool) -> (ProgressBar, impl Fn(&Status) + Sync) {
     (bar, f)
 }
 
+/// The paper's noise constants with the likelihood named by `--likelihood`.
+pub fn noise_settings(likelihood: &str) -> Result<hpge_inference::NoiseSettings> {
+    let kind = NoiseKind::parse(likelihood)
+        .with_context(|| format!("--likelihood {likelihood}: use paper or covariance"))?;
+    Ok(hpge_inference::NoiseSettings {
+        kind,
+        ..Default::default()
+    })
+}
+
 /// Runs `fit`.
 pub fn run(o: &FitOptions) -> Result<()> {
     let kind = sampler_kind(o.sampler)?;
-    let noise_kind = NoiseKind::parse(o.likelihood)
-        .with_context(|| format!("--likelihood {}: use paper or covariance", o.likelihood))?;
-    let noise = hpge_inference::NoiseSettings {
-        kind: noise_kind,
-        ..Default::default()
-    };
+    let noise = noise_settings(o.likelihood)?;
     let s = setup(o.data, o.model, o.prior, o.detector, noise)?;
     let truth = match o.truth {
         Some(p) => Some(read_truth(p, &s.prior)?),

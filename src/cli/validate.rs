@@ -4,11 +4,11 @@ use std::io::Write as _;
 use std::path::Path;
 
 use anyhow::{Context, Result, bail};
-use hpge_inference::{CvModel, ExactModel, FitSettings, NoiseKind, SampleSettings};
+use hpge_inference::{CvModel, ExactModel, FitSettings, SampleSettings};
 use hpge_validation::{CoverageSettings, coverage as run_coverage};
 use indicatif::{ProgressBar, ProgressStyle};
 
-use super::fit::{sampler_kind, setup};
+use super::fit::{noise_settings, sampler_kind, setup};
 
 /// Options of `validate coverage`.
 pub struct CoverageOptions<'a> {
@@ -37,12 +37,7 @@ pub fn coverage(o: &CoverageOptions) -> Result<()> {
         bail!("--ranks {}: need at least 9 draws to rank among", o.ranks);
     }
     let kind = sampler_kind(o.sampler)?;
-    let noise_kind = NoiseKind::parse(o.likelihood)
-        .with_context(|| format!("--likelihood {}: use paper or covariance", o.likelihood))?;
-    let noise = hpge_inference::NoiseSettings {
-        kind: noise_kind,
-        ..Default::default()
-    };
+    let noise = noise_settings(o.likelihood)?;
     let s = setup(o.data, o.model, o.prior, o.detector, noise)?;
     let mut sample = SampleSettings::for_sampler(kind);
     sample.ess_min = o.ess;

@@ -29,19 +29,6 @@ const BARS: RGBColor = RGBColor(87, 153, 199);
 const BAND_EDGE: RGBColor = RGBColor(150, 150, 150);
 /// A failed KS test in a panel title.
 const FAIL: RGBColor = RGBColor(214, 39, 40);
-/// One colour per parameter (tab10).
-const PALETTE: [RGBColor; 10] = [
-    RGBColor(31, 119, 180),
-    RGBColor(255, 127, 14),
-    RGBColor(44, 160, 44),
-    RGBColor(214, 39, 40),
-    RGBColor(148, 103, 189),
-    RGBColor(140, 86, 75),
-    RGBColor(227, 119, 194),
-    RGBColor(127, 127, 127),
-    RGBColor(188, 189, 34),
-    RGBColor(23, 190, 207),
-];
 
 /// Writes the figures of a coverage study into `dir` (created if missing), .svg and .png each;
 /// returns the paths.
@@ -379,7 +366,7 @@ fn coverage<DB: DrawingBackend>(
                 + PathElement::new(vec![(12, 0), (20, 0)], BLACK.stroke_width(2))
         });
     for (k, p) in report.parameters.iter().enumerate() {
-        let c = PALETTE[k % PALETTE.len()];
+        let c = super::fit::PALETTE[k % super::fit::PALETTE.len()];
         let pts: Vec<(f64, f64)> = report
             .levels
             .iter()

@@ -20,7 +20,7 @@ use std::sync::Arc;
 
 use super::LogDensity;
 use super::modes::{Modes, search};
-use super::run::{Draw, Engine, LocalMode, Phase, SampleSettings, Status, Tuned};
+use super::run::{Draw, Engine, Phase, SampleSettings, Status, Tuned};
 use crate::posterior::Cholesky;
 use crate::{Error, Result, rank_rhat};
 
@@ -280,18 +280,7 @@ pub(super) fn tune<'a>(
         }
     }
     Ok(Tuned {
-        modes: modes
-            .modes
-            .iter()
-            .map(|m| {
-                let (theta, ln_posterior) = target.output(&m.z, m.ln_p);
-                LocalMode {
-                    weight: m.weight,
-                    theta,
-                    ln_posterior,
-                }
-            })
-            .collect(),
+        modes: modes.local_modes(target),
         engines: chains
             .into_iter()
             .map(|c| Box::new(c) as Box<dyn Engine + 'a>)

@@ -17,6 +17,7 @@ use rayon::prelude::*;
 
 use super::LogDensity;
 use super::metropolis::chain_rng;
+use super::run::LocalMode;
 use crate::fit::nelder_mead;
 use crate::posterior::Cholesky;
 
@@ -215,6 +216,21 @@ pub(super) fn search(target: &dyn LogDensity, starts: usize, seed: u64) -> Modes
 }
 
 impl Modes {
+    /// The modes as reported: parameters, ln p(theta | data) and Laplace weight.
+    pub fn local_modes(&self, target: &dyn LogDensity) -> Vec<LocalMode> {
+        self.modes
+            .iter()
+            .map(|m| {
+                let (theta, ln_posterior) = target.output(&m.z, m.ln_p);
+                LocalMode {
+                    weight: m.weight,
+                    theta,
+                    ln_posterior,
+                }
+            })
+            .collect()
+    }
+
     /// A draw from the mixture q.
     pub fn sample(&self, rng: &mut StdRng) -> Vec<f64> {
         let u: f64 = rng.random();

@@ -13,8 +13,8 @@ use rand_distr::{Distribution, StandardNormal};
 
 use super::LogDensity;
 use super::metropolis::{chain_rng, start_point};
-use super::modes::search;
-use super::run::{Draw, Engine, LocalMode, Phase, SampleSettings, Samples, Status, Tuned, finish};
+use super::modes::{Modes, search};
+use super::run::{Draw, Engine, Phase, SampleSettings, Samples, Status, Tuned, finish};
 use crate::{Error, Result};
 
 /// A failed evaluation: a divergence for NUTS, never the end of the run.
@@ -244,11 +244,14 @@ pub(super) fn run(
     // Laplace standard deviation; dispersed prior draws without a search. NUTS does not jump
     // between modes: chains started in different ones make R-hat report it.
     let found = if s.mode_starts > 0 {
-        search(target, s.mode_starts, s.seed).modes
+        search(target, s.mode_starts, s.seed)
     } else {
-        Vec::new()
+        Modes {
+            modes: Vec::new(),
+            evaluations: 0,
+        }
     };
-    let significant: Vec<_> = found.iter().filter(|m| m.weight >= 0.01).collect();
+    let significant: Vec<_> = found.modes.iter().filter(|m| m.weight >= 0.01).collect();
     let d = target.dim();
     let starts: Vec<Option<Vec<f64>>> = (0..s.chains)
         .map(|c| {
@@ -264,17 +267,7 @@ pub(super) fn run(
             )
         })
         .collect();
-    let local_modes: Vec<LocalMode> = found
-        .iter()
-        .map(|m| {
-            let (theta, ln_posterior) = target.output(&m.z, m.ln_p);
-            LocalMode {
-                weight: m.weight,
-                theta,
-                ln_posterior,
-            }
-        })
-        .collect();
+    let local_modes = found.local_modes(target);
     std::thread::scope(|scope| {
         let mut proxies = Vec::with_capacity(s.chains);
         for (c, start) in starts.into_iter().enumerate() {

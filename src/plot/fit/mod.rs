@@ -172,8 +172,8 @@ const OUTSIDE: RGBColor = RGBColor(200, 200, 200);
 const PRIOR: RGBColor = RGBColor(31, 119, 180);
 /// The truth (dashed).
 const TRUTH: RGBColor = RGBColor(118, 42, 131);
-/// One colour per chain or profile (tab10).
-const PALETTE: [RGBColor; 10] = [
+/// One colour per chain, profile or parameter (tab10); the coverage figures use it too.
+pub(super) const PALETTE: [RGBColor; 10] = [
     RGBColor(31, 119, 180),
     RGBColor(255, 127, 14),
     RGBColor(44, 160, 44),
