@@ -2,6 +2,8 @@
 
 mod args;
 mod detector;
+mod discover;
+mod discover_report;
 mod fit;
 mod fit_outputs;
 mod fit_report;
@@ -12,6 +14,7 @@ mod sensitivity;
 mod simulate;
 mod surrogate;
 mod validate;
+mod validate_discovery;
 
 use std::path::PathBuf;
 
@@ -64,6 +67,9 @@ enum Command {
     /// surrogate, checked with the exact solver). With no arguments: the shipped data, model and
     /// the B_RZ prior.
     Fit(FitArgs),
+    /// Model discovery: locate where a start model (B_Z) disagrees with the data, name the
+    /// missing effect from a catalogue, add it and show the gap shrink.
+    Discover(discover::DiscoverArgs),
     /// Validation studies of the inference (simulation-based calibration).
     Validate(ValidateArgs),
 }
@@ -80,6 +86,10 @@ enum ValidateStudy {
     /// plus the noise model, fitted; rank uniformity (KS) and the coverage of the 68.3% and
     /// 95.5% smallest intervals. Exit code 1 when the study fails.
     Coverage(CoverageArgs),
+    /// Model discovery on data with hidden effects: one data set per catalogue entry and one
+    /// without, generated with the exact solver (seeded); the workflow must name each effect.
+    /// Exit code 1 when it misnames one.
+    Discovery(validate_discovery::DiscoveryArgs),
 }
 
 #[derive(Debug, clap::Args)]
@@ -682,7 +692,9 @@ pub fn run(cli: Cli) -> Result<()> {
                 mode_starts: a.mode_starts,
             })
         }
+        Command::Discover(a) => discover::run(&a),
         Command::Validate(v) => match v.study {
+            ValidateStudy::Discovery(a) => validate_discovery::run(&a),
             ValidateStudy::Coverage(a) => {
                 let stem = a
                     .prior

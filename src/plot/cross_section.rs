@@ -6,6 +6,7 @@ use std::path::Path;
 use anyhow::Result;
 use hpge_solver::{BoundaryKind, Detector, PassiveKind, Region, WorldSide};
 use plotters::coord::Shift;
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 
 use super::colormap::{density_color, t_color};
@@ -35,11 +36,11 @@ const DIELECTRIC: RGBColor = RGBColor(222, 203, 160);
 const OUTLINE: RGBColor = RGBColor(20, 20, 20);
 const REFLECTING: RGBColor = RGBColor(31, 119, 180);
 
-fn contact_color(i: usize) -> RGBColor {
+pub(super) fn contact_color(i: usize) -> RGBColor {
     CONTACT_COLORS[i % CONTACT_COLORS.len()]
 }
 
-fn passive_color(kind: PassiveKind) -> RGBColor {
+pub(super) fn passive_color(kind: PassiveKind) -> RGBColor {
     match kind {
         PassiveKind::Grounded => GROUNDED,
         PassiveKind::Floating => FLOATING,
@@ -126,79 +127,16 @@ fn draw<DB: DrawingBackend>(
         .draw()
         .map_err(err)?;
 
-    // Raster of regions, merged into runs of equal colour per row.
     let nx = (layout.plot_w / cell_px).max(1) as usize;
     let nz = (layout.plot_h / cell_px).max(1) as usize;
-    let dr = w.r_max_mm / nx as f64;
-    let dzc = (w.z_max_mm - w.z_min_mm) / nz as f64;
-    let regions: Vec<Region> = (0..nz)
-        .flat_map(|j| (0..nx).map(move |i| (i, j)))
-        .map(|(i, j)| det.classify((i as f64 + 0.5) * dr, w.z_min_mm + (j as f64 + 0.5) * dzc))
-        .collect();
-    let at = |i: usize, j: usize| regions[j * nx + i];
-    let is_outside_crystal = |r: Region| matches!(r, Region::Medium | Region::Passive(_));
-    let mut rects = Vec::new();
-    for j in 0..nz {
-        let z0 = w.z_min_mm + j as f64 * dzc;
-        let mut run_start = 0;
-        let mut run_color: Option<RGBColor> = None;
-        for i in 0..=nx {
-            let color = (i < nx).then(|| {
-                let reg = at(i, j);
-                match reg {
-                    Region::Contact(k) => contact_color(k),
-                    Region::Passive(k) => passive_color(det.passives[k].kind),
-                    Region::Medium => WHITE,
-                    Region::Semiconductor => {
-                        let edge = (i > 0 && is_outside_crystal(at(i - 1, j)))
-                            || (i + 1 < nx && is_outside_crystal(at(i + 1, j)))
-                            || (j > 0 && is_outside_crystal(at(i, j - 1)))
-                            || (j + 1 < nz && is_outside_crystal(at(i, j + 1)));
-                        if edge {
-                            OUTLINE
-                        } else {
-                            let r = (i as f64 + 0.5) * dr;
-                            let z = w.z_min_mm + (j as f64 + 0.5) * dzc;
-                            density_color(det.impurity().density_cm3(r, z), levels)
-                        }
-                    }
-                }
-            });
-            if color != run_color {
-                if let Some(c) = run_color {
-                    rects.push(Rectangle::new(
-                        [(run_start as f64 * dr, z0), (i as f64 * dr, z0 + dzc)],
-                        c.filled(),
-                    ));
-                }
-                run_start = i;
-                run_color = color;
-            }
-        }
-    }
-    chart.draw_series(rects).map_err(err)?;
-
-    // Zero-thickness surfaces (e.g. the p+ mantle) as thick lines.
-    for (k, c) in det.contacts.iter().enumerate() {
-        for (a, b) in c.geometry.surface_segments() {
-            chart
-                .draw_series(LineSeries::new(
-                    [(a[0], a[1]), (b[0], b[1])],
-                    contact_color(k).stroke_width(5),
-                ))
-                .map_err(err)?;
-        }
-    }
-    for p in &det.passives {
-        for (a, b) in p.geometry.surface_segments() {
-            chart
-                .draw_series(LineSeries::new(
-                    [(a[0], a[1]), (b[0], b[1])],
-                    passive_color(p.kind).stroke_width(4),
-                ))
-                .map_err(err)?;
-        }
-    }
+    draw_regions(
+        &mut chart,
+        det,
+        [0.0, w.r_max_mm],
+        [w.z_min_mm, w.z_max_mm],
+        (nx, nz),
+        |r, z| density_color(det.impurity().density_cm3(r, z), levels),
+    )?;
 
     // World boundaries and the axis.
     let sides = [
@@ -240,6 +178,93 @@ fn draw<DB: DrawingBackend>(
         .map_err(err)?;
 
     draw_panel(&right, det)?;
+    Ok(())
+}
+
+/// Draws the regions of `det` over `r` x `z` (mm) into `chart` as a raster of (nx, nz) cells
+/// merged into runs of equal colour per row -- contacts and passives in their colours, the
+/// medium white, the semiconductor's edge cells in `OUTLINE` and its interior in `interior(r, z)`
+/// -- then the zero-thickness contact and passive surfaces as thick lines.
+pub(super) fn draw_regions<DB: DrawingBackend>(
+    chart: &mut ChartContext<'_, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+    det: &Detector,
+    r: [f64; 2],
+    z: [f64; 2],
+    (nx, nz): (usize, usize),
+    interior: impl Fn(f64, f64) -> RGBColor,
+) -> Result<()> {
+    // Raster of regions, merged into runs of equal colour per row.
+    let dr = (r[1] - r[0]) / nx as f64;
+    let dzc = (z[1] - z[0]) / nz as f64;
+    let regions: Vec<Region> = (0..nz)
+        .flat_map(|j| (0..nx).map(move |i| (i, j)))
+        .map(|(i, j)| det.classify(r[0] + (i as f64 + 0.5) * dr, z[0] + (j as f64 + 0.5) * dzc))
+        .collect();
+    let at = |i: usize, j: usize| regions[j * nx + i];
+    let is_outside_crystal = |r: Region| matches!(r, Region::Medium | Region::Passive(_));
+    let mut rects = Vec::new();
+    for j in 0..nz {
+        let z0 = z[0] + j as f64 * dzc;
+        let mut run_start = 0;
+        let mut run_color: Option<RGBColor> = None;
+        for i in 0..=nx {
+            let color = (i < nx).then(|| {
+                let reg = at(i, j);
+                match reg {
+                    Region::Contact(k) => contact_color(k),
+                    Region::Passive(k) => passive_color(det.passives[k].kind),
+                    Region::Medium => WHITE,
+                    Region::Semiconductor => {
+                        let edge = (i > 0 && is_outside_crystal(at(i - 1, j)))
+                            || (i + 1 < nx && is_outside_crystal(at(i + 1, j)))
+                            || (j > 0 && is_outside_crystal(at(i, j - 1)))
+                            || (j + 1 < nz && is_outside_crystal(at(i, j + 1)));
+                        if edge {
+                            OUTLINE
+                        } else {
+                            interior(r[0] + (i as f64 + 0.5) * dr, z[0] + (j as f64 + 0.5) * dzc)
+                        }
+                    }
+                }
+            });
+            if color != run_color {
+                if let Some(c) = run_color {
+                    rects.push(Rectangle::new(
+                        [
+                            (r[0] + run_start as f64 * dr, z0),
+                            (r[0] + i as f64 * dr, z0 + dzc),
+                        ],
+                        c.filled(),
+                    ));
+                }
+                run_start = i;
+                run_color = color;
+            }
+        }
+    }
+    chart.draw_series(rects).map_err(err)?;
+
+    // Zero-thickness surfaces (e.g. the p+ mantle) as thick lines.
+    for (k, c) in det.contacts.iter().enumerate() {
+        for (a, b) in c.geometry.surface_segments() {
+            chart
+                .draw_series(LineSeries::new(
+                    [(a[0], a[1]), (b[0], b[1])],
+                    contact_color(k).stroke_width(5),
+                ))
+                .map_err(err)?;
+        }
+    }
+    for p in &det.passives {
+        for (a, b) in p.geometry.surface_segments() {
+            chart
+                .draw_series(LineSeries::new(
+                    [(a[0], a[1]), (b[0], b[1])],
+                    passive_color(p.kind).stroke_width(4),
+                ))
+                .map_err(err)?;
+        }
+    }
     Ok(())
 }
 

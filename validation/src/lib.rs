@@ -8,6 +8,7 @@
 mod coax;
 mod coverage;
 mod error;
+mod hidden;
 mod planar;
 mod radial1d;
 
@@ -17,6 +18,10 @@ pub use coverage::{
     coverage, ks_uniform,
 };
 pub use error::{Error, Result};
+pub use hidden::{
+    BASE_TRUTH, HiddenEffect, HiddenOutcome, RADIAL_TRUTH, hidden_curve, hidden_effects,
+    run_hidden, simulate_hidden,
+};
 pub use planar::PlanarPn;
 pub use radial1d::{DEFAULT_NODES, MIN_NODES, RadialReference, RadialSolution};
 

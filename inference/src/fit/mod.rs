@@ -9,6 +9,7 @@ mod summary;
 
 pub use exact_check::{ExactCheck, ParameterShift, exact_check};
 pub use optimise::nelder_mead;
+pub(crate) use predictive::thin_indices;
 pub use predictive::{Predictive, predictive};
 pub use run::{Fit, FitSettings, draw_range, fit};
 pub use summary::{FitSummary, LEVELS, ModeSummary, ParameterSummary};

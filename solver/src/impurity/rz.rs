@@ -21,6 +21,7 @@ pub struct RzModel {
     z_bottom_mm: f64,
     z_top_mm: f64,
     transform: LogTransform,
+    y_quad: f64,
 }
 
 impl RzModel {
@@ -62,7 +63,24 @@ impl RzModel {
             z_bottom_mm,
             z_top_mm,
             transform,
+            y_quad: 0.0,
         })
+    }
+
+    /// The model with a quadratic z term of amplitude `y_quad` added to y (zero at both faces,
+    /// `y_quad` at mid-height; see [`Self::y_at`]). Used by model discovery's `quadratic-z`
+    /// extension. Errors: `y_quad` not finite.
+    pub fn with_quadratic(mut self, y_quad: f64) -> Result<Self, String> {
+        if !y_quad.is_finite() {
+            return Err(format!("y_quad = {y_quad} is not a finite number"));
+        }
+        self.y_quad = y_quad;
+        Ok(self)
+    }
+
+    /// The quadratic z amplitude (0 for the paper's model).
+    pub fn y_quad(&self) -> f64 {
+        self.y_quad
     }
 
     /// The model from the paper's p_zeta_y = (y_1^bot..y_n^bot, y_1^top..y_n^top) (Eq. (23)),
@@ -143,12 +161,14 @@ impl RzModel {
         Self::p_zeta_from_p_zeta_y(&self.p_zeta_y(), &self.transform)
     }
 
-    /// y(r, z) = y_bot(r) + (y_top(r) - y_bot(r)) (z - z_bottom) / (z_top - z_bottom)
-    /// (paper Eq. (21)), r and z in mm; z is not clamped.
+    /// y(r, z) = y_bot(r) + (y_top(r) - y_bot(r)) t + 4 y_quad t (1 - t), with
+    /// t = (z - z_bottom) / (z_top - z_bottom) (paper Eq. (21) for y_quad = 0), r and z in mm;
+    /// z is not clamped.
     pub fn y_at(&self, r_mm: f64, z_mm: f64) -> f64 {
         let bot = self.bottom.eval(r_mm);
         let top = self.top.eval(r_mm);
-        bot + (top - bot) * (z_mm - self.z_bottom_mm) / (self.z_top_mm - self.z_bottom_mm)
+        let t = (z_mm - self.z_bottom_mm) / (self.z_top_mm - self.z_bottom_mm);
+        bot + (top - bot) * t + 4.0 * self.y_quad * t * (1.0 - t)
     }
 
     /// p_zeta_y from p_zeta (cm^-3), element by element: y_i = T^-1(x(zeta_i)) (inverse of paper
@@ -238,6 +258,20 @@ mod tests {
         let p_zeta = m.p_zeta_cm3();
         assert!(rel(p_zeta[2], 1.3e9) < 1e-12 && rel(p_zeta[6], 0.44e9) < 1e-12);
         assert_eq!(m.p_zeta_y().len(), 8);
+    }
+
+    #[test]
+    fn quadratic_term_vanishes_at_the_faces() {
+        let m = example();
+        let q = m.clone().with_quadratic(0.1).unwrap();
+        for r in [20.0, 30.0, 37.5] {
+            assert_eq!(q.y_at(r, 0.0), m.y_at(r, 0.0));
+            assert!((q.y_at(r, 70.0) - m.y_at(r, 70.0)).abs() < 1e-15);
+            assert!((q.y_at(r, 35.0) - m.y_at(r, 35.0) - 0.1).abs() < 1e-15);
+            assert!((q.y_at(r, 17.5) - m.y_at(r, 17.5) - 0.075).abs() < 1e-15);
+        }
+        assert_eq!(q.y_quad(), 0.1);
+        assert!(m.with_quadratic(f64::NAN).is_err());
     }
 
     #[test]

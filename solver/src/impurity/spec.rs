@@ -80,6 +80,10 @@ pub struct ImpuritySpec {
     /// `rz`: override of the transform's parameters (missing ones take the paper's values).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub transform: Option<LogTransform>,
+    /// `rz`: amplitude of a quadratic z term added to y, 4 y_quad t (1 - t) with t the relative
+    /// height (zero at both faces; model discovery's `quadratic-z` extension). Default 0.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub y_quad: Option<f64>,
 }
 
 /// What a model needs from the detector: the crystal's z range and default knots.
@@ -194,6 +198,7 @@ impl ImpuritySpec {
             ("zeta_bot_cm3", self.zeta_bot_cm3.is_some(), Rz),
             ("zeta_top_cm3", self.zeta_top_cm3.is_some(), Rz),
             ("transform", self.transform.is_some(), Rz),
+            ("y_quad", self.y_quad.is_some(), Rz),
         ];
         for (name, is_some, owner) in present {
             if is_some && owner != self.model {
@@ -260,6 +265,7 @@ impl ImpuritySpec {
             ctx.z_top_mm,
             transform,
         )
+        .and_then(|m| m.with_quadratic(self.y_quad.unwrap_or(0.0)))
         .map_err(|e| keys.err("model", e))
     }
 

@@ -1,0 +1,140 @@
+//! A lithium (n+) layer whose thickness varies linearly along z: d(z) = d_Li + s (t - 1/2), t the
+//! relative height along the contact, s the top-minus-bottom difference (mm). Lithium diffusion
+//! is not uniform along a crystal; the start model has one d_Li. Outside the surrogate's space:
+//! computed with the exact solver, by re-shaping the bias contact's tube.
+
+use std::sync::Arc;
+
+use hpge_solver::{ContactPotential, Detector, Primitive, Solid};
+
+use super::quadratic_z::base_inputs;
+use super::{Baseline, Candidate, ExactVariant, Extension, Predictor, one_more};
+use crate::prior::PriorDistribution;
+
+/// Domain of s, mm.
+pub const SLOPE_RANGE_MM: [f64; 2] = [-4.0, 4.0];
+/// Prior sd of s, mm.
+pub const SLOPE_PRIOR_SD_MM: f64 = 1.0;
+/// The thinnest layer allowed anywhere, mm.
+const MIN_THICKNESS_MM: f64 = 0.05;
+
+/// Replaces the bias contact's tube r in [r_in, r_in + d] by a layer of thickness
+/// d + s (t - 1/2): the cone with those radii, keeping the tube's rounded ends (within the
+/// rounding radius of each end the layer keeps at least the tube's shape). s = 0 leaves the
+/// contact unchanged.
+fn set_slope(det: &mut Detector, extra: &[f64]) -> Result<(), String> {
+    let s = extra[0];
+    let mut found = false;
+    for c in det.contacts.iter_mut() {
+        if c.potential != ContactPotential::Bias {
+            continue;
+        }
+        let Solid::Primitive(Primitive::Tube {
+            r_in_mm,
+            r_out_mm,
+            z_min_mm,
+            z_max_mm,
+            round_outer_mm,
+        }) = c.geometry.clone()
+        else {
+            return Err(format!(
+                "contact {} is not a single tube: the Li thickness slope needs a tube-shaped n+ layer",
+                c.label()
+            ));
+        };
+        let d = r_out_mm - r_in_mm;
+        if d - 0.5 * s.abs() < MIN_THICKNESS_MM {
+            return Err(format!(
+                "a slope of {s} mm on a {d} mm layer leaves less than {MIN_THICKNESS_MM} mm"
+            ));
+        }
+        if s == 0.0 {
+            found = true;
+            continue;
+        }
+        let cone = Solid::Primitive(Primitive::Cone {
+            z_mm: [z_min_mm, z_max_mm],
+            r_in_mm: [r_in_mm, r_in_mm],
+            r_out_mm: [r_out_mm - 0.5 * s, r_out_mm + 0.5 * s],
+        });
+        let core = Solid::Intersection(vec![
+            cone.clone(),
+            Solid::tube(
+                r_in_mm,
+                r_out_mm + s.abs() + 1.0,
+                z_min_mm + round_outer_mm,
+                z_max_mm - round_outer_mm,
+            ),
+        ]);
+        let outside = Solid::Difference {
+            base: Box::new(Solid::tube(
+                r_in_mm,
+                r_out_mm + s.abs() + 1.0,
+                z_min_mm,
+                z_max_mm,
+            )),
+            minus: vec![cone],
+        };
+        c.geometry = Solid::Difference {
+            base: Box::new(Solid::Union(vec![c.geometry.clone(), core])),
+            minus: vec![outside],
+        };
+        found = true;
+    }
+    if found {
+        Ok(())
+    } else {
+        Err("the detector has no contact at the bias potential (the n+ layer)".into())
+    }
+}
+
+/// The catalogue entry.
+pub struct LiSlope;
+
+impl Extension for LiSlope {
+    fn name(&self) -> &'static str {
+        "li-slope"
+    }
+
+    fn description(&self) -> &'static str {
+        "a lithium (n+) thickness that varies linearly along z (top minus bottom s, mm)"
+    }
+
+    fn signature(&self) -> &'static str {
+        "residuals near and above full depletion, where c12 is set by the n+ layer's shape; \
+         little at low voltage"
+    }
+
+    fn build(&self, base: &Baseline) -> std::result::Result<Candidate, String> {
+        let volts = base.surrogate.voltages();
+        let model = ExactVariant::new(
+            base.exact,
+            volts,
+            &[("d_li_slope_mm", SLOPE_RANGE_MM)],
+            set_slope,
+            "a Li thickness slope",
+        )
+        .map_err(|e| e.to_string())?;
+        let mut x = base_inputs(base)?;
+        x.push(0.1);
+        model.detector(&x).map_err(|e| e.to_string())?;
+        Ok(one_more(
+            self,
+            base,
+            Predictor::Exact,
+            Arc::new(model),
+            (
+                "d_li_slope_mm",
+                "mm",
+                "Li thickness at the top minus at the bottom of the n+ layer",
+                PriorDistribution::TruncatedNormal {
+                    mean: 0.0,
+                    sd: SLOPE_PRIOR_SD_MM,
+                    lo: None,
+                    hi: None,
+                },
+            ),
+            0.0,
+        ))
+    }
+}

@@ -1,0 +1,155 @@
+//! The catalogue of model extensions model discovery tries (issue 9): each entry names a
+//! physical effect the start model lacks, its parameters and priors, and the signature it leaves
+//! in the C-V residuals. Adding an entry is one file here implementing [`Extension`] and one line
+//! in [`catalogue`].
+//!
+//! An entry builds a [`Candidate`]: a [`CvModel`] whose inputs are the start model's plus the
+//! effect's, and a prior spec that contains the start model's parameters (the start model is the
+//! candidate at the effect's null value, so the two nest). Entries that need predictions the
+//! surrogate was not trained for run on the exact field solver ([`Predictor::Exact`]).
+
+mod exact_variant;
+mod li_slope;
+mod quadratic_z;
+mod radial;
+mod scale;
+mod stray;
+
+use std::sync::Arc;
+
+use hpge_surrogate::ExactSolver;
+use serde::Serialize;
+
+pub use exact_variant::ExactVariant;
+pub use li_slope::LiSlope;
+pub use quadratic_z::QuadraticZ;
+pub use radial::Radial;
+pub use scale::{CalibrationScale, Scaled};
+pub use stray::{Shifted, StrayCapacitance};
+
+use crate::model::CvModel;
+use crate::prior::{ParameterSpec, PriorDistribution, PriorSpec};
+
+/// What computes a candidate's curves.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Predictor {
+    /// The trained surrogate (the effect is in its space, or acts on its output).
+    Surrogate,
+    /// The exact field solver (the effect is outside the surrogate's space).
+    Exact,
+}
+
+impl Predictor {
+    /// `surrogate` or `exact`.
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            Predictor::Surrogate => "surrogate",
+            Predictor::Exact => "exact",
+        }
+    }
+}
+
+/// What an extension builds on: the start model and its fit.
+#[derive(Clone)]
+pub struct Baseline<'a> {
+    /// The start model's prior (its parameters and ties).
+    pub spec: &'a PriorSpec,
+    /// The start fit's global mode, in `spec`'s parameter order.
+    pub mode: &'a [f64],
+    /// The start model's predictor (the surrogate).
+    pub surrogate: Arc<dyn CvModel>,
+    /// The exact solver on the surrogate's space and detector.
+    pub exact: &'a ExactSolver,
+}
+
+/// A start model extended by one effect, ready to be scored and fitted.
+#[derive(Clone)]
+pub struct Candidate {
+    /// The extension's name (e.g. `radial`).
+    pub name: String,
+    /// What it adds, in words.
+    pub description: String,
+    /// The residual signature it explains.
+    pub signature: String,
+    /// What computes its curves.
+    pub predictor: Predictor,
+    /// The extended model.
+    pub model: Arc<dyn CvModel>,
+    /// Its prior: the start model's parameters (possibly split) and the added ones.
+    pub spec: PriorSpec,
+    /// Where an optimiser starts: the start mode with the effect at its null value.
+    pub start: Vec<f64>,
+    /// The parameters it adds (for a split, the new per-input parameters).
+    pub added: Vec<String>,
+}
+
+/// One entry of the catalogue.
+pub trait Extension: Send + Sync {
+    /// Short name used in outputs and on the command line (`radial`, `stray-capacitance`, ...).
+    fn name(&self) -> &'static str;
+    /// What the effect is, physically.
+    fn description(&self) -> &'static str;
+    /// The residual pattern the effect leaves when the start model lacks it.
+    fn signature(&self) -> &'static str;
+    /// The extended model, or why the entry does not apply to this start model or detector.
+    fn build(&self, base: &Baseline) -> std::result::Result<Candidate, String>;
+}
+
+/// Every entry, in a fixed order (the report lists them this way).
+pub fn catalogue() -> Vec<Box<dyn Extension>> {
+    vec![
+        Box::new(Radial),
+        Box::new(StrayCapacitance),
+        Box::new(CalibrationScale),
+        Box::new(QuadraticZ),
+        Box::new(LiSlope),
+    ]
+}
+
+/// `spec` with one more parameter `name` (a model input of the same name) and its prior.
+pub(crate) fn with_parameter(
+    spec: &PriorSpec,
+    name: &str,
+    unit: &str,
+    description: &str,
+    prior: PriorDistribution,
+) -> PriorSpec {
+    let mut s = spec.clone();
+    s.parameters.push(ParameterSpec {
+        name: name.into(),
+        unit: unit.into(),
+        description: description.into(),
+        inputs: vec![],
+        prior,
+    });
+    s.name = format!("{}+{name}", spec.name);
+    s
+}
+
+/// A candidate that adds one parameter with null value `null` to the start model.
+pub(crate) fn one_more(
+    ext: &dyn Extension,
+    base: &Baseline,
+    predictor: Predictor,
+    model: Arc<dyn CvModel>,
+    parameter: (&str, &str, &str, PriorDistribution),
+    null: f64,
+) -> Candidate {
+    let (name, unit, description, prior) = parameter;
+    let mut start = base.mode.to_vec();
+    start.push(null);
+    Candidate {
+        name: ext.name().into(),
+        description: ext.description().into(),
+        signature: ext.signature().into(),
+        predictor,
+        model,
+        spec: with_parameter(base.spec, name, unit, description, prior),
+        start,
+        added: vec![name.into()],
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,272 @@
+//! The quick fit of a candidate: the posterior mode by Levenberg-Marquardt on the whitened
+//! residuals, and the Laplace approximation around it (the evidence and a Gaussian posterior).
+//!
+//! Residuals: e_k = (c_p,k(theta) - c_m,k) / sigma_k, with sigma_k the likelihood's standard
+//! deviation at the current curve (held fixed within a step, updated between steps), and for
+//! each normal or truncated-normal prior the pseudo-residual (theta_j - mu_j) / sd_j. A step
+//! solves (J^T J + lambda diag(J^T J)) delta = -J^T e and is kept when the exact log posterior
+//! (the ln sigma term and every prior normalisation included) rises.
+//!
+//! Laplace (e.g. MacKay 2003, ch. 27): with H = J^T J at the mode (the Gauss-Newton Hessian of
+//! -ln p, prior rows included),
+//!   ln Z ~ ln p(theta*) + ln L(theta*) + (d/2) ln(2 pi) - (1/2) ln det H,
+//! and the posterior ~ N(theta*, H^-1). Models without a Jacobian (the exact solver) get forward
+//! differences, their columns computed in parallel.
+
+use rayon::prelude::*;
+use serde::Serialize;
+
+use crate::posterior::Cholesky;
+use crate::prior::PriorDistribution;
+use crate::{Error, Posterior, Result};
+
+/// Settings of the quick fit.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct LaplaceSettings {
+    /// Most Levenberg-Marquardt steps (accepted or not).
+    pub max_steps: usize,
+    /// Stop when a step raises ln p by less than this (1e-2: far below what changes a Bayes
+    /// factor's reading, and each exact-solver step costs d + 1 solves).
+    pub tolerance: f64,
+    /// Stop after this many curve evaluations (an exact-solver curve costs ~1-2 s; a geometry
+    /// parameter the grid resolves in steps can make the optimiser reject step after step).
+    pub max_evaluations: usize,
+    /// Forward-difference step of parameter j: this fraction of its support's width (1e-2: the
+    /// exact solver's curve is smooth on that scale; its discretisation noise is ~1e-5
+    /// relative).
+    pub fd_step: f64,
+}
+
+impl Default for LaplaceSettings {
+    fn default() -> Self {
+        Self {
+            max_steps: 20,
+            tolerance: 1e-2,
+            max_evaluations: 80,
+            fd_step: 1e-2,
+        }
+    }
+}
+
+/// A posterior mode with its Laplace approximation.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LaplaceFit {
+    /// theta at the mode.
+    pub theta: Vec<f64>,
+    /// ln p(theta*) + ln L(theta*).
+    pub ln_posterior: f64,
+    /// ln L(theta*).
+    pub ln_likelihood: f64,
+    /// chi^2 at the mode.
+    pub chi2: f64,
+    /// Laplace estimate of ln Z.
+    pub ln_evidence: f64,
+    /// Covariance H^-1 of theta (d x d, row-major).
+    pub covariance: Vec<f64>,
+    /// c_p at the mode, pF.
+    pub c_p: Vec<f64>,
+    /// dc_p / dtheta at the mode (voltages x parameters, row-major), pF per unit.
+    pub jacobian: Vec<f64>,
+    /// Curve evaluations used.
+    pub evaluations: usize,
+    /// Accepted steps.
+    pub steps: usize,
+}
+
+/// c_p and dc_p/dtheta at theta (analytic where the model has a Jacobian).
+fn curve_and_jacobian(
+    posterior: &Posterior,
+    theta: &[f64],
+    fd_step: f64,
+    evaluations: &mut usize,
+) -> Result<(Vec<f64>, Vec<f64>)> {
+    let prior = posterior.prior;
+    let d = prior.dim();
+    let nv = posterior.likelihood.len();
+    let nx = prior.input_names.len();
+    let mut x = vec![0.0; nx];
+    prior.expand(theta, &mut x);
+    let mut c = vec![0.0; nv];
+    let mut jt = vec![0.0; nv * d];
+    if posterior.model.has_jacobian() {
+        let mut jx = vec![0.0; nv * nx];
+        posterior.model.curve_jacobian(&x, &mut c, &mut jx)?;
+        *evaluations += 1;
+        for k in 0..nv {
+            prior.contract(&jx[k * nx..(k + 1) * nx], &mut jt[k * d..(k + 1) * d]);
+        }
+        return Ok((c, jt));
+    }
+    posterior.model.curve(&x, &mut c)?;
+    let columns: Vec<Result<(usize, f64, Vec<f64>)>> = (0..d)
+        .into_par_iter()
+        .map(|j| {
+            let s = prior.parameters[j].support;
+            let mut h = fd_step * (s[1] - s[0]);
+            if theta[j] + h > s[1] {
+                h = -h;
+            }
+            let mut t = theta.to_vec();
+            t[j] += h;
+            let mut xj = vec![0.0; nx];
+            prior.expand(&t, &mut xj);
+            let mut cj = vec![0.0; nv];
+            posterior.model.curve(&xj, &mut cj)?;
+            Ok((j, h, cj))
+        })
+        .collect();
+    for col in columns {
+        let (j, h, cj) = col?;
+        for k in 0..nv {
+            jt[k * d + j] = (cj[k] - c[k]) / h;
+        }
+    }
+    *evaluations += 1 + d;
+    Ok((c, jt))
+}
+
+/// Whitened residuals e and their Jacobian (rows: voltages, then prior rows).
+fn residuals(posterior: &Posterior, theta: &[f64], c: &[f64], jc: &[f64]) -> (Vec<f64>, Vec<f64>) {
+    let d = theta.len();
+    let lik = posterior.likelihood;
+    let sigma = lik.sigma(c);
+    let mut e = Vec::new();
+    let mut j = Vec::new();
+    for k in 0..c.len() {
+        e.push((c[k] - lik.c_m[k]) / sigma[k]);
+        j.extend(jc[k * d..(k + 1) * d].iter().map(|v| v / sigma[k]));
+    }
+    for (i, p) in posterior.prior.parameters.iter().enumerate() {
+        if let PriorDistribution::Normal { mean, sd }
+        | PriorDistribution::TruncatedNormal { mean, sd, .. } = p.distribution
+        {
+            e.push((theta[i] - mean) / sd);
+            let mut row = vec![0.0; d];
+            row[i] = 1.0 / sd;
+            j.extend(row);
+        }
+    }
+    (e, j)
+}
+
+/// J^T J and J^T e.
+fn normal_equations(e: &[f64], j: &[f64], d: usize) -> (Vec<f64>, Vec<f64>) {
+    let mut a = vec![0.0; d * d];
+    let mut g = vec![0.0; d];
+    for (r, &er) in e.iter().enumerate() {
+        let row = &j[r * d..(r + 1) * d];
+        for p in 0..d {
+            g[p] += row[p] * er;
+            for q in 0..d {
+                a[p * d + q] += row[p] * row[q];
+            }
+        }
+    }
+    (a, g)
+}
+
+/// theta moved inside its support by at least 1e-9 of the width.
+fn clamp(posterior: &Posterior, theta: &mut [f64]) {
+    for (t, p) in theta.iter_mut().zip(&posterior.prior.parameters) {
+        let [lo, hi] = p.support;
+        let m = 1e-9 * (hi - lo);
+        *t = t.clamp(lo + m, hi - m);
+    }
+}
+
+/// The mode from `start` and the Laplace approximation there (see the module docs).
+pub fn laplace_fit(
+    posterior: &Posterior,
+    start: &[f64],
+    settings: &LaplaceSettings,
+) -> Result<LaplaceFit> {
+    let d = posterior.dim();
+    let mut theta = start.to_vec();
+    clamp(posterior, &mut theta);
+    let mut evaluations = 0;
+    let mut current = posterior.evaluate(&theta)?;
+    evaluations += 1;
+    if !current.ln_posterior.is_finite() {
+        return Err(Error::Numerical {
+            what: "quick fit".into(),
+            message: format!("the start point {theta:?} has zero posterior density"),
+        });
+    }
+    let (mut c, mut jc) =
+        curve_and_jacobian(posterior, &theta, settings.fd_step, &mut evaluations)?;
+    let mut lambda = 1e-3;
+    let mut steps = 0;
+    for _ in 0..settings.max_steps {
+        if evaluations >= settings.max_evaluations {
+            break;
+        }
+        let (e, j) = residuals(posterior, &theta, &c, &jc);
+        let (a, g) = normal_equations(&e, &j, d);
+        let mut m = a.clone();
+        for p in 0..d {
+            m[p * d + p] += lambda * a[p * d + p].max(1e-12) + 1e-12;
+        }
+        let Some(ch) = Cholesky::new(&m, d) else {
+            lambda *= 10.0;
+            continue;
+        };
+        let delta = ch.solve(&g.iter().map(|v| -v).collect::<Vec<_>>());
+        let mut trial: Vec<f64> = theta.iter().zip(&delta).map(|(t, s)| t + s).collect();
+        clamp(posterior, &mut trial);
+        let ev = posterior.evaluate(&trial);
+        evaluations += 1;
+        match ev {
+            Ok(ev) if ev.ln_posterior > current.ln_posterior => {
+                let gain = ev.ln_posterior - current.ln_posterior;
+                theta = trial;
+                current = ev;
+                (c, jc) =
+                    curve_and_jacobian(posterior, &theta, settings.fd_step, &mut evaluations)?;
+                lambda = (lambda / 3.0).max(1e-9);
+                steps += 1;
+                if gain < settings.tolerance {
+                    break;
+                }
+            }
+            _ => {
+                lambda *= 4.0;
+                if lambda > 1e8 {
+                    break;
+                }
+            }
+        }
+    }
+    let (e, j) = residuals(posterior, &theta, &c, &jc);
+    let (h, _) = normal_equations(&e, &j, d);
+    let mut hr = h.clone();
+    for p in 0..d {
+        hr[p * d + p] += 1e-10 * h[p * d + p].abs().max(1e-12);
+    }
+    let ch = Cholesky::new(&hr, d).ok_or_else(|| Error::Numerical {
+        what: "Laplace approximation".into(),
+        message: "the Hessian at the mode is not positive definite".into(),
+    })?;
+    let mut covariance = vec![0.0; d * d];
+    for q in 0..d {
+        let mut unit = vec![0.0; d];
+        unit[q] = 1.0;
+        let col = ch.solve(&unit);
+        for p in 0..d {
+            covariance[p * d + q] = col[p];
+        }
+    }
+    let ln_evidence = current.ln_posterior + 0.5 * d as f64 * (2.0 * std::f64::consts::PI).ln()
+        - 0.5 * ch.ln_det();
+    Ok(LaplaceFit {
+        chi2: posterior.likelihood.chi2(&current.c_p),
+        theta,
+        ln_posterior: current.ln_posterior,
+        ln_likelihood: current.ln_likelihood,
+        ln_evidence,
+        covariance,
+        c_p: current.c_p,
+        jacobian: jc,
+        evaluations,
+        steps,
+    })
+}

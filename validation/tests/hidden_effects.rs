@@ -1,0 +1,91 @@
+//! Model discovery on data with hidden effects (issue 9), the reduced version CI runs: the null
+//! data set and the three effects the surrogate can express (radial dependence, a stray
+//! capacitance, a calibration scale), each generated with the exact solver plus the paper's
+//! noise, scored against those three entries, with lighter sampling (ESS 300). The full study,
+//! every entry on every data set, is `hpge-cv validate discovery` (reports/discovery/).
+
+use std::sync::Arc;
+
+use hpge_inference::{
+    CvModel, DiscoverSettings, FitSettings, PriorSpec, Progress, SampleSettings, SamplerKind,
+    Status, SurrogateModel, read_curve,
+};
+use hpge_solver::FieldSettings;
+use hpge_surrogate::{ExactSolver, Surrogate};
+use hpge_validation::{hidden_effects, repo_path, run_hidden, simulate_hidden};
+
+struct Quiet;
+
+impl Progress for Quiet {
+    fn stage(&self, _: &str) {}
+    fn sampling(&self, _: &Status) {}
+}
+
+#[test]
+#[ignore = "fails (2026-11-22): on the z-only null truth the shipped surrogate is 27% below the \
+            exact solver at 25 V and 4-6% off at many voltages (an n-type mantle, a corner of \
+            its space), so B_Z's chi2/ndf is 3.1 and `radial` is chosen; see issue 9's notes"]
+fn discovery_names_each_hidden_effect_and_none_in_the_null_case() {
+    let surrogate = Surrogate::load(&repo_path("models/super-siegfried-rz-split.safetensors"))
+        .expect("the shipped surrogate");
+    let exact = ExactSolver::new(
+        surrogate.info.space.clone(),
+        &repo_path("detectors/super-siegfried-k1.toml"),
+        FieldSettings::default(),
+    )
+    .expect("the shipped detector");
+    let start = PriorSpec::from_file(&repo_path("priors/b-z.toml")).expect("B_Z");
+    let volts = read_curve(&repo_path("data/super-siegfried-k1/cv.csv"), None)
+        .expect("the shipped curve")
+        .voltage_v;
+    let model: Arc<dyn CvModel> =
+        Arc::new(SurrogateModel::new(surrogate, &volts, "shipped surrogate").unwrap());
+    let mut sample = SampleSettings::for_sampler(SamplerKind::Metropolis);
+    sample.ess_min = 300.0;
+    sample.max_seconds = 60.0;
+    let mut settings = DiscoverSettings {
+        fit: FitSettings {
+            sample,
+            ..FitSettings::default()
+        },
+        only: vec![
+            "radial".into(),
+            "stray-capacitance".into(),
+            "calibration-scale".into(),
+        ],
+        draws: 500,
+        ..DiscoverSettings::default()
+    };
+    let mut report = Vec::new();
+    for (i, h) in hidden_effects().iter().enumerate() {
+        if !(h.effect == "none" || settings.only.contains(&h.effect)) {
+            continue;
+        }
+        let seed = 7 + i as u64;
+        settings.seed = seed;
+        settings.fit.sample.seed = seed;
+        let data = simulate_hidden(h, &exact, &start, &volts, seed).expect("hidden data");
+        let (d, o) = run_hidden(h, &data, model.clone(), &exact, &start, &settings, &Quiet)
+            .expect("the workflow runs");
+        report.push(format!(
+            "{}: chose {:?}, chi2/ndf {:.2} -> {:.2} (p {:.3}), scores {:?}",
+            h.effect, o.chosen, o.chi2_ndf_before, o.chi2_ndf_after, o.chi2_p_after, o.scores
+        ));
+        assert!(o.correct, "{}", report.join("\n"));
+        assert!(o.consistent, "{}", report.join("\n"));
+        if h.effect == "none" {
+            assert!(d.after.is_none() && d.summary.delta_elpd == 0.0);
+        } else {
+            // The gap shrinks: a better elpd, fewer large pulls, a plausible predictive.
+            let s = &d.summary;
+            assert!(
+                s.delta_elpd > 2.0 * s.delta_elpd_se,
+                "{}",
+                report.join("\n")
+            );
+            assert!(s.after.chi2 < s.before.chi2);
+            assert!(s.ln_bayes_factor.unwrap() >= settings.min_ln_bayes);
+        }
+    }
+    eprintln!("{}", report.join("\n"));
+}
