@@ -870,6 +870,8 @@ mod tests {
             elpd_blocks: 10,
             elpd_max_k_hat: [0.2, 0.3],
             runs: Vec::new(),
+            predictor: "exact".into(),
+            surrogate_start: gap("b-z", 3.41),
             not_applicable: Vec::new(),
             verdict: "synthetic".into(),
             program_version: "0".into(),

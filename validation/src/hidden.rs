@@ -65,17 +65,21 @@ impl HiddenEffect {
     }
 }
 
-/// The shipped set: the null case and one truth per catalogue entry, each effect a few sigma
-/// of the paper's noise where it acts (8 pF is 20% of c12 above full depletion; a 1.08 scale
-/// is 2.5 sigma at every point; y_quad = 0.02 is +15% in density at mid-height; a
-/// 2.5 mm top-bottom difference of a 3 mm Li layer).
+/// The shipped set: the null case and one truth per catalogue entry. Sizes: B_Z absorbs much
+/// of a stray capacitance and of a scale through d_Li and the y (8 pF left a chi^2 drop of 10.5
+/// and ln B 3.2, too close to the threshold), so 15 pF (40% of c12 above full depletion) and
+/// s = 1.15. Two entries are not identifiable at the paper's noise, measured: y_quad = 0.08
+/// (+70% density at mid-height, 1046 vs 859 pF at 25 V) is matched equally well by B_Z with
+/// d_Li = 0.2 mm and higher y (chi^2 58.86 vs 58.84, the LM optimum keeps y_quad ~ 0; 0.02 was
+/// absorbed the same way), and the Li slope (2.5 mm top minus bottom on 3 mm) moves no point
+/// by more than 0.43 sigma (chi^2 3.5 against the null curve).
 pub fn hidden_effects() -> Vec<HiddenEffect> {
     vec![
         HiddenEffect::new("none", &[]),
         HiddenEffect::new("radial", &RADIAL_TRUTH),
-        HiddenEffect::new("stray-capacitance", &[("c_stray_pf", 8.0)]),
-        HiddenEffect::new("calibration-scale", &[("cal_scale", 1.08)]),
-        HiddenEffect::new("quadratic-z", &[("y_quad", 0.02)]),
+        HiddenEffect::new("stray-capacitance", &[("c_stray_pf", 15.0)]),
+        HiddenEffect::new("calibration-scale", &[("cal_scale", 1.15)]),
+        HiddenEffect::new("quadratic-z", &[("y_quad", 0.08)]),
         HiddenEffect::new("li-slope", &[("d_li_slope_mm", 2.5)]),
     ]
 }
@@ -122,7 +126,8 @@ pub fn hidden_curve(
         let base = Baseline {
             spec: start,
             mode: &theta0,
-            surrogate: model,
+            model,
+            predictor: hpge_inference::Predictor::Exact,
             exact,
         };
         let c = ext.build(&base).map_err(argument)?;

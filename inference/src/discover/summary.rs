@@ -118,6 +118,11 @@ pub struct DiscoverySummary {
     /// Every run of same-sign residuals of the start model (the flagged ones are in
     /// `disagreement`).
     pub runs: Vec<Window>,
+    /// What computed the start model and the candidates (`exact`, or `surrogate` with the
+    /// exact solver only for entries outside its space).
+    pub predictor: String,
+    /// The start model's MCMC fit on the surrogate (it seeds the exact quick fit).
+    pub surrogate_start: Gap,
     /// Entries that do not apply to this start model or detector.
     pub not_applicable: Vec<NotApplicable>,
     /// The decision in words.

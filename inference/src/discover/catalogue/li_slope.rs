@@ -106,7 +106,7 @@ impl Extension for LiSlope {
     }
 
     fn build(&self, base: &Baseline) -> std::result::Result<Candidate, String> {
-        let volts = base.surrogate.voltages();
+        let volts = base.model.voltages();
         let model = ExactVariant::new(
             base.exact,
             volts,

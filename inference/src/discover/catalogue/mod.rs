@@ -57,8 +57,11 @@ pub struct Baseline<'a> {
     pub spec: &'a PriorSpec,
     /// The start fit's global mode, in `spec`'s parameter order.
     pub mode: &'a [f64],
-    /// The start model's predictor (the surrogate).
-    pub surrogate: Arc<dyn CvModel>,
+    /// The start model's predictor: the surrogate, or the exact solver (then every entry
+    /// runs on the exact solver).
+    pub model: Arc<dyn CvModel>,
+    /// Which of the two `model` is.
+    pub predictor: Predictor,
     /// The exact solver on the surrogate's space and detector.
     pub exact: &'a ExactSolver,
 }

@@ -48,7 +48,7 @@ impl Extension for QuadraticZ {
     }
 
     fn build(&self, base: &Baseline) -> std::result::Result<Candidate, String> {
-        let volts = base.surrogate.voltages();
+        let volts = base.model.voltages();
         let model = ExactVariant::new(
             base.exact,
             volts,
@@ -84,9 +84,9 @@ impl Extension for QuadraticZ {
 
 /// The start mode as model inputs of the surrogate's space (for a dry run of a modifier).
 pub(super) fn base_inputs(base: &Baseline) -> std::result::Result<Vec<f64>, String> {
-    let names = base.surrogate.inputs();
-    let prior = crate::Prior::bind(base.spec, &names, &base.surrogate.domain())
-        .map_err(|e| e.to_string())?;
+    let names = base.model.inputs();
+    let prior =
+        crate::Prior::bind(base.spec, &names, &base.model.domain()).map_err(|e| e.to_string())?;
     let mut x = vec![0.0; names.len()];
     prior.expand(base.mode, &mut x);
     Ok(x)

@@ -3,7 +3,7 @@
 //! (B_Z -> B_RZ, the paper's section 8.2). The surrogate's space already holds every knot, so the
 //! start model is the candidate with all knots of a face equal.
 
-use super::{Baseline, Candidate, Extension, Predictor};
+use super::{Baseline, Candidate, Extension};
 use crate::prior::{ParameterSpec, PriorDistribution, PriorSpec};
 
 /// Prior sd of each freed knot's y around the start model's shared value: 0.5 in y is a factor
@@ -74,8 +74,8 @@ impl Extension for Radial {
             name: self.name().into(),
             description: self.description().into(),
             signature: self.signature().into(),
-            predictor: Predictor::Surrogate,
-            model: base.surrogate.clone(),
+            predictor: base.predictor,
+            model: base.model.clone(),
             spec,
             start,
             added,

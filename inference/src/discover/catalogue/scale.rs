@@ -3,7 +3,7 @@
 
 use std::sync::Arc;
 
-use super::{Baseline, Candidate, Extension, Predictor, one_more};
+use super::{Baseline, Candidate, Extension, one_more};
 use crate::Result;
 use crate::model::CvModel;
 use crate::prior::PriorDistribution;
@@ -103,11 +103,11 @@ impl Extension for CalibrationScale {
     }
 
     fn build(&self, base: &Baseline) -> std::result::Result<Candidate, String> {
-        let model = Scaled::new(base.surrogate.clone(), "cal_scale", SCALE_RANGE);
+        let model = Scaled::new(base.model.clone(), "cal_scale", SCALE_RANGE);
         Ok(one_more(
             self,
             base,
-            Predictor::Surrogate,
+            base.predictor,
             Arc::new(model),
             (
                 "cal_scale",

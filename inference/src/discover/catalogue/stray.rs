@@ -3,7 +3,7 @@
 
 use std::sync::Arc;
 
-use super::{Baseline, Candidate, Extension, Predictor, one_more};
+use super::{Baseline, Candidate, Extension, one_more};
 use crate::Result;
 use crate::model::CvModel;
 use crate::prior::PriorDistribution;
@@ -100,11 +100,11 @@ impl Extension for StrayCapacitance {
     }
 
     fn build(&self, base: &Baseline) -> std::result::Result<Candidate, String> {
-        let model = Shifted::new(base.surrogate.clone(), "c_stray_pf", STRAY_RANGE_PF);
+        let model = Shifted::new(base.model.clone(), "c_stray_pf", STRAY_RANGE_PF);
         Ok(one_more(
             self,
             base,
-            Predictor::Surrogate,
+            base.predictor,
             Arc::new(model),
             (
                 "c_stray_pf",
