@@ -6,9 +6,11 @@
 
 mod catalogue;
 mod checks;
+mod fits;
 mod laplace;
 mod region;
 mod run;
+mod settings;
 mod summary;
 
 pub use catalogue::{
@@ -20,5 +22,6 @@ pub use checks::{
 };
 pub use laplace::{LaplaceFit, LaplaceSettings, laplace_fit};
 pub use region::{Region, probed_region};
-pub use run::{DiscoverInputs, DiscoverSettings, Discovery, ModelFit, Progress, discover};
+pub use run::discover;
+pub use settings::{DiscoverInputs, DiscoverSettings, Discovery, ModelFit, Progress};
 pub use summary::{CandidateScore, Disagreement, DiscoverySummary, Gap, NotApplicable};
