@@ -3,12 +3,13 @@
 //! The physics of hpge-cv: detector descriptions (geometry, materials, contacts, passives, world),
 //! impurity-density models with their parameter transforms, and the potential with depletion,
 //! weighting potentials and the capacitance matrix, on the CPU or (the `sor` method) on a GPU
-//! through wgpu.
+//! through wgpu; the electric field, charge drift (ADL model) and pulses by Shockley-Ramo.
 //!
 //! Units at the interfaces: lengths in mm, potentials in V, impurity densities in cm^-3 (signed:
 //! positive is n-type), capacitances in pF. SI inside the numerics.
 
 mod detector;
+mod drift;
 mod error;
 mod expr;
 mod field;
@@ -23,6 +24,10 @@ pub mod constants;
 pub use detector::{
     BoundaryKind, Contact, ContactPotential, Detector, Passive, PassiveKind, Region, Semiconductor,
     World, WorldSide,
+};
+pub use drift::{
+    AdlModel, AdlParameters, AxisParameters, Carrier, ContactSignal, Drift, DriftModel,
+    DriftSample, DriftSettings, ElectricField, Pulse, StopReason, drift_carrier, pulse,
 };
 pub use error::{Error, Result};
 pub use expr::Parameters;
