@@ -21,10 +21,10 @@ pub use diagnostics::{
     Diagnostics, ess, ess_bulk, ess_tail, fold, rank_normalise, rank_rhat, split_chains, split_rhat,
 };
 pub use discover::{
-    Baseline, CalibrationScale, Candidate, CandidateScore, Disagreement, DiscoverInputs,
-    DiscoverSettings, Discovery, DiscoverySummary, Elpd, ExactVariant, Extension, Gap, LaplaceFit,
-    LaplaceSettings, LiSlope, ModelFit, NotApplicable, PredictiveDraws, Predictor, Progress,
-    QuadraticZ, Radial, Region, ResidualCheck, Scaled, Shifted, StrayCapacitance, Window,
+    Affine, AffineKind, Baseline, CalibrationScale, Candidate, CandidateScore, Disagreement,
+    DiscoverInputs, DiscoverSettings, Discovery, DiscoverySummary, Elpd, ExactVariant, Extension,
+    Gap, LaplaceFit, LaplaceSettings, LiSlope, ModelFit, NotApplicable, PredictiveDraws, Predictor,
+    Progress, QuadraticZ, Radial, Region, ResidualCheck, Scaled, Shifted, StrayCapacitance, Window,
     catalogue, delta_elpd, discover, laplace_fit, leave_window_out, probed_region, residual_check,
 };
 pub use error::{Error, Result};

@@ -127,11 +127,12 @@ pub fn run(a: &DiscoveryArgs) -> Result<()> {
             &dir.join("cv.csv"),
             &data,
             &[format!(
-                "hpge-cv {} validate discovery --seed {}: exact solver, hidden effect {} {:?}, paper noise (seed {seed})",
+                "hpge-cv {} validate discovery --seed {}: exact solver, hidden effect {} {:?}, paper noise x {} (seed {seed})",
                 env!("CARGO_PKG_VERSION"),
                 a.seed,
                 h.effect,
-                h.truth
+                h.truth,
+                h.noise_scale
             )],
         )?;
         std::fs::write(
@@ -155,10 +156,11 @@ pub fn run(a: &DiscoveryArgs) -> Result<()> {
         bar.finish_and_clear();
         write_outputs(&dir, &d, &s.exact, a.no_plots)?;
         eprintln!(
-            "hidden effect {}: chose {} ({}), chi2/ndf {:.2} -> {:.2} (p {:.3}), {:.0} s",
+            "hidden effect {}: chose {} ({}, expected {}), chi2/ndf {:.2} -> {:.2} (p {:.3}), {:.0} s",
             h.effect,
             outcome.chosen.as_deref().unwrap_or("nothing"),
             if outcome.correct { "right" } else { "WRONG" },
+            outcome.expected.as_deref().unwrap_or("nothing"),
             outcome.chi2_ndf_before,
             outcome.chi2_ndf_after,
             outcome.chi2_p_after,
@@ -185,9 +187,9 @@ pub fn run(a: &DiscoveryArgs) -> Result<()> {
     )?;
     writeln!(
         md,
-        "| hidden effect | chosen | right | chi^2/ndf before | after | chi^2 p after | best scores (ln B) |"
+        "| hidden effect | noise x | expected | chosen | right | chi^2/ndf before | after | chi^2 p after | best scores (ln B) |"
     )?;
-    writeln!(md, "|---|---|---|---|---|---|---|")?;
+    writeln!(md, "|---|---|---|---|---|---|---|---|---|")?;
     for o in &study.outcomes {
         let scores: Vec<String> = o
             .scores
@@ -197,8 +199,10 @@ pub fn run(a: &DiscoveryArgs) -> Result<()> {
             .collect();
         writeln!(
             md,
-            "| {} | {} | {} | {:.2} | {:.2} | {:.3} | {} |",
+            "| {} | {} | {} | {} | {} | {:.2} | {:.2} | {:.3} | {} |",
             o.effect,
+            o.noise_scale,
+            o.expected.as_deref().unwrap_or("none"),
             o.chosen.as_deref().unwrap_or("none"),
             if o.correct { "yes" } else { "**no**" },
             o.chi2_ndf_before,

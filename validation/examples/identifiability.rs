@@ -37,6 +37,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let h = HiddenEffect {
             effect: args[0].clone(),
             truth: BTreeMap::from([(args[1].clone(), value)]),
+            noise_scale: 1.0,
+            identifiable: true,
         };
         let c = hidden_curve(&h, &exact, &start, &volts)?;
         let data = CvData {

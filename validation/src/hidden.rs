@@ -54,6 +54,14 @@ pub struct HiddenEffect {
     pub effect: String,
     /// Truth values of the entry's parameters (the rest is [`BASE_TRUTH`]).
     pub truth: BTreeMap<String, f64>,
+    /// Factor on every term of the paper's noise model, in the data and in the likelihood (1:
+    /// the paper's noise; below 1: a more precise measurement, for effects the paper's noise
+    /// cannot show).
+    pub noise_scale: f64,
+    /// Whether the data can show the effect: false where the start model imitates the effect's
+    /// curve to within the noise (measured with `examples/identifiability.rs`); the workflow
+    /// must then add nothing, since any choice would be a guess.
+    pub identifiable: bool,
 }
 
 impl HiddenEffect {
@@ -61,26 +69,61 @@ impl HiddenEffect {
         Self {
             effect: effect.into(),
             truth: truth.iter().map(|(k, v)| ((*k).into(), *v)).collect(),
+            noise_scale: 1.0,
+            identifiable: true,
+        }
+    }
+
+    /// Marks an effect the data cannot show (see [`Self::identifiable`]).
+    fn invisible(mut self) -> Self {
+        self.identifiable = false;
+        self
+    }
+
+    /// What the workflow should add: the effect, or nothing (the null case, or an effect the
+    /// data cannot show).
+    pub fn expected(&self) -> Option<String> {
+        (self.effect != "none" && self.identifiable).then(|| self.effect.clone())
+    }
+
+    fn with_noise_scale(mut self, scale: f64) -> Self {
+        self.noise_scale = scale;
+        self
+    }
+
+    /// `noise` with every term multiplied by [`Self::noise_scale`].
+    pub fn noise(&self, noise: NoiseSettings) -> NoiseSettings {
+        NoiseSettings {
+            measurement_rel: noise.measurement_rel * self.noise_scale,
+            solver_rel: noise.solver_rel * self.noise_scale,
+            solver_abs_pf: noise.solver_abs_pf * self.noise_scale,
+            ..noise
         }
     }
 }
 
-/// The shipped set: the null case and one truth per catalogue entry. Sizes: B_Z absorbs much
-/// of a stray capacitance and of a scale through d_Li and the y (8 pF left a chi^2 drop of 10.5
-/// and ln B 3.2, too close to the threshold), so 15 pF (40% of c12 above full depletion) and
-/// s = 1.15. Two entries are not identifiable at the paper's noise, measured: y_quad = 0.08
-/// (+70% density at mid-height, 1046 vs 859 pF at 25 V) is matched equally well by B_Z with
-/// d_Li = 0.2 mm and higher y (chi^2 58.86 vs 58.84, the LM optimum keeps y_quad ~ 0; 0.02 was
-/// absorbed the same way), and the Li slope (2.5 mm top minus bottom on 3 mm) moves no point
-/// by more than 0.43 sigma (chi^2 3.5 against the null curve).
+/// The shipped set: the null case and one truth per catalogue entry. Sizes, measured with
+/// `examples/identifiability.rs` (B_Z's smallest chi^2 against the noiseless exact curve, i.e.
+/// the chi^2 the effect leaves once B_Z has absorbed what it can):
+///
+/// - stray capacitance 15 pF and calibration scale 1.15: B_Z absorbs much through d_Li and the y
+///   (8 pF left a chi^2 drop of 10.5 and ln B 3.2, too close to the threshold);
+/// - quadratic z term: a positive y_quad raises the density at mid-height, which B_Z imitates
+///   with a thinner Li layer and higher y (0.08: chi^2 58.86 vs 58.84 on noisy data; 0.15:
+///   0.66 noiseless). A negative one is partly visible (-0.08: 5.0; -0.15: 7.7 at the paper's
+///   noise), so the data set is y_quad = -0.15 measured at half the paper's noise (chi^2 ~31);
+/// - Li slope: B_Z imitates a 2.5 mm top-minus-bottom slope with d_Li 2.75 mm to chi^2 0.02
+///   (c12 depends on the layer through its mean thickness to first order; the rest is
+///   quadratic in the slope). No realistic measurement can show it, so the workflow must add
+///   nothing there.
 pub fn hidden_effects() -> Vec<HiddenEffect> {
     vec![
         HiddenEffect::new("none", &[]),
         HiddenEffect::new("radial", &RADIAL_TRUTH),
         HiddenEffect::new("stray-capacitance", &[("c_stray_pf", 15.0)]),
         HiddenEffect::new("calibration-scale", &[("cal_scale", 1.15)]),
-        HiddenEffect::new("quadratic-z", &[("y_quad", 0.08)]),
-        HiddenEffect::new("li-slope", &[("d_li_slope_mm", 2.5)]),
+        HiddenEffect::new("quadratic-z", &[("y_quad", -0.15)]).with_noise_scale(0.5),
+        HiddenEffect::new("li-slope", &[("d_li_slope_mm", 2.5)]).invisible(),
     ]
 }
 
@@ -149,8 +192,9 @@ pub fn hidden_curve(
     Ok(c)
 }
 
-/// The paper's noise model without the surrogate term, for a curve at `volts`.
-fn measurement_noise(volts: &[f64], c: &[f64]) -> Result<Likelihood> {
+/// The paper's noise model without the surrogate term (times `h`'s noise scale), for a curve at
+/// `volts`.
+fn measurement_noise(h: &HiddenEffect, volts: &[f64], c: &[f64]) -> Result<Likelihood> {
     let data = CvData {
         voltage_v: volts.to_vec(),
         c12_pf: c.to_vec(),
@@ -158,7 +202,11 @@ fn measurement_noise(volts: &[f64], c: &[f64]) -> Result<Likelihood> {
         covariance_pf2: None,
         source: PathBuf::from("(hidden effect)"),
     };
-    Ok(Likelihood::new(&data, NoiseSettings::default(), 0.0)?)
+    Ok(Likelihood::new(
+        &data,
+        h.noise(NoiseSettings::default()),
+        0.0,
+    )?)
 }
 
 /// A simulated measurement of `h`: the exact curve plus the paper's measurement noise, seeded.
@@ -170,7 +218,7 @@ pub fn simulate_hidden(
     seed: u64,
 ) -> Result<CvData> {
     let c = hidden_curve(h, exact, start, volts)?;
-    let noise = measurement_noise(volts, &c)?;
+    let noise = measurement_noise(h, volts, &c)?;
     let c_m = noise.simulate(&c, &mut StdRng::seed_from_u64(seed));
     Ok(CvData {
         voltage_v: volts.to_vec(),
@@ -186,9 +234,14 @@ pub fn simulate_hidden(
 pub struct HiddenOutcome {
     /// The hidden effect (`none`: the null case).
     pub effect: String,
+    /// The hidden effect's noise scale.
+    pub noise_scale: f64,
     /// What the workflow added (null: nothing).
     pub chosen: Option<String>,
-    /// Whether that is the hidden effect (or nothing in the null case).
+    /// What the workflow should add ([`HiddenEffect::expected`]).
+    pub expected: Option<String>,
+    /// Whether it concluded that: the hidden effect, or nothing in the null case and where the
+    /// data cannot show the effect.
     pub correct: bool,
     /// chi^2/ndf after (the start model's when nothing was added).
     pub chi2_ndf_after: f64,
@@ -220,6 +273,9 @@ pub fn run_hidden(
     progress: &dyn Progress,
 ) -> Result<(Discovery, HiddenOutcome)> {
     let t0 = Instant::now();
+    let mut settings = settings.clone();
+    settings.fit.noise = h.noise(settings.fit.noise);
+    let settings = &settings;
     let likelihood = Likelihood::new(data, settings.fit.noise, surrogate.sigma_rel())?;
     let mut inputs = BTreeMap::new();
     inputs.insert("data".into(), format!("hidden effect {}", h.effect));
@@ -235,14 +291,16 @@ pub fn run_hidden(
         progress,
     )?;
     let s = &d.summary;
-    let expected = (h.effect != "none").then(|| h.effect.clone());
+    let expected = h.expected();
     let ndf = s.after.ndf.max(1);
     let chi2 = ChiSquared::new(ndf as f64).map_err(|e| argument(e.to_string()))?;
     let lower = chi2.cdf(s.after.chi2);
     let p = 2.0 * lower.min(1.0 - lower);
     let outcome = HiddenOutcome {
         effect: h.effect.clone(),
+        noise_scale: h.noise_scale,
         correct: s.chosen == expected,
+        expected,
         chosen: s.chosen.clone(),
         chi2_ndf_after: s.after.chi2_ndf,
         ndf_after: s.after.ndf,

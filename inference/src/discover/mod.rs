@@ -14,8 +14,8 @@ mod settings;
 mod summary;
 
 pub use catalogue::{
-    Baseline, CalibrationScale, Candidate, ExactVariant, Extension, LiSlope, Predictor, QuadraticZ,
-    Radial, Scaled, Shifted, StrayCapacitance, catalogue,
+    Affine, AffineKind, Baseline, CalibrationScale, Candidate, ExactVariant, Extension, LiSlope,
+    Predictor, QuadraticZ, Radial, Scaled, Shifted, StrayCapacitance, catalogue,
 };
 pub use checks::{
     Elpd, PredictiveDraws, ResidualCheck, Window, delta_elpd, leave_window_out, residual_check,

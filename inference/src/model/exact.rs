@@ -42,6 +42,21 @@ impl ExactModel {
     }
 }
 
+/// An error naming the first input of `x` outside its `domain` interval (NaN included).
+pub(crate) fn check_domain(names: &[String], domain: &[[f64; 2]], x: &[f64]) -> Result<()> {
+    for (k, (&v, r)) in x.iter().zip(domain).enumerate() {
+        if !(v >= r[0] && v <= r[1]) {
+            return Err(Error::Surrogate(hpge_surrogate::Error::OutsideDomain {
+                name: names[k].clone(),
+                value: v,
+                lo: r[0],
+                hi: r[1],
+            }));
+        }
+    }
+    Ok(())
+}
+
 impl CvModel for ExactModel {
     fn inputs(&self) -> Vec<String> {
         self.names.clone()
@@ -60,16 +75,7 @@ impl CvModel for ExactModel {
     }
 
     fn curve(&self, x: &[f64], c_pf: &mut [f64]) -> Result<()> {
-        for (k, (&v, r)) in x.iter().zip(&self.domain).enumerate() {
-            if !(v >= r[0] && v <= r[1]) {
-                return Err(Error::Surrogate(hpge_surrogate::Error::OutsideDomain {
-                    name: self.names[k].clone(),
-                    value: v,
-                    lo: r[0],
-                    hi: r[1],
-                }));
-            }
-        }
+        check_domain(&self.names, &self.domain, x)?;
         let c = self.solver.curve(x, &self.volts)?;
         c_pf.copy_from_slice(&c);
         Ok(())

@@ -6,6 +6,7 @@ mod exact;
 mod surrogate;
 
 pub use exact::ExactModel;
+pub(crate) use exact::check_domain;
 pub use surrogate::SurrogateModel;
 
 use crate::Result;

@@ -139,6 +139,7 @@ fn synthetic(extended: bool) -> Discovery {
         r_mm: r,
         z_mm: z,
         nodes: 100,
+        volume_cm3: 50.0,
     };
     let disagreement = if extended {
         vec![

@@ -5,7 +5,7 @@
 use hpge_solver::{Detector, cv_curve};
 use hpge_surrogate::ExactSolver;
 
-use crate::model::CvModel;
+use crate::model::{CvModel, check_domain};
 use crate::{Error, Result};
 
 /// Applies an extension's values (`extra`, in the order of [`ExactVariant`]'s added inputs) to a
@@ -82,16 +82,7 @@ impl CvModel for ExactVariant {
 
     /// c12 (pF) from the field solver ([`cv_curve`]) on the modified detector.
     fn curve(&self, x: &[f64], c_pf: &mut [f64]) -> Result<()> {
-        for (k, (&v, r)) in x.iter().zip(&self.domain).enumerate() {
-            if !(v >= r[0] && v <= r[1]) {
-                return Err(Error::Surrogate(hpge_surrogate::Error::OutsideDomain {
-                    name: self.names[k].clone(),
-                    value: v,
-                    lo: r[0],
-                    hi: r[1],
-                }));
-            }
-        }
+        check_domain(&self.names, &self.domain, x)?;
         let det = self.detector(x)?;
         let curve = cv_curve(&det, &self.volts, &self.solver.settings, |_, _| {})
             .map_err(|e| Error::Surrogate(e.into()))?;

@@ -8,6 +8,7 @@
 //! candidate at the effect's null value, so the two nest). Entries that need predictions the
 //! surrogate was not trained for run on the exact field solver ([`Predictor::Exact`]).
 
+mod affine;
 mod exact_variant;
 mod li_slope;
 mod quadratic_z;
@@ -20,12 +21,13 @@ use std::sync::Arc;
 use hpge_surrogate::ExactSolver;
 use serde::Serialize;
 
+pub use affine::{Affine, AffineKind, Scaled, Shifted};
 pub use exact_variant::ExactVariant;
 pub use li_slope::LiSlope;
 pub use quadratic_z::QuadraticZ;
 pub use radial::Radial;
-pub use scale::{CalibrationScale, Scaled};
-pub use stray::{Shifted, StrayCapacitance};
+pub use scale::CalibrationScale;
+pub use stray::StrayCapacitance;
 
 use crate::model::CvModel;
 use crate::prior::{ParameterSpec, PriorDistribution, PriorSpec};

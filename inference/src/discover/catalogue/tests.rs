@@ -82,8 +82,8 @@ fn shifted_and_scaled_curves_and_jacobians() {
     let toy: Arc<dyn CvModel> = Arc::new(Toy {
         volts: vec![1.0, 2.0, 3.0],
     });
-    let sh = Shifted::new(toy.clone(), "c_s", [-5.0, 5.0]);
-    let sc = Scaled::new(toy, "s", [0.5, 2.0]);
+    let sh = Shifted::shift(toy.clone(), "c_s", [-5.0, 5.0]);
+    let sc = Scaled::scale(toy, "s", [0.5, 2.0]);
     assert_eq!(sh.inputs(), ["a", "b", "c_s"]);
     assert_eq!(sc.domain()[2], [0.5, 2.0]);
     assert_eq!(sh.sigma_rel(), 0.01);
