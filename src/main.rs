@@ -5,6 +5,7 @@
 //! exits with code 3.
 
 mod cli;
+mod paper;
 mod plot;
 
 use std::process::ExitCode;

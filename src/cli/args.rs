@@ -31,6 +31,68 @@ pub fn parse_point(text: &str) -> Result<(f64, f64), String> {
     Ok((r, z))
 }
 
+/// Parses "R,PHI,Z" (mm, degrees, mm) as given to `pulse --at`; returns (r mm, phi deg, z mm).
+pub fn parse_cylindrical(text: &str) -> Result<(f64, f64, f64), String> {
+    let parts: Vec<&str> = text.split(',').collect();
+    if parts.len() != 3 {
+        return Err(format!(
+            "expected R,PHI,Z (mm, degrees, mm; e.g. 37,30,35), got `{text}`"
+        ));
+    }
+    let mut v = [0.0f64; 3];
+    for (k, (s, what)) in parts.iter().zip(["R", "PHI", "Z"]).enumerate() {
+        v[k] = s
+            .trim()
+            .parse()
+            .map_err(|_| format!("{what} `{}` in `{text}` is not a number", s.trim()))?;
+        if !v[k].is_finite() {
+            return Err(format!("{what} in `{text}` must be finite"));
+        }
+    }
+    if v[0] < 0.0 {
+        return Err(format!(
+            "R must be >= 0 mm (r is the distance from the axis), got {}",
+            v[0]
+        ));
+    }
+    Ok((v[0], v[1], v[2]))
+}
+
+/// A parsed `--r-range LO:HI:N`: N radii (mm) evenly from LO to HI inclusive.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RadiusRange(pub Vec<f64>);
+
+/// Parses "LO:HI:N" (mm, N >= 2 points, LO < HI, LO >= 0).
+pub fn parse_r_range(text: &str) -> Result<RadiusRange, String> {
+    let parts: Vec<&str> = text.split(':').collect();
+    if parts.len() != 3 {
+        return Err(format!("expected LO:HI:N (mm, mm, count), got `{text}`"));
+    }
+    let num = |s: &str| -> Result<f64, String> {
+        s.trim()
+            .parse::<f64>()
+            .ok()
+            .filter(|v| v.is_finite())
+            .ok_or_else(|| format!("`{}` in `{text}` is not a finite number", s.trim()))
+    };
+    let (lo, hi) = (num(parts[0])?, num(parts[1])?);
+    let n: usize = parts[2]
+        .trim()
+        .parse()
+        .map_err(|_| format!("N `{}` in `{text}` is not a whole number", parts[2].trim()))?;
+    if lo < 0.0 || hi <= lo {
+        return Err(format!("need 0 <= LO < HI in `{text}`"));
+    }
+    if !(2..=100_000).contains(&n) {
+        return Err(format!("N in `{text}` must be between 2 and 100000"));
+    }
+    Ok(RadiusRange(
+        (0..n)
+            .map(|k| lo + (hi - lo) * k as f64 / (n - 1) as f64)
+            .collect(),
+    ))
+}
+
 /// Parses a voltage list: "START:STOP:STEP" (inclusive of STOP when it falls on the step) or
 /// "V1,V2,...". Values are checked (finite, positive) and sorted by the caller.
 pub fn parse_voltages(text: &str) -> Result<VoltageList, String> {
@@ -124,5 +186,23 @@ mod tests {
         assert!(parse_point("a,1").unwrap_err().contains("not a number"));
         assert!(parse_point("-1,1").unwrap_err().contains("R must be >= 0"));
         assert!(parse_point("1,nan").unwrap_err().contains("finite"));
+    }
+
+    #[test]
+    fn cylindrical_points_and_radius_ranges() {
+        assert_eq!(parse_cylindrical("37,30,35").unwrap(), (37.0, 30.0, 35.0));
+        assert!(parse_cylindrical("37,30").unwrap_err().contains("R,PHI,Z"));
+        assert!(parse_cylindrical("37,x,35").unwrap_err().contains("PHI"));
+        assert!(
+            parse_cylindrical("-1,0,35")
+                .unwrap_err()
+                .contains("R must be")
+        );
+        let r = parse_r_range("0:10:11").unwrap().0;
+        assert_eq!(r.len(), 11);
+        assert!((r[3] - 3.0).abs() < 1e-12);
+        assert!(parse_r_range("5:1:10").is_err());
+        assert!(parse_r_range("0:1:1").is_err());
+        assert!(parse_r_range("0:1").is_err());
     }
 }

@@ -4,12 +4,15 @@ mod args;
 mod detector;
 mod discover;
 mod discover_report;
-mod fit;
+pub(crate) mod drift_common;
+pub(crate) mod field;
+pub(crate) mod fit;
 mod fit_outputs;
 mod fit_report;
 mod generate;
 mod impurity;
 mod measure;
+mod pulse;
 mod sensitivity;
 mod simulate;
 mod surrogate;
@@ -45,6 +48,19 @@ enum Command {
     Simulate(SimulateArgs),
     /// The full Maxwell capacitance matrix at one bias.
     Capacitance(CapacitanceArgs),
+    /// The charge signals of one interaction at (r, phi, z): electron and hole drifted with the
+    /// ADL model through the field at one bias, induced charges on every contact (Shockley-Ramo).
+    Pulse(pulse::PulseArgs),
+    /// The electric-field strength |E| along r at one (phi, z) and bias.
+    Field(field::FieldArgs),
+    /// The paper's section 9 (field strength along r and normalised n+ pulses for three impurity
+    /// models at 3000 V) into a folder; `report paper` will call it.
+    #[command(hide = true)]
+    PaperSection9 {
+        /// Output folder.
+        #[arg(long, value_name = "DIR", default_value = "reports/section9")]
+        out: PathBuf,
+    },
     /// c12 at one bias for constant impurity densities (the paper's sensitivity scan).
     Sensitivity(SensitivityArgs),
     /// Raw pulser data (a directory of .npy pulse files) to a C-V curve with its covariance.
@@ -693,6 +709,14 @@ pub fn run(cli: Cli) -> Result<()> {
             })
         }
         Command::Discover(a) => discover::run(&a),
+        Command::Pulse(a) => pulse::run(&a),
+        Command::Field(a) => field::run(&a),
+        Command::PaperSection9 { out } => {
+            for f in crate::paper::section9(&out, &crate::paper::Section9Inputs::default())? {
+                eprintln!("wrote {}", f.display());
+            }
+            Ok(())
+        }
         Command::Validate(v) => match v.study {
             ValidateStudy::Discovery(a) => validate_discovery::run(&a),
             ValidateStudy::Coverage(a) => {

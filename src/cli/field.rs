@@ -1,0 +1,199 @@
+//! `hpge-cv field`: the electric-field strength |E| along r at one (phi, z) and bias (paper
+//! Fig. 12a); null where the volume is undepleted, a contact or outside the crystal.
+
+use std::io::Write as _;
+use std::path::PathBuf;
+
+use anyhow::{Context, Result, bail};
+use hpge_solver::{Detector, ElectricField};
+use serde_json::json;
+
+use super::args::{RadiusRange, load_detector, parse_r_range};
+use super::drift_common::{PointStatus, point_status};
+use super::simulate::backend_json;
+use super::{DetectorInput, SolverArgs, WeightingArg};
+use crate::plot;
+
+/// V/m per V/cm.
+const V_PER_M_PER_V_PER_CM: f64 = 100.0;
+
+#[derive(Debug, clap::Args)]
+pub struct FieldArgs {
+    #[command(flatten)]
+    input: DetectorInput,
+    /// Bias voltage U_B in V (positive).
+    #[arg(long, value_name = "U", allow_hyphen_values = true)]
+    voltage: f64,
+    /// Azimuth phi in degrees (the field of the axisymmetric model does not depend on it; it
+    /// sets the direction of E in the lab frame).
+    #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
+    phi: f64,
+    /// Height z in mm.
+    #[arg(long, value_name = "Z", allow_hyphen_values = true)]
+    z: f64,
+    /// Radii LO:HI:N in mm (N points, ends included) [default: the crystal's r extent, 201 points].
+    #[arg(long = "r-range", value_name = "LO:HI:N", value_parser = parse_r_range)]
+    r_range: Option<RadiusRange>,
+    #[command(flatten)]
+    solver: SolverArgs,
+    /// Print exactly one JSON object on stdout (|E| null where there is no field).
+    #[arg(long)]
+    json: bool,
+    /// Draw |E| against r (.svg or .png); gaps where there is no field.
+    #[arg(long, value_name = "FILE")]
+    plot: Option<PathBuf>,
+    /// Write r_mm, |E| (V/cm, empty where there is no field) and the status as CSV.
+    #[arg(long, value_name = "FILE")]
+    out: Option<PathBuf>,
+}
+
+/// |E| along r with the status of every radius.
+pub struct FieldLine {
+    /// Radii, mm.
+    pub r_mm: Vec<f64>,
+    /// |E| in V/m; `None` where there is no field.
+    pub e_v_per_m: Vec<Option<f64>>,
+    /// Where each radius lies.
+    pub status: Vec<PointStatus>,
+}
+
+/// |E| at `r_mm` for (phi, z) in the field of one bias point.
+pub fn field_line(
+    det: &Detector,
+    field: &ElectricField,
+    phi_rad: f64,
+    z_mm: f64,
+    r_mm: &[f64],
+) -> FieldLine {
+    FieldLine {
+        r_mm: r_mm.to_vec(),
+        e_v_per_m: field.magnitude_along_r(phi_rad, z_mm, r_mm),
+        status: r_mm
+            .iter()
+            .map(|&r| point_status(det, field, r, z_mm))
+            .collect(),
+    }
+}
+
+/// Runs `field`.
+pub fn run(a: &FieldArgs) -> Result<()> {
+    if let Some(p) = &a.plot {
+        plot::check_output(p, "--plot")?;
+    }
+    if !(a.voltage.is_finite() && a.voltage > 0.0) {
+        bail!(
+            "--voltage {}: the bias must be a positive number of volts",
+            a.voltage
+        );
+    }
+    for (flag, v) in [("--phi", a.phi), ("--z", a.z)] {
+        if !v.is_finite() {
+            bail!("{flag} {v}: must be a finite number");
+        }
+    }
+    let det = load_detector(&a.input)?;
+    let b = det.semiconductor.geometry.bbox();
+    if a.z < b.z_min_mm || a.z > b.z_max_mm {
+        bail!(
+            "--z {}: the crystal spans z in [{}, {}] mm",
+            a.z,
+            b.z_min_mm,
+            b.z_max_mm
+        );
+    }
+    let r_mm = match &a.r_range {
+        Some(RadiusRange(r)) => r.clone(),
+        None => (0..201)
+            .map(|k| b.r_min_mm + (b.r_max_mm - b.r_min_mm) * k as f64 / 200.0)
+            .collect(),
+    };
+    let settings = a.solver.settings(WeightingArg::Conductor);
+    backend_json(&settings)?;
+    let point = hpge_solver::solve_point(&det, a.voltage, &settings, None)?;
+    let field = ElectricField::new(&det, &point);
+    let line = field_line(&det, &field, a.phi.to_radians(), a.z, &r_mm);
+    let v_cm: Vec<Option<f64>> = line
+        .e_v_per_m
+        .iter()
+        .map(|e| e.map(|e| e / V_PER_M_PER_V_PER_CM))
+        .collect();
+    let provenance = format!(
+        "hpge-cv {} field: detector {} impurity {} parameters [{}] U_B {} V, phi {} deg, z {} mm",
+        env!("CARGO_PKG_VERSION"),
+        det.file.display(),
+        det.semiconductor.impurity_file().display(),
+        det.parameters
+            .iter()
+            .map(|(k, v)| format!("{k}={v}"))
+            .collect::<Vec<_>>()
+            .join(" "),
+        a.voltage,
+        a.phi,
+        a.z
+    );
+    if let Some(path) = &a.out {
+        let ctx = || format!("--out {}: cannot write the file", path.display());
+        let mut f = std::io::BufWriter::new(std::fs::File::create(path).with_context(ctx)?);
+        writeln!(f, "# {provenance}").with_context(ctx)?;
+        writeln!(f, "r_mm,e_V_per_cm,status").with_context(ctx)?;
+        for ((r, e), s) in line.r_mm.iter().zip(&v_cm).zip(&line.status) {
+            let e = e.map_or(String::new(), |e| e.to_string());
+            writeln!(f, "{r},{e},{}", s.as_str()).with_context(ctx)?;
+        }
+        f.flush().with_context(ctx)?;
+    }
+    if let Some(path) = &a.plot {
+        let fig = plot::LineFigure {
+            title: format!(
+                "{}: |E| at phi = {} deg, z = {} mm, U_B = {} V",
+                det.name, a.phi, a.z, a.voltage
+            ),
+            x_desc: "r (mm)".into(),
+            y_desc: "|E| (V/cm)".into(),
+            curves: vec![plot::Curve {
+                label: det.semiconductor.impurity_file().display().to_string(),
+                points: line
+                    .r_mm
+                    .iter()
+                    .copied()
+                    .zip(v_cm.iter().copied())
+                    .collect(),
+            }],
+            y_from_zero: true,
+            legend: plot::Corner::LowerRight,
+            footnotes: vec![
+                provenance.clone(),
+                "gaps: undepleted, contact or outside the crystal".into(),
+            ],
+        };
+        plot::line_figure(&fig, path)?;
+    }
+    if a.json {
+        let v = json!({
+            "r_mm": line.r_mm,
+            "e_V_per_m": line.e_v_per_m,
+            "e_V_per_cm": v_cm,
+            "status": line.status.iter().map(|s| s.as_str()).collect::<Vec<_>>(),
+            "phi_deg": a.phi,
+            "z_mm": a.z,
+            "voltage_V": a.voltage,
+            "fully_depleted": point.fully_depleted(),
+            "detector": det.file.display().to_string(),
+            "impurity_file": det.semiconductor.impurity_file().display().to_string(),
+            "parameters": det.parameters.iter().collect::<std::collections::BTreeMap<_, _>>(),
+            "version": env!("CARGO_PKG_VERSION"),
+        });
+        println!("{v}");
+    } else {
+        println!(
+            "|E| at phi = {} deg, z = {} mm, U_B = {} V ({})",
+            a.phi, a.z, a.voltage, det.name
+        );
+        println!("{:>10} {:>14} {:>11}", "r (mm)", "|E| (V/cm)", "status");
+        for ((r, e), s) in line.r_mm.iter().zip(&v_cm).zip(&line.status) {
+            let e = e.map_or("-".to_string(), |e| format!("{e:.1}"));
+            println!("{r:>10.3} {e:>14} {:>11}", s.as_str());
+        }
+    }
+    Ok(())
+}

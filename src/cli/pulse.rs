@@ -1,0 +1,302 @@
+//! `hpge-cv pulse`: the charge signals of one interaction (paper section 9): the field at one
+//! bias, an electron and a hole drifted with the ADL model, Shockley-Ramo signals on every
+//! contact.
+
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, bail};
+use hpge_solver::{AdlModel, AdlParameters, Detector, DriftSettings, ElectricField, Pulse};
+use serde_json::json;
+
+use super::args::{load_detector, parse_cylindrical};
+use super::drift_common::{
+    check_interaction_point, drift_json, normalise, read_adl_parameters, reference_contact,
+    rise_time_10_90_ns, stop_text,
+};
+use super::simulate::backend_json;
+use super::{DetectorInput, SolverArgs, WeightingArg};
+use crate::plot;
+
+#[derive(Debug, clap::Args)]
+pub struct PulseArgs {
+    #[command(flatten)]
+    input: DetectorInput,
+    /// Bias voltage U_B in V (positive).
+    #[arg(long, value_name = "U", allow_hyphen_values = true)]
+    voltage: f64,
+    /// The interaction point "R,PHI,Z": r in mm, azimuth phi in degrees, z in mm (e.g. 37,30,35).
+    #[arg(long, value_name = "R,PHI,Z", allow_hyphen_values = true, value_parser = parse_cylindrical)]
+    at: (f64, f64, f64),
+    #[command(flatten)]
+    solver: SolverArgs,
+    /// ADL drift-model parameters (TOML with the keys of the published defaults: e100, e111,
+    /// h100, h111 tables of mu0_cm2_per_vs, beta, e0_v_per_cm, mun_cm2_per_vs; ml_over_me,
+    /// mt_over_me, phi110_deg); missing keys keep the published 78 K values.
+    #[arg(long = "drift-parameters", value_name = "FILE")]
+    drift_parameters: Option<PathBuf>,
+    /// Divide every signal by the end value of the bias (n+) contact's signal, so that it ends at
+    /// exactly +1 (without this, signals are in units of the pair charge and the bias contact
+    /// ends at +1 only for complete collection).
+    #[arg(long)]
+    normalise: bool,
+    /// Print exactly one JSON object on stdout: t_ns, contacts [{name, signal}],
+    /// collection_time_ns, how each carrier stopped, inputs and version.
+    #[arg(long)]
+    json: bool,
+    /// Draw the signals of every contact against time (.svg or .png).
+    #[arg(long, value_name = "FILE")]
+    plot: Option<PathBuf>,
+    /// Write the signals as CSV (t_ns, then one column per contact; first line: provenance).
+    #[arg(long, value_name = "FILE")]
+    out: Option<PathBuf>,
+}
+
+/// Runs `pulse`.
+pub fn run(a: &PulseArgs) -> Result<()> {
+    if let Some(p) = &a.plot {
+        plot::check_output(p, "--plot")?;
+    }
+    if let Some(p) = &a.out
+        && let Some(dir) = p.parent().filter(|d| !d.as_os_str().is_empty())
+        && !dir.is_dir()
+    {
+        bail!(
+            "--out {}: the folder {} does not exist",
+            p.display(),
+            dir.display()
+        );
+    }
+    if !(a.voltage.is_finite() && a.voltage > 0.0) {
+        bail!(
+            "--voltage {}: the bias must be a positive number of volts",
+            a.voltage
+        );
+    }
+    let adl = match &a.drift_parameters {
+        Some(p) => read_adl_parameters(p, "--drift-parameters")?,
+        None => AdlParameters::default(),
+    };
+    let model =
+        AdlModel::new(adl.clone()).map_err(|m| anyhow::anyhow!("--drift-parameters: {m}"))?;
+    let det = load_detector(&a.input)?;
+    if det.bias_contacts().is_empty() {
+        bail!(
+            "{}: no contact has potential = \"bias\", so the bias voltage acts on nothing",
+            det.file.display()
+        );
+    }
+    let (r_mm, phi_deg, z_mm) = a.at;
+    let flag = format!("--at {r_mm},{phi_deg},{z_mm}");
+    // Cheap geometric checks before the field solve.
+    if let hpge_solver::Region::Contact(i) = det.classify(r_mm, z_mm) {
+        bail!(
+            "{flag}: (r, z) = ({r_mm}, {z_mm}) mm is inside the contact `{}`; an interaction must be in the depleted crystal",
+            det.contacts[i].name
+        );
+    }
+    let settings = a.solver.settings(WeightingArg::Conductor);
+    backend_json(&settings)?;
+    let point = hpge_solver::solve_point(&det, a.voltage, &settings, None)?;
+    let field = ElectricField::new(&det, &point);
+    check_interaction_point(&det, &point, &field, (r_mm, z_mm), &flag)?;
+    let drift = DriftSettings::default();
+    let mut p = hpge_solver::pulse(
+        &det,
+        &point,
+        &model,
+        (r_mm, phi_deg.to_radians(), z_mm),
+        &drift,
+    )?;
+    let k_ref = reference_contact(&det);
+    let divisor = if a.normalise {
+        Some(normalise(&mut p, k_ref)?)
+    } else {
+        None
+    };
+    let provenance = Provenance {
+        det: &det,
+        voltage_v: a.voltage,
+        at: a.at,
+        drift_file: a.drift_parameters.as_deref(),
+        normalised: a.normalise,
+    };
+    if let Some(path) = &a.out {
+        write_csv(path, &p, &provenance)?;
+    }
+    if let Some(path) = &a.plot {
+        plot::line_figure(&pulse_figure(&p, &provenance), path)?;
+    }
+    let rise = rise_time_10_90_ns(&p.t_ns, &p.signals[k_ref].charge);
+    if a.json {
+        let v = json!({
+            "t_ns": p.t_ns,
+            "contacts": p.signals.iter().map(|s| json!({"name": s.name, "signal": s.charge})).collect::<Vec<_>>(),
+            "collection_time_ns": p.collection_time_ns,
+            "electron": drift_json(&det, &p.electron),
+            "hole": drift_json(&det, &p.hole),
+            "normalised": a.normalise,
+            "normalised_by": divisor,
+            "reference_contact": det.contacts[k_ref].name,
+            "rise_time_10_90_ns": rise,
+            "at": {"r_mm": r_mm, "phi_deg": phi_deg, "z_mm": z_mm},
+            "voltage_V": a.voltage,
+            "fully_depleted": point.fully_depleted(),
+            "detector": det.file.display().to_string(),
+            "impurity_file": det.semiconductor.impurity_file().display().to_string(),
+            "parameters": det.parameters.iter().collect::<std::collections::BTreeMap<_, _>>(),
+            "drift_model": {"name": "ADL", "file": a.drift_parameters.as_ref().map(|f| f.display().to_string()), "parameters": adl},
+            "drift_settings": drift,
+            "version": env!("CARGO_PKG_VERSION"),
+        });
+        println!("{v}");
+    } else {
+        print_summary(&det, &p, &provenance, rise, divisor);
+    }
+    Ok(())
+}
+
+/// The inputs every output records.
+struct Provenance<'a> {
+    det: &'a Detector,
+    voltage_v: f64,
+    at: (f64, f64, f64),
+    drift_file: Option<&'a Path>,
+    normalised: bool,
+}
+
+impl Provenance<'_> {
+    fn line(&self) -> String {
+        let (r, phi, z) = self.at;
+        let params: Vec<String> = self
+            .det
+            .parameters
+            .iter()
+            .map(|(k, v)| format!("{k}={v}"))
+            .collect();
+        format!(
+            "hpge-cv {} pulse: detector {} impurity {} parameters [{}] U_B {} V at r {r} mm phi {phi} deg z {z} mm; ADL {}{}",
+            env!("CARGO_PKG_VERSION"),
+            self.det.file.display(),
+            self.det.semiconductor.impurity_file().display(),
+            params.join(" "),
+            self.voltage_v,
+            self.drift_file
+                .map_or("published defaults".to_string(), |f| f
+                    .display()
+                    .to_string()),
+            if self.normalised { "; normalised" } else { "" }
+        )
+    }
+}
+
+fn print_summary(
+    det: &Detector,
+    p: &Pulse,
+    prov: &Provenance<'_>,
+    rise: Option<f64>,
+    divisor: Option<f64>,
+) {
+    let (r, phi, z) = prov.at;
+    println!(
+        "pulse at r = {r} mm, phi = {phi} deg, z = {z} mm; U_B = {} V ({})",
+        prov.voltage_v, det.name
+    );
+    for d in [&p.electron, &p.hole] {
+        let end = d.path.last().map_or([f64::NAN; 3], |s| s.x_mm);
+        println!(
+            "  {:8} {} after {:.1} ns, at r = {:.2} mm, z = {:.2} mm",
+            d.carrier.as_str(),
+            stop_text(det, d.stop),
+            d.end_time_ns(),
+            end[0].hypot(end[1]),
+            end[2]
+        );
+    }
+    println!("collection time {:.1} ns", p.collection_time_ns);
+    let unit = if divisor.is_some() {
+        "normalised"
+    } else {
+        "units of the pair charge"
+    };
+    let ends: Vec<String> = p
+        .signals
+        .iter()
+        .map(|s| format!("{} {:+.4}", s.name, s.charge.last().unwrap_or(&0.0)))
+        .collect();
+    println!("end charges ({unit}): {}", ends.join(", "));
+    if let Some(t) = rise {
+        println!(
+            "10-90% rise time of {}: {t:.1} ns",
+            det.contacts[reference_contact(det)].name
+        );
+    }
+}
+
+fn write_csv(path: &Path, p: &Pulse, prov: &Provenance<'_>) -> Result<()> {
+    let ctx = || format!("--out {}: cannot write the file", path.display());
+    let mut f = std::io::BufWriter::new(std::fs::File::create(path).with_context(ctx)?);
+    let cols: Vec<String> = prov
+        .det
+        .contacts
+        .iter()
+        .map(|c| format!("q{} = {}", c.id, c.name))
+        .collect();
+    writeln!(
+        f,
+        "# {}; columns q<contact id>: {} ({})",
+        prov.line(),
+        cols.join("; "),
+        if prov.normalised {
+            "normalised"
+        } else {
+            "units of the pair charge"
+        }
+    )
+    .with_context(ctx)?;
+    let head: Vec<String> = prov
+        .det
+        .contacts
+        .iter()
+        .map(|c| format!("q{}", c.id))
+        .collect();
+    writeln!(f, "t_ns,{}", head.join(",")).with_context(ctx)?;
+    for (i, t) in p.t_ns.iter().enumerate() {
+        let row: Vec<String> = p.signals.iter().map(|s| s.charge[i].to_string()).collect();
+        writeln!(f, "{t},{}", row.join(",")).with_context(ctx)?;
+    }
+    f.flush().with_context(ctx)?;
+    Ok(())
+}
+
+fn pulse_figure(p: &Pulse, prov: &Provenance<'_>) -> plot::LineFigure {
+    let (r, phi, z) = prov.at;
+    plot::LineFigure {
+        title: format!(
+            "{}: signals of an interaction at r = {r} mm, phi = {phi} deg, z = {z} mm, U_B = {} V",
+            prov.det.name, prov.voltage_v
+        ),
+        x_desc: "time (ns)".into(),
+        y_desc: if prov.normalised {
+            "induced charge (normalised: bias contact ends at 1)".into()
+        } else {
+            "induced charge (units of the pair charge)".into()
+        },
+        curves: p
+            .signals
+            .iter()
+            .map(|s| plot::Curve {
+                label: s.name.clone(),
+                points: p
+                    .t_ns
+                    .iter()
+                    .zip(&s.charge)
+                    .map(|(&t, &q)| (t, Some(q)))
+                    .collect(),
+            })
+            .collect(),
+        y_from_zero: false,
+        legend: plot::Corner::UpperLeft,
+        footnotes: vec![prov.line()],
+    }
+}
