@@ -124,16 +124,22 @@ pub fn write_report(path: &Path, d: &Discovery, figures: &[PathBuf]) -> Result<(
     }
     match &s.chosen {
         Some(name) => {
+            let k_hat = if s.elpd_max_k_hat.iter().all(|k| k.is_finite()) {
+                format!(
+                    "; Pareto k-hat before/after {:.2}/{:.2}",
+                    s.elpd_max_k_hat[0], s.elpd_max_k_hat[1]
+                )
+            } else {
+                String::new()
+            };
             let _ = writeln!(
                 m,
                 "\nAdding `{name}`: Delta elpd = {:.1} +- {:.1} (leave-window-out over {} voltage \
-                 blocks, {}; Pareto k-hat before/after {:.2}/{:.2}), ln Bayes factor {:.1}.\n",
+                 blocks, {}{k_hat}), ln Bayes factor {:.1}.\n",
                 s.delta_elpd,
                 s.delta_elpd_se,
                 s.elpd_blocks,
                 s.elpd_method,
-                s.elpd_max_k_hat[0],
-                s.elpd_max_k_hat[1],
                 s.ln_bayes_factor.unwrap_or(f64::NAN)
             );
             let _ = writeln!(m, "Parameters at the global mode after the extension:\n");

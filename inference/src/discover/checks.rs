@@ -273,7 +273,7 @@ pub struct Elpd {
 
 /// `n_blocks` (clamped to `[1, n]`) contiguous blocks `[first, last]` covering `0..n`, sizes
 /// `floor(n / B)` or one more (the first `n mod B` blocks are the longer ones). Empty if n = 0.
-fn block_partition(n: usize, n_blocks: usize) -> Vec<[usize; 2]> {
+pub(super) fn block_partition(n: usize, n_blocks: usize) -> Vec<[usize; 2]> {
     if n == 0 {
         return Vec::new();
     }

@@ -7,6 +7,7 @@ use rand_distr::{Distribution, StandardNormal};
 
 use super::catalogue::Candidate;
 use super::checks::{PredictiveDraws, leave_window_out, residual_check};
+use super::elpd_linear::leave_window_out_linear;
 use super::laplace::{LaplaceFit, laplace_fit};
 use super::settings::{DiscoverSettings, ModelFit, Progress};
 use super::summary::Gap;
@@ -128,7 +129,8 @@ pub(super) fn mcmc_fit(
     })
 }
 
-/// A Laplace fit's checks (draws of the linearised Gaussian).
+/// A Laplace fit's checks: the residual check on draws of the linearised Gaussian, the elpd
+/// in closed form for it ([`leave_window_out_linear`]).
 pub(super) fn laplace_model_fit(
     posterior: &Posterior,
     lf: LaplaceFit,
@@ -140,7 +142,7 @@ pub(super) fn laplace_model_fit(
         model: posterior.prior.name.clone(),
         names: posterior.prior.names(),
         check: residual_check(&lik.c_m, &draws, settings.min_run, settings.seed),
-        elpd: leave_window_out(&lik.c_m, &draws, settings.elpd_blocks),
+        elpd: leave_window_out_linear(&lik.c_m, &lf, &lik.sigma(&lf.c_p), settings.elpd_blocks),
         sigma_mode: lik.sigma(&lf.c_p),
         c_mode: lf.c_p.clone(),
         mcmc: None,

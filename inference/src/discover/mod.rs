@@ -6,6 +6,7 @@
 
 mod catalogue;
 mod checks;
+mod elpd_linear;
 mod fits;
 mod laplace;
 mod region;

@@ -179,7 +179,7 @@ pub fn discover(
     let mut after_gap = before_gap.clone();
     let (mut d_elpd, mut d_se) = (0.0, 0.0);
     let mut elpd_method = if settings.exact {
-        "laplace-psis"
+        "laplace-linear"
     } else {
         "psis"
     }
@@ -204,7 +204,7 @@ pub fn discover(
                 (af, before.elpd.clone())
             }
             Predictor::Exact => {
-                elpd_method = "laplace-psis".into();
+                elpd_method = "laplace-linear".into();
                 let p = Posterior::new(c.model.as_ref(), prior, &lik_exact)?;
                 let lf = quick[i].0.clone();
                 let theta = lf.theta.clone();

@@ -108,12 +108,14 @@ pub struct DiscoverySummary {
     pub seconds: f64,
     /// ln Bayes factor of the chosen extension (its Laplace score), null when none was chosen.
     pub ln_bayes_factor: Option<f64>,
-    /// How the elpd was estimated: `psis` over MCMC draws, or over draws of the Laplace
-    /// approximation with a linearised curve (`laplace-psis`, exact-solver candidates).
+    /// How the elpd was estimated: `psis` (Pareto-smoothed importance sampling over MCMC
+    /// draws), or `laplace-linear` (closed form for the Laplace approximation with a
+    /// linearised curve: the exact-solver fits).
     pub elpd_method: String,
     /// Blocks of the leave-window-out elpd.
     pub elpd_blocks: usize,
-    /// Largest Pareto k-hat of the elpd's importance weights (before, after).
+    /// Largest Pareto k-hat of the elpd's importance weights (before, after); NaN (null in
+    /// the JSON) for `laplace-linear`, which samples nothing.
     pub elpd_max_k_hat: [f64; 2],
     /// Every run of same-sign residuals of the start model (the flagged ones are in
     /// `disagreement`).
