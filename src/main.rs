@@ -7,6 +7,7 @@
 mod cli;
 mod paper;
 mod plot;
+mod report;
 
 use std::process::ExitCode;
 

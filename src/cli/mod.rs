@@ -88,6 +88,8 @@ enum Command {
     Discover(discover::DiscoverArgs),
     /// Validation studies of the inference (simulation-based calibration).
     Validate(ValidateArgs),
+    /// Reports made of several commands' results: `report paper` remakes the paper's figures.
+    Report(crate::report::ReportArgs),
 }
 
 #[derive(Debug, clap::Args)]
@@ -709,6 +711,7 @@ pub fn run(cli: Cli) -> Result<()> {
             })
         }
         Command::Discover(a) => discover::run(&a),
+        Command::Report(a) => crate::report::run(&a),
         Command::Pulse(a) => pulse::run(&a),
         Command::Field(a) => field::run(&a),
         Command::PaperSection9 { out } => {
