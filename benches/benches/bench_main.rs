@@ -2,6 +2,7 @@
 
 use criterion::{criterion_group, criterion_main};
 
+mod drift;
 mod generate;
 mod gpu;
 mod impurity;
@@ -16,6 +17,7 @@ criterion_group!(
     gpu::bench,
     generate::bench,
     surrogate::bench,
-    inference::bench
+    inference::bench,
+    drift::bench
 );
 criterion_main!(benches);

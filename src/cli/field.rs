@@ -1,5 +1,5 @@
 //! `hpge-cv field`: the electric-field strength |E| along r at one (phi, z) and bias (paper
-//! Fig. 12a); null where the volume is undepleted, a contact or outside the crystal.
+//! Fig. 29a, section 9); null where the volume is undepleted, a contact or outside the crystal.
 
 use std::io::Write as _;
 use std::path::PathBuf;

@@ -1,7 +1,8 @@
-//! The paper's section 9 (Fig. 12): the electric-field strength along r at (phi = 30 deg,
-//! z = 35 mm) and the normalised n+ pulse of an interaction at (r = 37 mm, phi = 30 deg,
-//! z = 35 mm) at U_B = 3000 V, for the manufacturer's impurity model with d_Li = 3 mm and the
-//! global modes of the B_Z and B_RZ fits; ADL drift with its published 78 K parameters.
+//! The paper's section 9 (Fig. 29, counting its figures in order): the electric-field
+//! strength along r at (phi = 30 deg, z = 35 mm) and the normalised n+ pulse of an interaction
+//! at (r = 37 mm, phi = 30 deg, z = 35 mm), U_B = 3000 V, for the manufacturer's impurity
+//! model with d_Li = 3 mm and the global modes of the B_Z and B_RZ fits; ADL drift with its
+//! published 78 K parameters.
 
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
