@@ -45,12 +45,15 @@ pub enum Corner {
     UpperLeft,
     /// Bottom right.
     LowerRight,
+    /// Middle of the plot area (for curves that leave the centre empty).
+    MiddleMiddle,
 }
 
 impl Corner {
     fn position(self) -> SeriesLabelPosition {
         match self {
             Corner::UpperLeft => SeriesLabelPosition::UpperLeft,
+            Corner::MiddleMiddle => SeriesLabelPosition::MiddleMiddle,
             Corner::LowerRight => SeriesLabelPosition::LowerRight,
         }
     }

@@ -124,7 +124,7 @@ pub fn run(ctx: &mut Ctx) -> Result<()> {
             y_desc: "fraction of samples per bin".into(),
             curves,
             y_from_zero: true,
-            legend: Corner::UpperLeft,
+            legend: Corner::MiddleMiddle,
             footnotes: vec![format!(
                 "hpge-cv {} report paper: {}, golden sequence seed 0, indices 0..47999 (training), 48000..59999 (test); {}",
                 env!("CARGO_PKG_VERSION"),
