@@ -253,27 +253,61 @@ fn simulate_paper_weighting_mode() {
     assert!((c / 18.12 - 1.0).abs() < 5e-3, "{c}");
 }
 
-/// An impurity model under which the crystal stays undepleted between the contacts at every
-/// listed voltage: a clear error naming the bias and the contacts, exit code 2.
-#[test]
-fn simulate_undepleted_crystal_is_a_clear_error() {
-    let dir = std::env::temp_dir().join(format!("hpge-cv-undepleted-{}", std::process::id()));
+/// `simulate` on the coax with an impurity model under which the crystal stays undepleted
+/// between the contacts (1e16 cm^-3), with `extra` arguments; the output and the scratch folder.
+fn simulate_shorted_coax(tag: &str, extra: &[&str]) -> (std::process::Output, std::path::PathBuf) {
+    let dir = std::env::temp_dir().join(format!("hpge-cv-{tag}-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let model = dir.join("dense.toml");
     std::fs::write(&model, "model = \"constant\"\nzeta_cm3 = 1e16\n").unwrap();
-    let out = hpge_cv(&[
+    let mut args = vec![
         "simulate",
         "--detector",
         "detectors/coax-analytic.toml",
         "--impurity",
         model.to_str().unwrap(),
-        "--voltages",
-        "25,75",
-    ]);
+    ];
+    args.extend_from_slice(extra);
+    (hpge_cv(&args), dir)
+}
+
+/// An impurity model under which the crystal stays undepleted between the contacts at every
+/// listed voltage: a clear error naming the bias and the contacts, exit code 2.
+#[test]
+fn simulate_undepleted_crystal_is_a_clear_error() {
+    let (out, _) = simulate_shorted_coax("undepleted", &["--voltages", "25,75"]);
     assert_eq!(out.status.code(), Some(2));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("undepleted region connects"), "{err}");
     assert!(!err.contains("panicked"), "{err}");
+}
+
+/// Issue 18: a bridge error still draws the failing state with `--field-plot`, marks where the
+/// region joins the contacts, and says so.
+#[test]
+fn simulate_bridge_error_draws_the_field() {
+    let png = std::env::temp_dir().join(format!("hpge-cv-bridge-{}.png", std::process::id()));
+    let (out, _) = simulate_shorted_coax(
+        "bridge-plot",
+        &[
+            "--voltages",
+            "25",
+            "--field",
+            "25",
+            "--field-plot",
+            png.to_str().unwrap(),
+        ],
+    );
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("undepleted region connects"), "{err}");
+    assert!(err.contains("is drawn in"), "{err}");
+    let bytes = std::fs::read(&png).expect("the field plot of the failing state");
+    assert!(
+        bytes.starts_with(b"\x89PNG") && bytes.len() > 10_000,
+        "{} bytes",
+        bytes.len()
+    );
 }
 
 /// GPU issue: `--backend wgpu` gives the CPU's c12 and says in the JSON where it ran.

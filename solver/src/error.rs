@@ -71,9 +71,10 @@ pub enum Error {
         /// What went wrong.
         reason: String,
     },
-    /// An undepleted region connects two conductors at different potentials (shorted contacts).
+    /// An undepleted region connects two conductors at different potentials (shorted contacts):
+    /// conducting material (semiconductor that is not depleted) runs from one to the other.
     #[error(
-        "at U_B = {bias_v} V an undepleted region connects {first} and {second}: the crystal does not deplete between them (impurity density too high for this bias, or a depleted layer thinner than the grid's min_tick_distance_mm)"
+        "at U_B = {bias_v} V an undepleted region connects {first} and {second} near (r, z) = ({r_mm:.3}, {z_mm:.3}) mm: the crystal does not deplete between them at this bias (the impurity density is too high for this bias there, or a depleted layer is thinner than the grid's min_tick_distance_mm); draw the state with `simulate --field-plot`"
     )]
     UndepletedBridge {
         /// One conductor.
@@ -82,6 +83,10 @@ pub enum Error {
         second: String,
         /// Bias, V.
         bias_v: f64,
+        /// Radius of an undepleted node where the two conductors' regions meet, mm.
+        r_mm: f64,
+        /// Height of that node, mm.
+        z_mm: f64,
     },
     /// The wgpu backend found no usable adapter.
     #[error("no GPU adapter for the wgpu backend ({tried}): {reason}; {hint}")]

@@ -5,8 +5,8 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result, bail};
 use hpge_solver::{
-    Backend, CvCurve, FieldSettings, Precision, cv_curve, gpu_adapter, normalise_voltages,
-    solve_point,
+    Backend, CvCurve, Error, FieldSettings, Precision, cv_curve, gpu_adapter, normalise_voltages,
+    solve_point, solve_potential,
 };
 use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::json;
@@ -79,7 +79,30 @@ pub fn run(o: &SimulateOptions<'_>) -> Result<()> {
     let start = std::time::Instant::now();
     let curve = cv_curve(&det, &volts, &settings, |k, _| bar.set_position(k as u64));
     bar.finish_and_clear();
-    let curve = curve?;
+    let curve = match curve {
+        Ok(c) => c,
+        Err(e @ Error::UndepletedBridge { .. }) => {
+            // Draw the state that fails (at --field U, or at the failing bias) before giving up.
+            if let (
+                Some(path),
+                Error::UndepletedBridge {
+                    bias_v, r_mm, z_mm, ..
+                },
+            ) = (o.field_plot, &e)
+            {
+                let u = o.field.unwrap_or(*bias_v);
+                let p = solve_potential(&det, u, &settings, None)?;
+                let at = (u == *bias_v).then_some((*r_mm, *z_mm));
+                plot::field_map(&det, &p, at, path)?;
+                eprintln!(
+                    "note: the potential at {u} V is drawn in {} (red cross: where the undepleted region joins the contacts)",
+                    path.display()
+                );
+            }
+            return Err(e.into());
+        }
+        Err(e) => return Err(e.into()),
+    };
     if curve.points.iter().all(|p| !p.fully_depleted) && curve.points.len() > 1 {
         eprintln!("note: the detector is not fully depleted at any listed voltage");
     }
@@ -91,8 +114,8 @@ pub fn run(o: &SimulateOptions<'_>) -> Result<()> {
         plot::cv_curve(&curve, &det, path)?;
     }
     if let (Some(u), Some(path)) = (o.field, o.field_plot) {
-        let p = solve_point(&det, u, &settings, None)?;
-        plot::field_map(&det, &p, path)?;
+        let p = solve_potential(&det, u, &settings, None)?;
+        plot::field_map(&det, &p, None, path)?;
     }
     let last = curve.points.last().map_or((0, 0), |p| p.grid);
     if o.json {
@@ -101,6 +124,16 @@ pub fn run(o: &SimulateOptions<'_>) -> Result<()> {
             "c12_pF": curve.points.iter().map(|p| p.c12_pf).collect::<Vec<_>>(),
             "fully_depleted": curve.points.iter().map(|p| p.fully_depleted).collect::<Vec<_>>(),
             "depletion_voltage_V": curve.depletion_voltage_v,
+            "pinch_off_voltage_V": curve.pinch_off_voltage_v,
+            "pockets": curve.points.iter().map(|p| p.pockets.iter().map(|k| json!({
+                "carrier": k.carrier,
+                "level_V": k.level_v,
+                "volume_cm3": k.volume_cm3,
+                "nodes": k.nodes,
+                "centroid_mm": [k.centroid_mm.0, k.centroid_mm.1],
+                "r_range_mm": [k.r_range_mm.0, k.r_range_mm.1],
+                "z_range_mm": [k.z_range_mm.0, k.z_range_mm.1],
+            })).collect::<Vec<_>>()).collect::<Vec<_>>(),
             "grid": {"nr": last.0, "nz": last.1},
             "grid_per_point": curve.points.iter().map(|p| json!({"nr": p.grid.0, "nz": p.grid.1})).collect::<Vec<_>>(),
             "method": settings.method.as_str(),
@@ -124,6 +157,22 @@ pub fn run(o: &SimulateOptions<'_>) -> Result<()> {
                 "{:>10} {:>12.5} {:>8} {:>5}x{:<5}",
                 p.voltage_v, p.c12_pf, p.fully_depleted, p.grid.0, p.grid.1
             );
+        }
+        for p in curve.points.iter().filter(|p| !p.pockets.is_empty()) {
+            for k in &p.pockets {
+                println!(
+                    "  {:>6} V: pocket of trapped {}s at {:.1} V, {:.3} cm^3, centre (r, z) = ({:.1}, {:.1}) mm",
+                    p.voltage_v,
+                    k.carrier.as_str(),
+                    k.level_v,
+                    k.volume_cm3,
+                    k.centroid_mm.0,
+                    k.centroid_mm.1
+                );
+            }
+        }
+        if let Some(v) = curve.pinch_off_voltage_v {
+            println!("pinch-off voltage {v:.1} V (a pocket of trapped carriers forms)");
         }
         match curve.depletion_voltage_v {
             Some(v) => println!("full-depletion voltage {v:.1} V"),

@@ -3,7 +3,7 @@
 use std::path::Path;
 
 use anyhow::Result;
-use hpge_solver::{Detector, PointResult};
+use hpge_solver::{Detector, PotentialPoint};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
@@ -30,8 +30,18 @@ fn viridis(t: f64) -> RGBColor {
     RGBColor(m(0), m(1), m(2))
 }
 
-/// Draws the potential (colour) and the undepleted semiconductor (grey) of `p`.
-pub fn field_map(det: &Detector, p: &PointResult, path: &Path) -> Result<()> {
+/// Colour of trapped-carrier pockets.
+const POCKET: RGBColor = RGBColor(240, 120, 20);
+
+/// Draws the potential (colour), the undepleted semiconductor joined to a contact (grey) and the
+/// trapped-carrier pockets (orange) of `p`; `bridge_mm` marks (red cross) where an undepleted
+/// region joins two contacts.
+pub fn field_map(
+    det: &Detector,
+    p: &PotentialPoint,
+    bridge_mm: Option<(f64, f64)>,
+    path: &Path,
+) -> Result<()> {
     let w = &det.world;
     let s = (700.0 / w.r_max_mm).min(900.0 / (w.z_max_mm - w.z_min_mm));
     let (pw, ph) = (
@@ -41,14 +51,15 @@ pub fn field_map(det: &Detector, p: &PointResult, path: &Path) -> Result<()> {
     let size = (pw + 260, (ph + 140).max(480));
     render!(path, size, |root, svg| {
         let cell = if svg { (ph / 250).max(1) } else { 1 };
-        draw(&root, det, p, (pw, ph), cell)
+        draw(&root, det, p, bridge_mm, (pw, ph), cell)
     })
 }
 
 fn draw<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     det: &Detector,
-    p: &PointResult,
+    p: &PotentialPoint,
+    bridge_mm: Option<(f64, f64)>,
     (pw, ph): (u32, u32),
     cell: u32,
 ) -> Result<()> {
@@ -61,7 +72,7 @@ fn draw<DB: DrawingBackend>(
     let mut chart = ChartBuilder::on(&main)
         .caption(
             format!(
-                "{}: potential at U_B = {} V, undepleted in grey",
+                "{}: U_B = {} V (grey: undepleted, orange: pocket)",
                 det.name, p.bias_v
             ),
             ("sans-serif", 18),
@@ -89,8 +100,15 @@ fn draw<DB: DrawingBackend>(
         for ix in 0..nx {
             let rc = (ix as f64 + 0.5) * dr;
             let v = g.interpolate_at(&p.potential.phi_v, rc, zc);
-            let undepleted = p.potential.undepleted[g.nearest(rc, zc)];
-            let color = if undepleted {
+            let k = g.nearest(rc, zc);
+            let undepleted = p.potential.undepleted[k];
+            // A pocket: undepleted at a level between the contact potentials.
+            let at = p.potential.phi_v[k];
+            let pocket =
+                undepleted && (at - lo).abs() > 1e-9 * span && (hi - at).abs() > 1e-9 * span;
+            let color = if pocket {
+                POCKET
+            } else if undepleted {
                 RGBColor(150, 150, 150)
             } else {
                 viridis((v - lo) / span)
@@ -104,6 +122,19 @@ fn draw<DB: DrawingBackend>(
         }
     }
     chart.draw_series(rects).map_err(err)?;
+    if let Some(at) = bridge_mm {
+        chart
+            .draw_series([Cross::new(at, 9, RED.stroke_width(3))])
+            .map_err(err)?
+            .label("undepleted bridge between contacts")
+            .legend(|(x, y)| Cross::new((x, y), 6, RED.stroke_width(3)));
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .draw()
+            .map_err(err)?;
+    }
     // Colour bar.
     let (x0, y0, bw, bh) = (20, 60, 26, 300);
     for k in 0..bh {
@@ -132,7 +163,18 @@ fn draw<DB: DrawingBackend>(
         RGBColor(150, 150, 150).filled(),
     ))
     .map_err(err)?;
-    side.draw(&Text::new("undepleted", (x0 + bw + 8, y0 + bh + 30), font))
+    side.draw(&Text::new(
+        "undepleted",
+        (x0 + bw + 8, y0 + bh + 30),
+        font.clone(),
+    ))
+    .map_err(err)?;
+    side.draw(&Rectangle::new(
+        [(x0, y0 + bh + 56), (x0 + bw, y0 + bh + 72)],
+        POCKET.filled(),
+    ))
+    .map_err(err)?;
+    side.draw(&Text::new("pocket", (x0 + bw + 8, y0 + bh + 56), font))
         .map_err(err)?;
     Ok(())
 }

@@ -28,7 +28,8 @@ pub use signal::{ContactSignal, Pulse, pulse};
 pub use trajectory::{Drift, DriftSample, StopReason, drift_carrier};
 
 /// The two kinds of charge carrier (a closed set).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum Carrier {
     /// Conduction electron, charge -q: drifts against the field.
     Electron,

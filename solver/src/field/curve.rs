@@ -4,6 +4,8 @@ use serde::Serialize;
 
 use super::full_depletion::full_depletion_voltage;
 use super::mesh::Mesh;
+use super::pinch_off::pinch_off_voltage;
+use super::pockets::Pocket;
 use super::point::{FieldSettings, Seed, solve_point};
 use crate::{Detector, Error, Result};
 
@@ -26,6 +28,8 @@ pub struct CvPoint {
     pub solve_seconds: f64,
     /// Wall time of the point (grids, potential, weighting potentials, capacitances), s.
     pub seconds: f64,
+    /// Trapped-carrier pockets at this bias (`field::pockets`): volume, level, location.
+    pub pockets: Vec<Pocket>,
 }
 
 /// A C-V curve.
@@ -38,6 +42,10 @@ pub struct CvCurve {
     /// from the unconstrained potential on the first fully depleted point's grid
     /// (`full_depletion_voltage`); None when no listed bias depletes the detector.
     pub depletion_voltage_v: Option<f64>,
+    /// Pinch-off voltage (V): the lowest bias at which a trapped-carrier pocket exists, bisected
+    /// between the last listed bias without a pocket (or 0 V) and the first with one, on the
+    /// latter's grid (`pinch_off_voltage`); None when no listed bias holds a pocket.
+    pub pinch_off_voltage_v: Option<f64>,
 }
 
 /// Checks a voltage list: every value finite and positive; returns it sorted and deduplicated.
@@ -82,12 +90,14 @@ pub fn cv_curve(
     let done = AtomicUsize::new(0);
     // Each chunk returns its points and the mesh of its first fully depleted point (for the
     // full-depletion voltage).
-    let parts: Vec<Result<(Vec<CvPoint>, Option<Mesh>)>> = volts
+    type Part = (Vec<CvPoint>, Option<Mesh>, Option<Mesh>);
+    let parts: Vec<Result<Part>> = volts
         .par_chunks(size)
         .map(|chunk| {
             let mut points = Vec::with_capacity(chunk.len());
             let mut prev: Option<Seed> = None;
             let mut depleted_mesh: Option<Mesh> = None;
+            let mut pocket_mesh: Option<Mesh> = None;
             for (k, &v) in chunk.iter().enumerate() {
                 let start = std::time::Instant::now();
                 let p = solve_point(det, v, settings, prev.as_ref())?;
@@ -102,22 +112,28 @@ pub fn cv_curve(
                     iterations: p.reports.iter().map(|r| r.iterations).sum(),
                     solve_seconds: p.reports.iter().map(|r| r.seconds).sum(),
                     seconds: start.elapsed().as_secs_f64(),
+                    pockets: p.potential.pockets.clone(),
                 });
+                if pocket_mesh.is_none() && !p.potential.pockets.is_empty() {
+                    pocket_mesh = Some(p.mesh.clone());
+                }
                 if depleted_mesh.is_none() && p.fully_depleted() {
                     depleted_mesh = Some(p.mesh.clone());
                 }
                 prev = Some(p.seed(scale));
                 progress(done.fetch_add(1, Ordering::Relaxed) + 1, volts.len());
             }
-            Ok((points, depleted_mesh))
+            Ok((points, depleted_mesh, pocket_mesh))
         })
         .collect();
     let mut points = Vec::with_capacity(volts.len());
     let mut depleted_mesh = None;
+    let mut pocket_mesh = None;
     for part in parts {
-        let (pts, mesh) = part?;
+        let (pts, mesh, pmesh) = part?;
         points.extend(pts);
         depleted_mesh = depleted_mesh.or(mesh);
+        pocket_mesh = pocket_mesh.or(pmesh);
     }
     // The first chunk with a fully depleted point holds the first such point overall.
     let depletion_voltage_v = match (points.iter().position(|p| p.fully_depleted), depleted_mesh) {
@@ -127,9 +143,25 @@ pub fn cv_curve(
         }
         _ => None,
     };
+    let pinch_off_voltage_v = match (
+        points.iter().position(|p| !p.pockets.is_empty()),
+        pocket_mesh,
+    ) {
+        (Some(k), Some(mesh)) => {
+            let lo = if k > 0 { points[k - 1].voltage_v } else { 0.0 };
+            pinch_off_voltage(
+                &mesh,
+                det,
+                lo.max(1e-3 * points[k].voltage_v),
+                points[k].voltage_v,
+            )?
+        }
+        _ => None,
+    };
     Ok(CvCurve {
         points,
         depletion_voltage_v,
+        pinch_off_voltage_v,
     })
 }
 

@@ -76,7 +76,8 @@ pub(crate) fn crossings(
             NodeKind::Contact(_) if (phi_v[p] - bound_of(p)).abs() <= 1e-9 * span => true,
             _ => continue,
         };
-        let b = bound_of(p);
+        // The undepleted side's own potential: a contact bound, or a pocket's level.
+        let b = if at_contact { bound_of(p) } else { phi_v[p] };
         let (i, j) = ((p % nr) as isize, (p / nr) as isize);
         for (di, dj) in [(1isize, 0isize), (-1, 0), (0, 1), (0, -1)] {
             let (i2, j2) = (i + 2 * di, j + 2 * dj);

@@ -15,9 +15,16 @@
 //! parabola through the contact node and the next two nodes must not leave the bounds either:
 //! its slope at the contact, pointing into the semiconductor, must point away from the bound
 //! (at full depletion the field at that contact vanishes). This is second order.
+//!
+//! Within the bounds is not enough where carriers can be trapped (`field::pockets`): the
+//! unconstrained potential of an inverted-coax detector in its pinch-off window stays within
+//! the contact potentials but has a minimum in the p-type bulk that holes cannot leave. So phi(U)
+//! must also have no depression for holes in p-type or electrons in n-type material (a flood fill
+//! from the contacts); the detector is fully depleted only when the last pocket is gone.
 
 use super::depletion::potential_dofs;
 use super::mesh::{Mesh, NodeKind};
+use super::pockets::{CARRIERS, deepest_depression_v};
 use super::system::{Dof, System};
 use crate::{Detector, Result};
 
@@ -85,6 +92,16 @@ impl Affine {
         for n in (0..nr * nz).filter(|&n| semi(n)) {
             let p = phi(n);
             if p > hi + tol || p < lo - tol {
+                return false;
+            }
+        }
+        // No trapped-carrier pocket: no depression for holes in p-type material nor for
+        // electrons in n-type (an undepleted pocket of an ICPC lies within the bounds).
+        let all: Vec<f64> = (0..nr * nz).map(phi).collect();
+        for carrier in CARRIERS {
+            if deepest_depression_v(mesh, &all, carrier, (lo, hi)).0
+                > 1e-9 * (hi - lo).abs().max(1.0)
+            {
                 return false;
             }
         }

@@ -48,6 +48,13 @@ pub struct Mesh {
     pub w_z: Vec<f64>,
     /// Fixed space charge (C) of every node where depleted: q zeta V_semiconductor.
     pub charge_c: Vec<f64>,
+    /// Cells [r_i, r_{i+1}] x [z_j, z_{j+1}] (index j * (nr - 1) + i) whose material conducts
+    /// charge: semiconductor or a conductor (contact, grounded or floating passive). Free carriers
+    /// move only along edges that touch such a cell (`Mesh::edge_conducts`), never across a
+    /// dielectric or vacuum gap, however coarse the grid.
+    pub cell_conducts: Vec<bool>,
+    /// Semiconductor part of every node's control volume, m^3.
+    pub volume_m3: Vec<f64>,
 }
 
 impl Mesh {
@@ -90,6 +97,7 @@ impl Mesh {
         // Cell permittivities (F/m) and semiconductor flags, from the cell centres.
         let mut eps = vec![0.0; (nr - 1) * (nz - 1)];
         let mut semi = vec![false; (nr - 1) * (nz - 1)];
+        let mut cell_conducts = vec![false; (nr - 1) * (nz - 1)];
         for j in 0..nz - 1 {
             for i in 0..nr - 1 {
                 let rc = 0.5 * (grid.r_mm()[i] + grid.r_mm()[i + 1]);
@@ -97,6 +105,12 @@ impl Mesh {
                 let (e, s) = det.dielectric_at(rc, zc);
                 eps[j * (nr - 1) + i] = e * VACUUM_PERMITTIVITY_F_PER_M;
                 semi[j * (nr - 1) + i] = s;
+                cell_conducts[j * (nr - 1) + i] = s
+                    || match det.classify(rc, zc) {
+                        Region::Contact(_) => true,
+                        Region::Passive(p) => det.passives[p].kind != PassiveKind::Dielectric,
+                        Region::Semiconductor | Region::Medium => false,
+                    };
             }
         }
 
@@ -148,6 +162,26 @@ impl Mesh {
             w_r,
             w_z,
             charge_c,
+            cell_conducts,
+            volume_m3: vol,
+        }
+    }
+
+    /// True when free carriers can cross the edge between neighbouring nodes `p` and `q`: one of
+    /// the (up to two) cells along the edge is semiconductor or conductor. An edge whose cells
+    /// are all dielectric or vacuum (e.g. across a PTFE spacer with no grid line inside it)
+    /// insulates, whatever the materials of its end nodes.
+    pub fn edge_conducts(&self, p: usize, q: usize) -> bool {
+        let (nr, nz) = (self.grid.nr(), self.grid.nz());
+        let (a, b) = (p.min(q), p.max(q));
+        let (i, j) = (a % nr, a / nr);
+        let cell = |ci: usize, cj: usize| self.cell_conducts[cj * (nr - 1) + ci];
+        if b == a + 1 {
+            // Radial edge (i, j)-(i+1, j): cells (i, j-1) and (i, j).
+            (j > 0 && cell(i, j - 1)) || (j + 1 < nz && cell(i, j))
+        } else {
+            // Axial edge (i, j)-(i, j+1): cells (i-1, j) and (i, j).
+            (i > 0 && cell(i - 1, j)) || (i + 1 < nr && cell(i, j))
         }
     }
 

@@ -7,10 +7,13 @@ mod depletion;
 mod front;
 mod full_depletion;
 mod mesh;
+mod pinch_off;
+pub(crate) mod pockets;
 mod point;
 mod report;
 pub(crate) mod sor;
 mod system;
+mod union_find;
 mod weighting;
 
 pub use capacitance::CapacitanceMatrix;
@@ -18,7 +21,9 @@ pub use curve::{CvCurve, CvPoint, cv_curve, normalise_voltages};
 pub use depletion::{PotentialSolution, solve_fast};
 pub use full_depletion::full_depletion_voltage;
 pub use mesh::{Mesh, NodeKind};
-pub use point::{FieldSettings, PointResult, Seed, solve_point};
+pub use pinch_off::pinch_off_voltage;
+pub use pockets::{Pocket, deepest_depression_v, deepest_empty_depression_v, find_pockets};
+pub use point::{FieldSettings, PointResult, PotentialPoint, Seed, solve_point, solve_potential};
 pub use report::{Backend, Method, SolveReport, Termination};
 pub use sor::{solve_sor, solve_sor_wgpu, weighting_potentials_wgpu};
 pub use weighting::{

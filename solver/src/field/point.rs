@@ -159,6 +159,33 @@ pub(crate) fn pair(det: &Detector) -> Result<(usize, usize)> {
     }
 }
 
+/// The potential with depletion at one bias on its refined grid: what [`solve_point`] solves
+/// before the weighting potentials.
+#[derive(Debug, Clone)]
+pub struct PotentialPoint {
+    /// Bias, V.
+    pub bias_v: f64,
+    /// The final (refined) mesh.
+    pub mesh: Mesh,
+    /// The potential on it.
+    pub potential: PotentialSolution,
+    /// One report per solve (initial grid, then each refinement).
+    pub reports: Vec<SolveReport>,
+}
+
+/// Solves the potential at `bias_v` with refinement (div(eps grad phi) = -rho with the
+/// depletion bounds and pockets, paper Eq. (3)), without the weighting potentials: the state a
+/// user looks at when the weighting problem fails (an undepleted region shorting two contacts).
+/// The same mesh and potential as [`solve_point`] for the same arguments.
+pub fn solve_potential(
+    det: &Detector,
+    bias_v: f64,
+    settings: &FieldSettings,
+    seed: Option<&Seed>,
+) -> Result<PotentialPoint> {
+    refined_potential(det, bias_v, settings, seed)
+}
+
 /// Solves the potential at `bias_v` with refinement, then the weighting potentials and C*.
 ///
 /// `seed` may carry the solution at a neighbouring voltage: the initial grid is split down to
@@ -169,37 +196,13 @@ pub fn solve_point(
     settings: &FieldSettings,
     seed: Option<&Seed>,
 ) -> Result<PointResult> {
-    settings.validate().map_err(|m| Error::Argument {
-        name: "settings".into(),
-        message: m,
-    })?;
-    if !bias_v.is_finite() {
-        return Err(Error::Argument {
-            name: "bias_v".into(),
-            message: format!("must be finite, got {bias_v}"),
-        });
-    }
     let (a, b) = pair(det)?;
-    let gs = &settings.grid;
-    let mut grid = Grid::initial(det, gs);
-    let mut guess: Option<Vec<f64>> = None;
-    if let Some(sd) = seed {
-        let sr = overlapping(grid.r_mm(), &sd.front_r_mm);
-        let sz = overlapping(grid.z_mm(), &sd.front_z_mm);
-        if let Some(g) = grid.split(&sr, &sz, gs.front_spacing_mm, gs) {
-            grid = g;
-        }
-        guess = Some(sd.grid.interpolate_to(&sd.phi_v, &grid));
-    }
-    let mut reports = Vec::new();
-    let solve = |mesh: &Mesh, guess: Option<&[f64]>| match (settings.backend, settings.method) {
-        (Backend::Cpu, Method::Fast) => solve_fast(mesh, det, bias_v, guess),
-        (Backend::Cpu, Method::Sor) => super::sor::solve_sor(mesh, det, bias_v, guess),
-        // (Wgpu, Fast) is rejected by validate().
-        (Backend::Wgpu, _) => {
-            super::sor::solve_sor_wgpu(mesh, det, bias_v, guess, settings.gpu_precision)
-        }
-    };
+    let PotentialPoint {
+        mesh,
+        potential: pot,
+        reports,
+        ..
+    } = refined_potential(det, bias_v, settings, seed)?;
     let weigh = |mesh: &Mesh, undepleted: &[bool]| match settings.backend {
         Backend::Cpu => weighting_potentials(mesh, det, undepleted, bias_v),
         Backend::Wgpu => super::sor::weighting_potentials_wgpu(
@@ -210,36 +213,6 @@ pub fn solve_point(
             settings.gpu_precision,
         ),
     };
-    let mut mesh = Mesh::new(det, grid.clone());
-    let mut pot = solve(&mesh, guess.as_deref())?;
-    reports.push(pot.report.clone());
-    // Moves to a finer grid: the current potential, interpolated, seeds the new solve.
-    let mut advance =
-        |grid: &mut Grid, mesh: &mut Mesh, pot: &mut PotentialSolution, finer: Grid| {
-            let g = grid.interpolate_to(&pot.phi_v, &finer);
-            *mesh = Mesh::new(det, finer.clone());
-            *grid = finer;
-            *pot = solve(mesh, Some(&g))?;
-            reports.push(pot.report.clone());
-            Ok::<(), Error>(())
-        };
-    let span = (pot.bounds_v.1 - pot.bounds_v.0)
-        .abs()
-        .max(f64::MIN_POSITIVE);
-    for &limit in &gs.refinement_limits {
-        if let Some(finer) = grid.refined(&pot.phi_v, limit * span, gs) {
-            advance(&mut grid, &mut mesh, &mut pot, finer)?;
-        }
-    }
-    // Resolve the depletion front: divide the intervals it crosses down to front_spacing_mm.
-    loop {
-        let (split_r, split_z) =
-            super::front::front_splits(&mesh, &pot.phi_v, &pot.undepleted, pot.bounds_v);
-        let Some(finer) = grid.split(&split_r, &split_z, gs.front_spacing_mm, gs) else {
-            break;
-        };
-        advance(&mut grid, &mut mesh, &mut pot, finer)?;
-    }
     let cross = super::front::crossings(&mesh, &pot.phi_v, &pot.undepleted, pot.bounds_v);
     let (wmesh, weighting) = match settings.weighting {
         WeightingMode::Conductor => {
@@ -278,6 +251,82 @@ pub fn solve_point(
         c12_pf,
         undepleted_nodes,
         contact_layers,
+        reports,
+    })
+}
+
+/// The refined potential of [`solve_point`] and [`solve_potential`].
+fn refined_potential(
+    det: &Detector,
+    bias_v: f64,
+    settings: &FieldSettings,
+    seed: Option<&Seed>,
+) -> Result<PotentialPoint> {
+    settings.validate().map_err(|m| Error::Argument {
+        name: "settings".into(),
+        message: m,
+    })?;
+    if !bias_v.is_finite() {
+        return Err(Error::Argument {
+            name: "bias_v".into(),
+            message: format!("must be finite, got {bias_v}"),
+        });
+    }
+    pair(det)?;
+    let gs = &settings.grid;
+    let mut grid = Grid::initial(det, gs);
+    let mut guess: Option<Vec<f64>> = None;
+    if let Some(sd) = seed {
+        let sr = overlapping(grid.r_mm(), &sd.front_r_mm);
+        let sz = overlapping(grid.z_mm(), &sd.front_z_mm);
+        if let Some(g) = grid.split(&sr, &sz, gs.front_spacing_mm, gs) {
+            grid = g;
+        }
+        guess = Some(sd.grid.interpolate_to(&sd.phi_v, &grid));
+    }
+    let mut reports = Vec::new();
+    let solve = |mesh: &Mesh, guess: Option<&[f64]>| match (settings.backend, settings.method) {
+        (Backend::Cpu, Method::Fast) => solve_fast(mesh, det, bias_v, guess),
+        (Backend::Cpu, Method::Sor) => super::sor::solve_sor(mesh, det, bias_v, guess),
+        // (Wgpu, Fast) is rejected by validate().
+        (Backend::Wgpu, _) => {
+            super::sor::solve_sor_wgpu(mesh, det, bias_v, guess, settings.gpu_precision)
+        }
+    };
+    let mut mesh = Mesh::new(det, grid.clone());
+    let mut pot = solve(&mesh, guess.as_deref())?;
+    reports.push(pot.report.clone());
+    // Moves to a finer grid: the current potential, interpolated, seeds the new solve.
+    let mut advance =
+        |grid: &mut Grid, mesh: &mut Mesh, pot: &mut PotentialSolution, finer: Grid| {
+            let g = grid.interpolate_to(&pot.phi_v, &finer);
+            *mesh = Mesh::new(det, finer.clone());
+            *grid = finer;
+            *pot = solve(mesh, Some(&g))?;
+            reports.push(pot.report.clone());
+            Ok::<(), Error>(())
+        };
+    let span = (pot.bounds_v.1 - pot.bounds_v.0)
+        .abs()
+        .max(f64::MIN_POSITIVE);
+    for &limit in &gs.refinement_limits {
+        if let Some(finer) = grid.refined(&pot.phi_v, limit * span, gs) {
+            advance(&mut grid, &mut mesh, &mut pot, finer)?;
+        }
+    }
+    // Resolve the depletion front: divide the intervals it crosses down to front_spacing_mm.
+    loop {
+        let (split_r, split_z) =
+            super::front::front_splits(&mesh, &pot.phi_v, &pot.undepleted, pot.bounds_v);
+        let Some(finer) = grid.split(&split_r, &split_z, gs.front_spacing_mm, gs) else {
+            break;
+        };
+        advance(&mut grid, &mut mesh, &mut pot, finer)?;
+    }
+    Ok(PotentialPoint {
+        bias_v,
+        mesh,
+        potential: pot,
         reports,
     })
 }

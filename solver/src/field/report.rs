@@ -57,6 +57,10 @@ pub enum Termination {
     ToleranceReached,
     /// A linear problem without constraints, solved directly.
     Direct,
+    /// The pocket rounds cycled (a hole and an electron pocket pouring into each other at a p-n
+    /// junction inside the crystal): the round of the cycle with the shallowest remaining
+    /// depression is the answer, its depth in `residual_v`.
+    PocketCycle,
 }
 
 /// Report of one solve.

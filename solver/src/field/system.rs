@@ -178,11 +178,6 @@ impl System {
         Symbolic::new(self.n, &self.col_ptr, &self.row_idx, Some(&self.order()))
     }
 
-    /// Factorises the matrix with values `val` and solves for `rhs`.
-    pub fn solve(&self, sym: &Symbolic, val: &[f64], rhs: &[f64]) -> Result<Vec<f64>> {
-        Ok(self.factor(sym, val)?.solve(rhs))
-    }
-
     /// Numeric Cholesky factorisation with values `val`.
     pub fn factor(&self, sym: &Symbolic, val: &[f64]) -> Result<Factor> {
         sym.factor(&self.col_ptr, &self.row_idx, val)

@@ -12,6 +12,7 @@ use serde::{Deserialize, Serialize};
 
 use super::mesh::{Mesh, NodeKind};
 use super::system::{Dof, System};
+use super::union_find::UnionFind;
 use crate::{Detector, Error, Result};
 
 /// How undepleted semiconductor enters the weighting potentials (a closed set).
@@ -79,24 +80,6 @@ pub struct WeightingPotentials {
     pub owned: Vec<Vec<bool>>,
 }
 
-struct UnionFind(Vec<usize>);
-
-impl UnionFind {
-    fn find(&mut self, mut a: usize) -> usize {
-        while self.0[a] != a {
-            self.0[a] = self.0[self.0[a]];
-            a = self.0[a];
-        }
-        a
-    }
-    fn union(&mut self, a: usize, b: usize) {
-        let (ra, rb) = (self.find(a), self.find(b));
-        if ra != rb {
-            self.0[ra] = rb;
-        }
-    }
-}
-
 /// Labels every node: its owner if it is a conductor (contact, grounded, floating passive or an
 /// undepleted semiconductor node attached to one); `None` for free nodes.
 pub(crate) fn owners(
@@ -112,31 +95,29 @@ pub(crate) fn owners(
     let contact_root = |c: usize| nn + c;
     let ground_root = nn + nc;
     let passive_root = |p: usize| nn + nc + 1 + p;
-    let mut uf = UnionFind((0..nn + nc + 1 + np).collect());
+    let mut uf = UnionFind::new(nn + nc + 1 + np);
     let root_of = |k: NodeKind| match k {
         NodeKind::Contact(c) => Some(contact_root(c)),
         NodeKind::Grounded => Some(ground_root),
         NodeKind::Floating(p) => Some(passive_root(p)),
         _ => None,
     };
+    // Conductors first: every conductor node joins its virtual root (no two roots share a set).
     for (n, k) in mesh.kind.iter().enumerate() {
         if let Some(r) = root_of(*k) {
             uf.union(n, r);
         }
     }
-    mesh.for_each_edge(|p, q, _| {
-        let (up, uq) = (undepleted[p], undepleted[q]);
-        if up && uq {
-            uf.union(p, q);
-        } else if up {
-            if let Some(r) = root_of(mesh.kind[q]) {
-                uf.union(p, r);
-            }
-        } else if uq && let Some(r) = root_of(mesh.kind[p]) {
-            uf.union(q, r);
-        }
-    });
-    // Which virtual roots share a set: that is a short through an undepleted region.
+    // Which virtual root a set holds, if any (indexed by the set's representative).
+    let mut root_in = vec![None; nn + nc + 1 + np];
+    for r in nn..nn + nc + 1 + np {
+        let s = uf.find(r);
+        root_in[s] = Some(r);
+    }
+    // Then the undepleted semiconductor, edge by edge, only along edges that conduct (through
+    // semiconductor or conductor material, never across a dielectric or vacuum gap). Two sets
+    // holding different contacts (or a contact and ground) joined by an edge are a short: the
+    // first such edge is where the undepleted region bridges them.
     let name = |r: usize| -> String {
         if r < nn + nc {
             format!("contact {}", det.contacts[r - nn].label())
@@ -146,23 +127,57 @@ pub(crate) fn owners(
             format!("floating passive `{}`", det.passives[r - nn - nc - 1].name)
         }
     };
-    let mut set_owner: std::collections::HashMap<usize, (usize, Owner)> = Default::default();
+    let mut bridge: Option<(usize, usize, usize)> = None;
+    mesh.for_each_edge(|p, q, _| {
+        if bridge.is_some() || !(undepleted[p] || undepleted[q]) {
+            return;
+        }
+        let joins = (undepleted[p] || root_of(mesh.kind[p]).is_some())
+            && (undepleted[q] || root_of(mesh.kind[q]).is_some());
+        if !joins || !mesh.edge_conducts(p, q) {
+            return;
+        }
+        let (sp, sq) = (uf.find(p), uf.find(q));
+        if sp == sq {
+            return;
+        }
+        match (root_in[sp], root_in[sq]) {
+            (Some(a), Some(b)) if a < nn + nc + 1 && b < nn + nc + 1 => {
+                // Contacts or ground on both sides: a short (floating passives merge harmlessly).
+                let at = if undepleted[p] { p } else { q };
+                bridge = Some((a, b, at));
+                return;
+            }
+            _ => {}
+        }
+        uf.union(sp, sq);
+        let s = uf.find(sp);
+        // Keep the contact/ground root if the set holds one, else a floating passive's.
+        let keep = match (root_in[sp], root_in[sq]) {
+            (Some(a), Some(b)) => Some(a.min(b)),
+            (a, b) => a.or(b),
+        };
+        root_in[s] = keep;
+    });
+    if let Some((a, b, at)) = bridge {
+        let (first, second) = (name(a.min(b)), name(a.max(b)));
+        let nr = mesh.grid.nr();
+        return Err(Error::UndepletedBridge {
+            first,
+            second,
+            bias_v,
+            r_mm: mesh.grid.r_mm()[at % nr],
+            z_mm: mesh.grid.z_mm()[at / nr],
+        });
+    }
+    let mut set_owner: std::collections::HashMap<usize, Owner> = Default::default();
     for r in nn..nn + nc + 1 {
         let owner = if r == ground_root {
             Owner::Ground
         } else {
             Owner::Contact(r - nn)
         };
-        let s = uf.find(r);
-        if let Some((other, _)) = set_owner.get(&s) {
-            // Contacts at the same potential may be joined harmlessly only if they are the same.
-            return Err(Error::UndepletedBridge {
-                first: name(*other),
-                second: name(r),
-                bias_v,
-            });
-        }
-        set_owner.insert(s, (r, owner));
+        set_owner.insert(uf.find(r), owner);
     }
     let mut out = vec![None; nn];
     let mut islands = std::collections::HashMap::new();
@@ -173,7 +188,7 @@ pub(crate) fn owners(
         }
         let s = uf.find(n);
         out[n] = Some(match set_owner.get(&s) {
-            Some((_, o)) => *o,
+            Some(o) => *o,
             None => {
                 let next = islands.len();
                 Owner::Floating(*islands.entry(s).or_insert(next))

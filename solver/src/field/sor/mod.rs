@@ -21,6 +21,7 @@
 //! (q_n + sum w x_m) / sum w lies beyond a bound (multiplier lambda_n = f_n - (A x)_n of the
 //! bound's sign), not from |x_n - bound| < eps.
 
+mod levels;
 mod residual;
 mod settings;
 mod solve;

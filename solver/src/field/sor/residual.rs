@@ -31,6 +31,16 @@ pub(super) fn projected_residual(
     phi: &[f64],
     (lo, hi): (f64, f64),
 ) -> f64 {
+    projected_residual_within(mesh, dofs, phi, &vec![(lo, hi); phi.len()])
+}
+
+/// [`projected_residual`] with every node's own bounds (`bounds[n]`; semiconductor nodes only).
+pub(super) fn projected_residual_within(
+    mesh: &Mesh,
+    dofs: &[Dof],
+    phi: &[f64],
+    bounds: &[(f64, f64)],
+) -> f64 {
     let nn = phi.len();
     // g / A_nn = x - target for free nodes; for a conductor the sums run over its boundary.
     let kx = mesh.apply(phi);
@@ -48,7 +58,7 @@ pub(super) fn projected_residual(
                 let g = kx[n] - mesh.charge_c[n];
                 let step = phi[n] - g / diag[n];
                 let p = if mesh.kind[n] == NodeKind::Semiconductor {
-                    step.clamp(lo, hi)
+                    step.clamp(bounds[n].0, bounds[n].1)
                 } else {
                     step
                 };

@@ -3,13 +3,15 @@
 
 use std::time::Instant;
 
-use super::residual::projected_residual;
+use super::levels::{Levels, MAX_LEVEL_ROUNDS, next_levels, settled, tied_bounds};
+use super::residual::{projected_residual, projected_residual_within};
 use super::settings::{SorSettings, default_omega};
-use super::stencil::{groups, initial, inverse_sum, undepleted, weights};
+use super::stencil::{groups, initial, inverse_sum, undepleted_within, weights};
 use super::stop::StopRule;
 use super::sweep::{Block, Coef, Layout, PARALLEL_MIN_NODES, half_sweep, to_nodes, update_blocks};
-use crate::field::depletion::{PotentialSolution, potential_dofs};
+use crate::field::depletion::{POCKET_TOL, PotentialSolution, potential_dofs};
 use crate::field::mesh::{Mesh, NodeKind};
+use crate::field::pockets::{self, Ties, find_pockets};
 use crate::field::report::{Backend, Method, SolveReport, Termination};
 use crate::field::system::Dof;
 use crate::{Detector, Error, Result};
@@ -133,52 +135,90 @@ pub fn solve_sor_with(
         });
     }
 
-    // Sweeps.
+    // Rounds of converged sweeps with the pockets' nodes bounded by fixed levels (none in the
+    // first round), the levels moved by secant steps between rounds (`levels.rs`).
     let parallel = nn >= PARALLEL_MIN_NODES;
-    let mut rule = StopRule::new(
-        settings,
-        (hi - lo).abs(),
-        hi.abs().max(lo.abs()),
-        f64::EPSILON,
-    );
+    let base = coef.clone();
+    let span = (hi - lo).abs().max(1.0);
+    let level_tol = (10.0 * settings.tolerance).max(1e-13) * span;
+    let flood_tol = level_tol.max(POCKET_TOL * span);
+    let mut ties: Ties = vec![None; nn];
+    let mut levels = Levels::new();
     let mut sweeps = 0;
-    loop {
-        sweeps += 1;
-        let check = sweeps % settings.check_every == 0;
-        let [red, black] = &mut x;
-        let d0 = half_sweep(0, red, black, &coef[0], lay, omega, check, parallel);
-        let d1 = half_sweep(1, black, red, &coef[1], lay, omega, check, parallel);
-        let d2 = update_blocks(&blocks, &mut x, omega);
-        if check {
-            match rule.converged(d0.max(d1).max(d2)) {
-                Some(true) => break,
-                Some(false) => {}
-                None => {
-                    return Err(Error::NotConverged {
-                        method: Method::Sor.as_str(),
-                        iterations: sweeps,
-                        residual_v: f64::NAN,
-                    });
-                }
+    let mut rounds = 0;
+    let phi_v = loop {
+        rounds += 1;
+        coef = base.clone();
+        for (n, t) in ties.iter().enumerate() {
+            if let (Some(t), Dof::Free) = (t, dofs[n]) {
+                let (c, k) = lay.slot(n);
+                let b = base[c][k];
+                (coef[c][k].lo, coef[c][k].hi) = tied_bounds(t, &levels, (b.lo, b.hi));
             }
         }
-        if sweeps >= settings.max_sweeps {
-            let phi = to_nodes(&x, lay);
+        let mut rule = StopRule::new(
+            settings,
+            (hi - lo).abs(),
+            hi.abs().max(lo.abs()),
+            f64::EPSILON,
+        );
+        loop {
+            sweeps += 1;
+            let check = sweeps % settings.check_every == 0;
+            let [red, black] = &mut x;
+            let d0 = half_sweep(0, red, black, &coef[0], lay, omega, check, parallel);
+            let d1 = half_sweep(1, black, red, &coef[1], lay, omega, check, parallel);
+            let d2 = update_blocks(&blocks, &mut x, omega);
+            if check {
+                match rule.converged(d0.max(d1).max(d2)) {
+                    Some(true) => break,
+                    Some(false) => {}
+                    None => {
+                        return Err(Error::NotConverged {
+                            method: Method::Sor.as_str(),
+                            iterations: sweeps,
+                            residual_v: f64::NAN,
+                        });
+                    }
+                }
+            }
+            if sweeps >= settings.max_sweeps {
+                let phi = to_nodes(&x, lay);
+                return Err(Error::NotConverged {
+                    method: Method::Sor.as_str(),
+                    iterations: sweeps,
+                    residual_v: projected_residual(mesh, &dofs, &phi, (lo, hi)),
+                });
+            }
+        }
+        let phi = to_nodes(&x, lay);
+        let bounds = node_bounds(&coef, lay, nn);
+        let und = undepleted_within(mesh, &dofs, &phi, &bounds);
+        let occupied: Vec<bool> = (0..nn).map(|k| ties[k].is_some() && und[k]).collect();
+        let next = pockets::ties(mesh, &phi, (lo, hi), &occupied, flood_tol);
+        if settled(&next, &ties, &levels, &dofs, &phi, level_tol) {
+            break phi;
+        }
+        if rounds >= MAX_LEVEL_ROUNDS {
             return Err(Error::NotConverged {
-                method: Method::Sor.as_str(),
+                method: "sor: pocket levels",
                 iterations: sweeps,
-                residual_v: projected_residual(mesh, &dofs, &phi, (lo, hi)),
+                residual_v: f64::NAN,
             });
         }
-    }
+        levels = next_levels(&next, &levels, &dofs, &phi);
+        ties = next;
+    };
 
-    let phi_v = to_nodes(&x, lay);
-    let residual_v = projected_residual(mesh, &dofs, &phi_v, (lo, hi));
-    let undepleted = undepleted(mesh, &dofs, &phi_v, (lo, hi));
+    let bounds = node_bounds(&coef, lay, nn);
+    let residual_v = projected_residual_within(mesh, &dofs, &phi_v, &bounds);
+    let undepleted = undepleted_within(mesh, &dofs, &phi_v, &bounds);
+    let pockets = find_pockets(mesh, &phi_v, &undepleted);
     Ok(PotentialSolution {
         phi_v,
         undepleted,
         bounds_v: (lo, hi),
+        pockets,
         report: SolveReport {
             backend: Backend::Cpu,
             method: Method::Sor,
@@ -188,4 +228,19 @@ pub fn solve_sor_with(
             seconds: start.elapsed().as_secs_f64(),
         },
     })
+}
+
+/// The bounds (lo, hi) of every node as the coefficients hold them (unbounded for others).
+fn node_bounds(coef: &[Vec<Coef>; 2], lay: Layout, nn: usize) -> Vec<(f64, f64)> {
+    (0..nn)
+        .map(|n| {
+            let (c, s) = lay.slot(n);
+            let cf = coef[c][s];
+            if cf.active {
+                (cf.lo, cf.hi)
+            } else {
+                (f64::NEG_INFINITY, f64::INFINITY)
+            }
+        })
+        .collect()
 }

@@ -130,13 +130,14 @@ pub(super) fn initial(guess_v: Option<&[f64]>, n: usize, q: f64, (lo, hi): (f64,
     x0.clamp(lo, hi)
 }
 
-/// Undepleted nodes from the KKT conditions: a free semiconductor node whose unconstrained
-/// Gauss-Seidel target (q_n + sum w x_m) / sum w lies beyond a bound.
-pub(super) fn undepleted(
+/// The undepleted semiconductor nodes of a converged iterate with every node's own bounds
+/// (`bounds[n]`: the contact potentials, or a pocket's level for a tied node): those whose
+/// unconstrained Gauss-Seidel target lies beyond a bound (KKT readout).
+pub(super) fn undepleted_within(
     mesh: &Mesh,
     dofs: &[Dof],
     phi: &[f64],
-    (lo, hi): (f64, f64),
+    bounds: &[(f64, f64)],
 ) -> Vec<bool> {
     (0..phi.len())
         .map(|n| {
@@ -145,7 +146,7 @@ pub(super) fn undepleted(
             }
             let (t, _) =
                 super::residual::target(mesh, phi, n, &weights(mesh, n), &neighbours(mesh, n));
-            t > hi || t < lo
+            t > bounds[n].1 || t < bounds[n].0
         })
         .collect()
 }

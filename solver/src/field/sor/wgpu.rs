@@ -4,11 +4,13 @@
 
 use std::time::Instant;
 
-use super::residual::projected_residual;
+use super::levels::{Levels, MAX_LEVEL_ROUNDS, next_levels, settled, tied_bounds};
+use super::residual::projected_residual_within;
 use super::settings::{SorSettings, default_omega};
-use super::stencil::{device_problem, undepleted};
-use crate::field::depletion::{PotentialSolution, potential_dofs};
+use super::stencil::{device_problem, undepleted_within};
+use crate::field::depletion::{POCKET_TOL, PotentialSolution, potential_dofs};
 use crate::field::mesh::Mesh;
+use crate::field::pockets::{self, Ties, find_pockets};
 use crate::field::report::{Backend, Method, SolveReport, Termination};
 use crate::field::system::Dof;
 use crate::field::weighting::{Owner, WeightingPotentials, owners};
@@ -81,26 +83,88 @@ pub(crate) fn solve_sor_wgpu_with(
     let gpu = gpu::shared()?;
     let double = gpu.use_f64(precision)?;
     let (dofs, bounds) = potential_dofs(mesh, det, bias_v);
-    let problem = device_problem(mesh, &dofs, &mesh.charge_c, Some(bounds), guess_v, omega)?;
-    let sol = gpu::run(&gpu, &problem, settings, double)?;
-    let phi_v = sol.x;
-    let residual_v = projected_residual(mesh, &dofs, &phi_v, bounds);
-    if !sol.converged {
-        return Err(Error::NotConverged {
-            method: "sor (wgpu)",
-            iterations: sol.sweeps,
-            residual_v,
-        });
+    let mut problem = device_problem(mesh, &dofs, &mesh.charge_c, Some(bounds), guess_v, omega)?;
+    // Pockets (`field::pockets`): rounds of device solves with the tied nodes' bounds at their
+    // pocket's level, the levels moved by secant steps on l = phi(pour point), the ties from a
+    // host flood, until ties and levels are stationary.
+    let base = [
+        (problem.colours[0].lo.clone(), problem.colours[0].hi.clone()),
+        (problem.colours[1].lo.clone(), problem.colours[1].hi.clone()),
+    ];
+    let mut slot = vec![None; nn];
+    for (c, rows) in problem.colours.iter().enumerate() {
+        for (k, &n) in rows.node.iter().enumerate() {
+            slot[n as usize] = Some((c, k));
+        }
     }
-    let undepleted = undepleted(mesh, &dofs, &phi_v, bounds);
+    let span = (bounds.1 - bounds.0).abs().max(1.0);
+    // In f32 levels and depressions are resolved to 1e-6 of the span (1e-5 moved the
+    // ppc-example's pocket at 3500 V by enough to change 5 nodes of its boundary, c12 by 5e-5).
+    let eps = if double { 1e-13 } else { 1e-6 };
+    let level_tol = (10.0 * settings.tolerance).max(eps) * span;
+    let flood_tol = level_tol.max(POCKET_TOL * span);
+    let mut ties: Ties = vec![None; nn];
+    let mut levels = Levels::new();
+    let mut sweeps = 0;
+    let mut rounds = 0;
+    let (phi_v, node_bounds) = loop {
+        rounds += 1;
+        let sol = gpu::run(&gpu, &problem, settings, double)?;
+        sweeps += sol.sweeps;
+        let phi = sol.x;
+        let nb: Vec<(f64, f64)> = (0..nn)
+            .map(|n| match slot[n] {
+                Some((c, k)) => (problem.colours[c].lo[k], problem.colours[c].hi[k]),
+                None => (f64::NEG_INFINITY, f64::INFINITY),
+            })
+            .collect();
+        if !sol.converged {
+            return Err(Error::NotConverged {
+                method: "sor (wgpu)",
+                iterations: sweeps,
+                residual_v: projected_residual_within(mesh, &dofs, &phi, &nb),
+            });
+        }
+        let und = undepleted_within(mesh, &dofs, &phi, &nb);
+        let occupied: Vec<bool> = (0..nn).map(|k| ties[k].is_some() && und[k]).collect();
+        let next = pockets::ties(mesh, &phi, bounds, &occupied, flood_tol);
+        if settled(&next, &ties, &levels, &dofs, &phi, level_tol) {
+            break (phi, nb);
+        }
+        if rounds >= MAX_LEVEL_ROUNDS {
+            return Err(Error::NotConverged {
+                method: "sor (wgpu): pocket levels",
+                iterations: sweeps,
+                residual_v: f64::NAN,
+            });
+        }
+        levels = next_levels(&next, &levels, &dofs, &phi);
+        for (c, (lo, hi)) in base.iter().enumerate() {
+            problem.colours[c].lo.clone_from(lo);
+            problem.colours[c].hi.clone_from(hi);
+        }
+        for (n, t) in next.iter().enumerate() {
+            let (Some(t), Some((c, k))) = (t, slot[n]) else {
+                continue;
+            };
+            let b = (base[c].0[k], base[c].1[k]);
+            (problem.colours[c].lo[k], problem.colours[c].hi[k]) = tied_bounds(t, &levels, b);
+        }
+        problem.x0.clone_from(&phi);
+        ties = next;
+    };
+    let residual_v = projected_residual_within(mesh, &dofs, &phi_v, &node_bounds);
+    let undepleted = undepleted_within(mesh, &dofs, &phi_v, &node_bounds);
+    let pockets = find_pockets(mesh, &phi_v, &undepleted);
     Ok(PotentialSolution {
         phi_v,
         undepleted,
         bounds_v: bounds,
+        pockets,
         report: SolveReport {
             method: Method::Sor,
             backend: Backend::Wgpu,
-            iterations: sol.sweeps,
+            iterations: sweeps,
             residual_v,
             termination: Termination::ToleranceReached,
             seconds: start.elapsed().as_secs_f64(),
