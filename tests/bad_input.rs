@@ -377,3 +377,89 @@ fn simulate_bad_voltages_and_options() {
     ]);
     assert!(msg.contains("bias"), "{msg}");
 }
+
+/// Issue 18: grid and accuracy options. A tolerance <= 0, NaN or below what any grid can reach,
+/// unknown or ill-typed `--grid` keys and an unknown key in a detector's `[grid]` table: errors
+/// naming the option or key, exit 2.
+#[test]
+fn bad_grid_and_tolerance() {
+    let det = write("detector-for-grid.toml", DETECTOR);
+    let d = det.to_str().unwrap();
+    for t in ["0", "-0.01", "nan", "1e-9", "1"] {
+        let msg = fails(&[
+            "simulate",
+            "--detector",
+            d,
+            "--voltages",
+            "25",
+            "--tolerance",
+            t,
+        ]);
+        assert!(
+            msg.contains("--tolerance") && msg.contains("tolerance"),
+            "{t}: {msg}"
+        );
+    }
+    let msg = fails(&[
+        "simulate",
+        "--detector",
+        d,
+        "--voltages",
+        "25",
+        "--grid",
+        "front_spacing=0.1",
+    ]);
+    assert!(msg.contains("unknown grid key `front_spacing`"), "{msg}");
+    let msg = fails(&[
+        "capacitance",
+        "--detector",
+        d,
+        "--voltage",
+        "25",
+        "--grid",
+        "adaptive=perhaps",
+    ]);
+    assert!(msg.contains("`adaptive`"), "{msg}");
+    let msg = fails(&[
+        "capacitance",
+        "--detector",
+        d,
+        "--voltage",
+        "25",
+        "--grid",
+        "front_spacing_mm",
+    ]);
+    assert!(msg.contains("KEY=VALUE"), "{msg}");
+    let msg = fails(&[
+        "simulate",
+        "--detector",
+        d,
+        "--voltages",
+        "25",
+        "--grid",
+        "min_tick_distance_mm=-1",
+    ]);
+    assert!(msg.contains("min_tick_distance_mm"), "{msg}");
+    let with_table = write(
+        "detector-with-grid-table.toml",
+        &format!("{DETECTOR}\n[grid]\ntolerance = 0.01\nspacing_mm = 0.5\n"),
+    );
+    let msg = fails(&["detector", "--detector", with_table.to_str().unwrap()]);
+    assert!(msg.contains("spacing_mm"), "{msg}");
+    let with_bad = write(
+        "detector-with-bad-grid.toml",
+        &format!("{DETECTOR}\n[grid]\ntolerance = -1.0\n"),
+    );
+    let msg = fails(&["detector", "--detector", with_bad.to_str().unwrap()]);
+    assert!(msg.contains("grid") && msg.contains("tolerance"), "{msg}");
+    let msg = fails(&[
+        "convergence",
+        "--detector",
+        d,
+        "--voltage",
+        "25",
+        "--levels",
+        "0",
+    ]);
+    assert!(msg.contains("--levels"), "{msg}");
+}

@@ -155,8 +155,15 @@ fn simulate_coax_json_csv_and_plots() {
     assert!((vd - 3501.1).abs() < 0.003 * 3501.1, "{vd}");
     assert_eq!(v["method"], "fast");
     assert!(v["grid"]["nr"].as_u64().unwrap() > 10 && v["seconds"].as_f64().unwrap() > 0.0);
+    // Issue 18: every c12 with its estimated error, within the default tolerance (0.2%).
+    for (k, c) in c.iter().enumerate() {
+        let e = v["c12_err_pF"][k].as_f64().unwrap();
+        assert!(e >= 0.0 && e <= 0.002 * c, "{k}: {c} +- {e}");
+        assert_eq!(v["tolerance_reached"][k], true);
+    }
+    assert_eq!(v["tolerance"], 0.002);
     let text = std::fs::read_to_string(&csv).unwrap();
-    assert!(text.starts_with("voltage_V,c12_pF,fully_depleted\n25,"));
+    assert!(text.starts_with("voltage_V,c12_pF,fully_depleted,c12_err_pF\n25,"));
     assert_eq!(&std::fs::read(&png).unwrap()[..4], b"\x89PNG");
     assert!(std::fs::read_to_string(&field).unwrap().starts_with("<svg"));
 }
@@ -536,4 +543,69 @@ fn synthesize_then_measure_with_a_broken_file() {
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("nowhere"));
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Issue 18: `convergence` prints c12 against the resolution with the estimates and draws it;
+/// `--tolerance` and `--grid` reach the solver (a tighter tolerance: a smaller estimate).
+#[test]
+fn convergence_and_tolerance_options() {
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("cli_convergence");
+    std::fs::create_dir_all(&dir).unwrap();
+    let png = dir.join("convergence.png");
+    let out = hpge_cv(&[
+        "convergence",
+        "--detector",
+        "detectors/coax-analytic.toml",
+        "--voltage",
+        "1025",
+        "--levels",
+        "3",
+        "--json",
+        "--plot",
+        png.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("one JSON object");
+    let rows = v["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), 4);
+    let nodes: Vec<u64> = rows[..3]
+        .iter()
+        .map(|r| r["nodes"].as_u64().unwrap())
+        .collect();
+    assert!(nodes[0] < nodes[1] && nodes[1] < nodes[2], "{nodes:?}");
+    assert_eq!(rows[3]["adaptive"], true);
+    assert_eq!(&std::fs::read(&png).unwrap()[..4], b"\x89PNG");
+    let c12 = |extra: &[&str]| -> (f64, f64) {
+        let mut args = vec![
+            "capacitance",
+            "--detector",
+            "detectors/coax-analytic.toml",
+            "--voltage",
+            "25",
+            "--json",
+        ];
+        args.extend_from_slice(extra);
+        let out = hpge_cv(&args);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        (
+            v["c12_pF"].as_f64().unwrap(),
+            v["c12_err_pF"].as_f64().unwrap(),
+        )
+    };
+    let (c_loose, e_loose) = c12(&["--tolerance", "0.02", "--grid", "front_spacing_mm=1.0"]);
+    let (c_tight, e_tight) = c12(&["--tolerance", "0.0005"]);
+    assert!(
+        e_tight / c_tight <= 0.0005 && e_tight < e_loose,
+        "{e_tight} vs {e_loose}"
+    );
+    assert!((c_loose / c_tight - 1.0).abs() <= 0.02);
 }

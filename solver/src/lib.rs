@@ -32,16 +32,17 @@ pub use drift::{
 pub use error::{Error, Result};
 pub use expr::Parameters;
 pub use field::{
-    Backend, CapacitanceMatrix, CvCurve, CvPoint, FieldSettings, Mesh, Method, NodeKind,
-    PAPER_EPSILON_FACTOR, Pocket, PointResult, PotentialPoint, PotentialSolution, Seed,
-    SolveReport, Termination, WeightingMode, WeightingPotentials, cv_curve, deepest_depression_v,
-    deepest_empty_depression_v, find_pockets, full_depletion_voltage, normalise_voltages,
-    pinch_off_voltage, solve_fast, solve_point, solve_potential, solve_sor, solve_sor_wgpu,
+    Accuracy, Backend, CapacitanceMatrix, ConvergenceRow, CvCurve, CvPoint, FieldSettings, Mesh,
+    Method, NodeKind, PAPER_EPSILON_FACTOR, Pocket, PointResult, PotentialPoint, PotentialSolution,
+    Seed, SolveReport, Termination, WeightingMode, WeightingPotentials, convergence_study,
+    curve_pinch_off_voltage, cv_curve, deepest_depression_v, deepest_empty_depression_v,
+    find_pockets, full_depletion_voltage, normalise_voltages, pinch_off_voltage, solve_fast,
+    solve_point, solve_point_on_grid, solve_potential, solve_sor, solve_sor_wgpu,
     weighting_potentials, weighting_potentials_wgpu,
 };
 pub use geometry::{BoundingBox, Primitive, Solid};
 pub use gpu::{AdapterReport, Precision, gpu_adapter, gpu_test_gate};
-pub use grid::{Grid, GridSettings};
+pub use grid::{Grid, GridSettings, MIN_TOLERANCE};
 pub use impurity::{
     ClampedNaturalSpline, ConstantModel, ImpurityContext, ImpurityModel, ImpuritySpec,
     LinearZModel, LogTransform, ModelKind, PointDensity, RzModel,

@@ -74,6 +74,8 @@ pub struct DiscoverArgs {
     /// (Laplace; the default, because the surrogate is up to 27% off on z-only profiles).
     #[arg(long)]
     pub surrogate_only: bool,
+    #[command(flatten)]
+    pub grid: super::args::GridArgs,
 }
 
 /// Stage lines and the sampler's progress on stderr.
@@ -140,7 +142,7 @@ pub fn run(a: &DiscoverArgs) -> Result<()> {
     }
     let prior_file = start_prior(&a.start_model)?;
     let noise = noise_settings("paper")?;
-    let s = setup(&a.data, &a.model, &prior_file, &a.detector, noise)?;
+    let s = setup(&a.data, &a.model, &prior_file, &a.detector, noise, &a.grid)?;
     let spec = PriorSpec::from_file(&prior_file)?;
     let out = a.out.clone().unwrap_or_else(|| {
         PathBuf::from("discoveries").join(

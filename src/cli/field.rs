@@ -107,7 +107,10 @@ pub fn run(a: &FieldArgs) -> Result<()> {
             .map(|k| b.r_min_mm + (b.r_max_mm - b.r_min_mm) * k as f64 / 200.0)
             .collect(),
     };
-    let settings = a.solver.settings(WeightingArg::Conductor);
+    let settings = a
+        .solver
+        .grid
+        .apply(&a.solver.settings(WeightingArg::Conductor), &det)?;
     backend_json(&settings)?;
     let point = hpge_solver::solve_point(&det, a.voltage, &settings, None)?;
     let field = ElectricField::new(&det, &point);

@@ -43,6 +43,7 @@ pub struct FitOptions<'a> {
     pub truth: Option<&'a Path>,
     pub no_plots: bool,
     pub mode_starts: usize,
+    pub grid: &'a super::args::GridArgs,
 }
 
 /// Everything a fit was set up from.
@@ -66,6 +67,7 @@ pub fn setup(
     prior: &Path,
     detector: &Path,
     noise: hpge_inference::NoiseSettings,
+    grid: &super::args::GridArgs,
 ) -> Result<Setup> {
     let data_curve = match load_data(data)? {
         Data::Curve(c) => c,
@@ -76,12 +78,11 @@ pub fn setup(
         ),
     };
     let surrogate = Surrogate::load(model)?;
-    let exact = ExactSolver::new(
-        surrogate.info.space.clone(),
-        detector,
-        hpge_solver::FieldSettings::default(),
-    )
-    .with_context(|| format!("--detector {}", detector.display()))?;
+    let det = hpge_solver::Detector::from_file(detector, &hpge_solver::Parameters::new())
+        .with_context(|| format!("--detector {}", detector.display()))?;
+    let settings = grid.apply(&hpge_solver::FieldSettings::default(), &det)?;
+    let exact = ExactSolver::new(surrogate.info.space.clone(), detector, settings)
+        .with_context(|| format!("--detector {}", detector.display()))?;
     match &surrogate.info.detector {
         Some(d) if d.hash != exact.detector_hash() => bail!(
             "{}: the model was trained for the detector {} (hash {}), not for {} (hash {}); \
@@ -183,7 +184,7 @@ pub fn noise_settings(likelihood: &str) -> Result<hpge_inference::NoiseSettings>
 pub fn run(o: &FitOptions) -> Result<()> {
     let kind = sampler_kind(o.sampler)?;
     let noise = noise_settings(o.likelihood)?;
-    let s = setup(o.data, o.model, o.prior, o.detector, noise)?;
+    let s = setup(o.data, o.model, o.prior, o.detector, noise, o.grid)?;
     let truth = match o.truth {
         Some(p) => Some(read_truth(p, &s.prior)?),
         None => None,

@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::Result;
-use hpge_solver::FieldSettings;
+use hpge_solver::{Detector, FieldSettings, Parameters};
 use hpge_surrogate::{Generator, ParameterSpace, SequenceKind, Shard, merge, run};
 use indicatif::{ProgressBar, ProgressStyle};
 
@@ -19,20 +19,16 @@ pub struct GenerateOptions<'a> {
     pub threads: Option<usize>,
     pub seed: u64,
     pub sequence: SequenceKind,
+    pub grid: &'a super::args::GridArgs,
 }
 
 /// Runs or resumes a generation.
 pub fn generate(o: &GenerateOptions<'_>) -> Result<()> {
     let space = ParameterSpace::from_file(o.space)?;
+    let det = Detector::from_file(o.detector, &Parameters::new())?;
+    let settings = o.grid.apply(&FieldSettings::default(), &det)?;
     let g = Generator::new(
-        space,
-        o.detector,
-        FieldSettings::default(),
-        o.sequence,
-        o.seed,
-        o.offset,
-        o.n,
-        o.shard,
+        space, o.detector, settings, o.sequence, o.seed, o.offset, o.n, o.shard,
     )?;
     let bar = ProgressBar::new(0);
     bar.set_style(

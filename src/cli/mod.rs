@@ -1,6 +1,7 @@
 //! Command-line interface: argument definitions and dispatch.
 
 mod args;
+mod convergence;
 mod detector;
 mod discover;
 mod discover_report;
@@ -24,7 +25,7 @@ use std::path::PathBuf;
 use anyhow::Result;
 use clap::{Parser, Subcommand};
 
-pub use args::{parse_param, parse_point, parse_voltages};
+pub use args::{GridArgs, parse_param, parse_point, parse_voltages};
 pub use fit::Unconverged;
 pub use sensitivity::ScanPoint;
 
@@ -48,6 +49,9 @@ enum Command {
     Simulate(SimulateArgs),
     /// The full Maxwell capacitance matrix at one bias.
     Capacitance(CapacitanceArgs),
+    /// Grid convergence of c12 at one bias: fixed grids from coarse to fine, each with its error
+    /// estimate, beside the adaptive answer at the tolerance.
+    Convergence(convergence::ConvergenceArgs),
     /// The charge signals of one interaction at (r, phi, z): electron and hole drifted with the
     /// ADL model through the field at one bias, induced charges on every contact (Shockley-Ramo).
     Pulse(pulse::PulseArgs),
@@ -238,6 +242,8 @@ struct FitArgs {
     /// Nelder-Mead starts of the mode search before sampling (0: none).
     #[arg(long, default_value_t = 24)]
     mode_starts: usize,
+    #[command(flatten)]
+    grid: args::GridArgs,
 }
 
 /// The shipped surrogate `fit` uses by default.
@@ -354,6 +360,8 @@ struct GenerateArgs {
     /// Sequence.
     #[arg(long, value_enum, default_value = "golden")]
     sequence: SequenceArg,
+    #[command(flatten)]
+    grid: args::GridArgs,
 }
 
 #[derive(Debug, clap::Args)]
@@ -491,6 +499,8 @@ struct SolverArgs {
     /// Floating-point precision on the wgpu backend.
     #[arg(long = "gpu-precision", value_enum, default_value = "auto")]
     gpu_precision: PrecisionArg,
+    #[command(flatten)]
+    grid: args::GridArgs,
 }
 
 impl SolverArgs {
@@ -638,6 +648,7 @@ pub fn run(cli: Cli) -> Result<()> {
                 d_li_mm: a.d_li,
                 voltages: &volts,
                 settings: a.solver.settings(a.weighting),
+                grid: &a.solver.grid,
                 json: a.json,
                 out: a.out.as_ref(),
                 plot: a.plot.as_ref(),
@@ -650,6 +661,7 @@ pub fn run(cli: Cli) -> Result<()> {
             voltage_v: a.voltage,
             zetas_cm3: &a.zeta_range,
             settings: a.solver.settings(WeightingArg::Conductor),
+            grid: &a.solver.grid,
             json: a.json,
             out: a.out.as_ref(),
             plot: a.plot.as_ref(),
@@ -667,6 +679,7 @@ pub fn run(cli: Cli) -> Result<()> {
                 SequenceArg::Golden => hpge_surrogate::SequenceKind::Golden,
                 SequenceArg::Sobol => hpge_surrogate::SequenceKind::Sobol,
             },
+            grid: &a.grid,
         }),
         Command::Merge(a) => generate::merge_shards(&a.dirs, &a.out),
         Command::Train(a) => surrogate::train(&surrogate::TrainOptions {
@@ -708,11 +721,13 @@ pub fn run(cli: Cli) -> Result<()> {
                 truth: a.truth.as_deref(),
                 no_plots: a.no_plots,
                 mode_starts: a.mode_starts,
+                grid: &a.grid,
             })
         }
         Command::Discover(a) => discover::run(&a),
         Command::Report(a) => crate::report::run(&a),
         Command::Pulse(a) => pulse::run(&a),
+        Command::Convergence(a) => convergence::run(&a),
         Command::Field(a) => field::run(&a),
         Command::PaperSection9 { out } => {
             for f in crate::paper::section9(&out, &crate::paper::Section9Inputs::default())? {
@@ -791,7 +806,7 @@ pub fn run(cli: Cli) -> Result<()> {
         }
         Command::Capacitance(a) => {
             let settings = a.solver.settings(a.weighting);
-            simulate::capacitance(&a.input, a.voltage, &settings, a.json)
+            simulate::capacitance(&a.input, a.voltage, &settings, &a.solver.grid, a.json)
         }
     }
 }

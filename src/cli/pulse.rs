@@ -95,7 +95,10 @@ pub fn run(a: &PulseArgs) -> Result<()> {
             det.contacts[i].name
         );
     }
-    let settings = a.solver.settings(WeightingArg::Conductor);
+    let settings = a
+        .solver
+        .grid
+        .apply(&a.solver.settings(WeightingArg::Conductor), &det)?;
     backend_json(&settings)?;
     let point = hpge_solver::solve_point(&det, a.voltage, &settings, None)?;
     let field = ElectricField::new(&det, &point);

@@ -56,6 +56,8 @@ pub struct SensitivityOptions<'a> {
     pub plot: Option<&'a PathBuf>,
     /// Backend, method and precision (weighting: conductor).
     pub settings: FieldSettings,
+    /// Grid and accuracy options.
+    pub grid: &'a super::args::GridArgs,
 }
 
 /// Runs the scan and writes what was asked for.
@@ -70,7 +72,7 @@ pub fn run(o: &SensitivityOptions<'_>) -> Result<()> {
         plot::check_output(p, "--plot")?;
     }
     let mut det = load_detector(o.input)?;
-    let settings = o.settings.clone();
+    let settings = o.grid.apply(&o.settings, &det)?;
     let device = super::simulate::backend_json(&settings)?;
     let bar = ProgressBar::new(o.zetas_cm3.len() as u64);
     bar.set_style(

@@ -5,14 +5,14 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result, bail};
 use hpge_solver::{
-    Backend, CvCurve, Error, FieldSettings, Precision, cv_curve, gpu_adapter, normalise_voltages,
-    solve_point, solve_potential,
+    Backend, CvCurve, Error, FieldSettings, Precision, curve_pinch_off_voltage, cv_curve,
+    gpu_adapter, normalise_voltages, solve_point, solve_potential,
 };
 use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::json;
 
 use super::DetectorInput;
-use super::args::load_detector;
+use super::args::{GridArgs, load_detector};
 use crate::plot;
 
 /// Options of `simulate`.
@@ -21,6 +21,7 @@ pub struct SimulateOptions<'a> {
     pub d_li_mm: Option<f64>,
     pub voltages: &'a [f64],
     pub settings: FieldSettings,
+    pub grid: &'a GridArgs,
     pub json: bool,
     pub out: Option<&'a PathBuf>,
     pub plot: Option<&'a PathBuf>,
@@ -69,7 +70,7 @@ pub fn run(o: &SimulateOptions<'_>) -> Result<()> {
             det.file.display()
         );
     }
-    let settings = o.settings.clone();
+    let settings = o.grid.apply(&o.settings, &det)?;
     let device = backend_json(&settings)?;
     let bar = ProgressBar::new(volts.len() as u64);
     bar.set_style(
@@ -103,6 +104,40 @@ pub fn run(o: &SimulateOptions<'_>) -> Result<()> {
         }
         Err(e) => return Err(e.into()),
     };
+    let missed: Vec<&hpge_solver::CvPoint> = curve
+        .points
+        .iter()
+        .filter(|p| !p.tolerance_reached)
+        .collect();
+    if settings.grid.adaptive && !missed.is_empty() && missed.len() == curve.points.len() {
+        bail!(
+            "grid.tolerance {:e}: no bias reached it (estimated relative errors {:.1e} to {:.1e}); the grid cannot be refined that far with min_tick_distance_mm = {} mm in {} passes: raise --tolerance",
+            settings.grid.tolerance,
+            missed
+                .iter()
+                .map(|p| p.c12_err_pf / p.c12_pf)
+                .fold(f64::INFINITY, f64::min),
+            missed
+                .iter()
+                .map(|p| p.c12_err_pf / p.c12_pf)
+                .fold(0.0, f64::max),
+            settings.grid.min_tick_distance_mm,
+            settings.grid.max_adaptive_passes
+        );
+    }
+    for p in &missed {
+        eprintln!(
+            "note: at {} V the estimated error of c12 is {:.2}% (tolerance {:.2}%){}",
+            p.voltage_v,
+            100.0 * p.c12_err_pf / p.c12_pf,
+            100.0 * settings.grid.tolerance,
+            if p.pockets.is_empty() {
+                ""
+            } else {
+                ": a pocket's neck at pinch-off, where c12 changes faster than any grid resolves"
+            }
+        );
+    }
     if curve.points.iter().all(|p| !p.fully_depleted) && curve.points.len() > 1 {
         eprintln!("note: the detector is not fully depleted at any listed voltage");
     }
@@ -117,14 +152,19 @@ pub fn run(o: &SimulateOptions<'_>) -> Result<()> {
         let p = solve_potential(&det, u, &settings, None)?;
         plot::field_map(&det, &p, None, path)?;
     }
+    let pinch_off_v = curve_pinch_off_voltage(&det, &curve, &settings)?;
     let last = curve.points.last().map_or((0, 0), |p| p.grid);
     if o.json {
         let v = json!({
             "voltage_V": curve.points.iter().map(|p| p.voltage_v).collect::<Vec<_>>(),
             "c12_pF": curve.points.iter().map(|p| p.c12_pf).collect::<Vec<_>>(),
+            "c12_err_pF": curve.points.iter().map(|p| p.c12_err_pf).collect::<Vec<_>>(),
+            "tolerance_reached": curve.points.iter().map(|p| p.tolerance_reached).collect::<Vec<_>>(),
+            "tolerance": settings.grid.tolerance,
+            "adaptive": settings.grid.adaptive,
             "fully_depleted": curve.points.iter().map(|p| p.fully_depleted).collect::<Vec<_>>(),
             "depletion_voltage_V": curve.depletion_voltage_v,
-            "pinch_off_voltage_V": curve.pinch_off_voltage_v,
+            "pinch_off_voltage_V": pinch_off_v,
             "pockets": curve.points.iter().map(|p| p.pockets.iter().map(|k| json!({
                 "carrier": k.carrier,
                 "level_V": k.level_v,
@@ -149,13 +189,13 @@ pub fn run(o: &SimulateOptions<'_>) -> Result<()> {
         println!("{v}");
     } else {
         println!(
-            "{:>10} {:>12} {:>8} {:>11}",
-            "U_B (V)", "c12 (pF)", "depleted", "grid"
+            "{:>10} {:>12} {:>10} {:>8} {:>11}",
+            "U_B (V)", "c12 (pF)", "+- (pF)", "depleted", "grid"
         );
         for p in &curve.points {
             println!(
-                "{:>10} {:>12.5} {:>8} {:>5}x{:<5}",
-                p.voltage_v, p.c12_pf, p.fully_depleted, p.grid.0, p.grid.1
+                "{:>10} {:>12.5} {:>10.2e} {:>8} {:>5}x{:<5}",
+                p.voltage_v, p.c12_pf, p.c12_err_pf, p.fully_depleted, p.grid.0, p.grid.1
             );
         }
         for p in curve.points.iter().filter(|p| !p.pockets.is_empty()) {
@@ -171,7 +211,7 @@ pub fn run(o: &SimulateOptions<'_>) -> Result<()> {
                 );
             }
         }
-        if let Some(v) = curve.pinch_off_voltage_v {
+        if let Some(v) = pinch_off_v {
             println!("pinch-off voltage {v:.1} V (a pocket of trapped carriers forms)");
         }
         match curve.depletion_voltage_v {
@@ -224,9 +264,13 @@ pub(super) fn backend_json(settings: &FieldSettings) -> Result<serde_json::Value
 fn write_csv(path: &std::path::Path, curve: &CvCurve) -> Result<()> {
     let mut f = std::fs::File::create(path)
         .with_context(|| format!("--out {}: cannot create the file", path.display()))?;
-    writeln!(f, "voltage_V,c12_pF,fully_depleted")?;
+    writeln!(f, "voltage_V,c12_pF,fully_depleted,c12_err_pF")?;
     for p in &curve.points {
-        writeln!(f, "{},{},{}", p.voltage_v, p.c12_pf, p.fully_depleted)?;
+        writeln!(
+            f,
+            "{},{},{},{}",
+            p.voltage_v, p.c12_pf, p.fully_depleted, p.c12_err_pf
+        )?;
     }
     Ok(())
 }
@@ -236,12 +280,14 @@ pub fn capacitance(
     input: &DetectorInput,
     voltage: f64,
     settings: &FieldSettings,
+    grid: &GridArgs,
     as_json: bool,
 ) -> Result<()> {
     if !(voltage.is_finite() && voltage > 0.0) {
         bail!("--voltage {voltage}: the bias must be a positive number of volts");
     }
     let det = load_detector(input)?;
+    let settings = &grid.apply(settings, &det)?;
     let device = backend_json(settings)?;
     let p = solve_point(&det, voltage, settings, None)?;
     let c = &p.capacitance;
@@ -252,6 +298,9 @@ pub fn capacitance(
             "maxwell_pF": c.energy_pf,
             "maxwell_from_charges_pF": c.charge_pf,
             "c12_pF": p.c12_pf,
+            "c12_err_pF": p.accuracy.c12_err_pf,
+            "adaptive_passes": p.accuracy.passes,
+            "tolerance_reached": p.accuracy.reached,
             "fully_depleted": p.fully_depleted(),
             "grid": {"nr": p.mesh.grid.nr(), "nz": p.mesh.grid.nz()},
             "method": settings.method.as_str(),
@@ -289,8 +338,10 @@ pub fn capacitance(
             println!();
         }
         println!(
-            "c12 = -C*_12 = {:.5} pF; fully depleted: {}",
+            "c12 = -C*_12 = {:.5} pF (estimated error {:.2e} pF, {} adaptive passes); fully depleted: {}",
             p.c12_pf,
+            p.accuracy.c12_err_pf,
+            p.accuracy.passes,
             p.fully_depleted()
         );
     }

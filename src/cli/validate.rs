@@ -38,7 +38,14 @@ pub fn coverage(o: &CoverageOptions) -> Result<()> {
     }
     let kind = sampler_kind(o.sampler)?;
     let noise = noise_settings(o.likelihood)?;
-    let s = setup(o.data, o.model, o.prior, o.detector, noise)?;
+    let s = setup(
+        o.data,
+        o.model,
+        o.prior,
+        o.detector,
+        noise,
+        &super::args::GridArgs::default(),
+    )?;
     let mut sample = SampleSettings::for_sampler(kind);
     sample.ess_min = o.ess;
     // A study needs many fits: a fit that has not reached its ESS after 20 000 kept draws per

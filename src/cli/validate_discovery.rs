@@ -68,6 +68,8 @@ pub struct DiscoveryArgs {
     /// Write no figures.
     #[arg(long)]
     pub no_plots: bool,
+    #[command(flatten)]
+    pub grid: super::args::GridArgs,
 }
 
 /// The study's result.
@@ -91,7 +93,14 @@ pub fn run(a: &DiscoveryArgs) -> Result<()> {
         }
     }
     let noise = noise_settings("paper")?;
-    let s = setup(&a.data, &a.model, &a.start_model, &a.detector, noise)?;
+    let s = setup(
+        &a.data,
+        &a.model,
+        &a.start_model,
+        &a.detector,
+        noise,
+        &a.grid,
+    )?;
     let start = PriorSpec::from_file(&a.start_model)?;
     let mut sample = SampleSettings::for_sampler(SamplerKind::Metropolis);
     sample.ess_min = a.ess;

@@ -35,6 +35,7 @@ macro_rules! render {
 }
 
 mod colormap;
+mod convergence;
 mod coverage;
 mod cross_section;
 mod cv;
@@ -48,6 +49,7 @@ mod surrogate;
 
 use std::path::Path;
 
+pub use convergence::convergence;
 pub use coverage::coverage_figures;
 pub use cross_section::cross_section;
 pub use cv::cv_curve;

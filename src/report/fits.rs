@@ -64,6 +64,7 @@ fn run_fit(ctx: &Ctx, key: &str, prior: &Path, truth: Option<&Path>) -> Result<V
         truth,
         no_plots: false,
         mode_starts: 24,
+        grid: &crate::cli::GridArgs::default(),
     })?;
     let path = out.join("summary.json");
     let text = std::fs::read_to_string(&path)

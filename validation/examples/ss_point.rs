@@ -46,8 +46,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             }
         }
         println!(
-            "U_B {v:>6} V  c12 {:>9.4} pF  grid {}x{} ({} nodes)  passes {}  iterations {it}  undepleted {}  potential {solve:.2} s  point {:.2} s",
+            "U_B {v:>6} V  c12 {:>9.4} pF +- {:.1e} ({} adaptive)  grid {}x{} ({} nodes)  passes {}  iterations {it}  undepleted {}  potential {solve:.2} s  point {:.2} s",
             p.c12_pf,
+            p.accuracy.c12_err_pf,
+            p.accuracy.passes,
             p.mesh.grid.nr(),
             p.mesh.grid.nz(),
             p.mesh.grid.len(),

@@ -5,6 +5,7 @@
 //! references, planar cases and synthetic truths. The integration tests in `tests/` check the
 //! solver crate against them.
 
+mod accuracy;
 mod coax;
 mod coverage;
 mod error;
@@ -12,6 +13,7 @@ mod hidden;
 mod planar;
 mod radial1d;
 
+pub use accuracy::{AccuracyCase, AccuracyRow, accuracy_cases, accuracy_row};
 pub use coax::{COAX_REFERENCE_TABLE, LongCoax};
 pub use coverage::{
     COVERAGE_LEVELS, CoverageReport, CoverageSettings, ParameterCoverage, binomial_interval,

@@ -344,6 +344,13 @@ pub(crate) fn build(spec: &DetectorSpec, file: &Path, overrides: &Parameters) ->
         semiconductor,
         contacts,
         passives,
+        grid: match &spec.grid {
+            Some(g) => {
+                g.validate().map_err(|m| Error::invalid(file, "grid", m))?;
+                Some(g.clone())
+            }
+            None => None,
+        },
     })
 }
 

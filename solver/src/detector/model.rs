@@ -204,6 +204,9 @@ pub struct Detector {
     pub contacts: Vec<Contact>,
     /// Passive objects.
     pub passives: Vec<Passive>,
+    /// The file's `[grid]` table (grid and accuracy settings for this detector), if it has one;
+    /// [`crate::FieldSettings::for_detector`] puts it into force.
+    pub grid: Option<crate::GridSettings>,
 }
 
 impl Detector {

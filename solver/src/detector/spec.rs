@@ -31,6 +31,10 @@ pub(crate) struct DetectorSpec {
     pub contacts: Vec<ContactSpec>,
     #[serde(default)]
     pub passives: Vec<PassiveSpec>,
+    /// Grid and accuracy settings for this detector (`GridSettings`: keys left out keep their
+    /// defaults; unknown keys are errors).
+    #[serde(default)]
+    pub grid: Option<crate::grid::GridSettings>,
 }
 
 #[derive(Debug, Clone, Deserialize, Serialize)]

@@ -4,9 +4,8 @@ use serde::Serialize;
 
 use super::full_depletion::full_depletion_voltage;
 use super::mesh::Mesh;
-use super::pinch_off::pinch_off_voltage;
 use super::pockets::Pocket;
-use super::point::{FieldSettings, Seed, solve_point};
+use super::point::{FieldSettings, Seed, solve_point_with};
 use crate::{Detector, Error, Result};
 
 /// One point of a C-V curve.
@@ -16,6 +15,10 @@ pub struct CvPoint {
     pub voltage_v: f64,
     /// Mutual capacitance c12, pF.
     pub c12_pf: f64,
+    /// Estimated absolute error of c12, pF (`field::adaptive`).
+    pub c12_err_pf: f64,
+    /// True when the estimate is within the settings' tolerance (see `Accuracy::reached`).
+    pub tolerance_reached: bool,
     /// No undepleted semiconductor node at this bias.
     pub fully_depleted: bool,
     /// Final grid size (r ticks, z ticks).
@@ -42,10 +45,6 @@ pub struct CvCurve {
     /// from the unconstrained potential on the first fully depleted point's grid
     /// (`full_depletion_voltage`); None when no listed bias depletes the detector.
     pub depletion_voltage_v: Option<f64>,
-    /// Pinch-off voltage (V): the lowest bias at which a trapped-carrier pocket exists, bisected
-    /// between the last listed bias without a pocket (or 0 V) and the first with one, on the
-    /// latter's grid (`pinch_off_voltage`); None when no listed bias holds a pocket.
-    pub pinch_off_voltage_v: Option<f64>,
 }
 
 /// Checks a voltage list: every value finite and positive; returns it sorted and deduplicated.
@@ -90,22 +89,24 @@ pub fn cv_curve(
     let done = AtomicUsize::new(0);
     // Each chunk returns its points and the mesh of its first fully depleted point (for the
     // full-depletion voltage).
-    type Part = (Vec<CvPoint>, Option<Mesh>, Option<Mesh>);
+    type Part = (Vec<CvPoint>, Option<Mesh>);
     let parts: Vec<Result<Part>> = volts
         .par_chunks(size)
         .map(|chunk| {
             let mut points = Vec::with_capacity(chunk.len());
             let mut prev: Option<Seed> = None;
             let mut depleted_mesh: Option<Mesh> = None;
-            let mut pocket_mesh: Option<Mesh> = None;
+            let mut depleted_stage = None;
             for (k, &v) in chunk.iter().enumerate() {
                 let start = std::time::Instant::now();
-                let p = solve_point(det, v, settings, prev.as_ref())?;
+                let p = solve_point_with(det, v, settings, prev.as_ref(), &mut depleted_stage)?;
                 // Scale the potential to the next bias for a better seed.
                 let scale = chunk.get(k + 1).map_or(1.0, |next| next / v);
                 points.push(CvPoint {
                     voltage_v: v,
                     c12_pf: p.c12_pf,
+                    c12_err_pf: p.accuracy.c12_err_pf,
+                    tolerance_reached: p.accuracy.reached,
                     fully_depleted: p.fully_depleted(),
                     grid: (p.mesh.grid.nr(), p.mesh.grid.nz()),
                     passes: p.reports.len(),
@@ -114,26 +115,21 @@ pub fn cv_curve(
                     seconds: start.elapsed().as_secs_f64(),
                     pockets: p.potential.pockets.clone(),
                 });
-                if pocket_mesh.is_none() && !p.potential.pockets.is_empty() {
-                    pocket_mesh = Some(p.mesh.clone());
-                }
                 if depleted_mesh.is_none() && p.fully_depleted() {
                     depleted_mesh = Some(p.mesh.clone());
                 }
                 prev = Some(p.seed(scale));
                 progress(done.fetch_add(1, Ordering::Relaxed) + 1, volts.len());
             }
-            Ok((points, depleted_mesh, pocket_mesh))
+            Ok((points, depleted_mesh))
         })
         .collect();
     let mut points = Vec::with_capacity(volts.len());
     let mut depleted_mesh = None;
-    let mut pocket_mesh = None;
     for part in parts {
-        let (pts, mesh, pmesh) = part?;
+        let (pts, mesh) = part?;
         points.extend(pts);
         depleted_mesh = depleted_mesh.or(mesh);
-        pocket_mesh = pocket_mesh.or(pmesh);
     }
     // The first chunk with a fully depleted point holds the first such point overall.
     let depletion_voltage_v = match (points.iter().position(|p| p.fully_depleted), depleted_mesh) {
@@ -143,25 +139,9 @@ pub fn cv_curve(
         }
         _ => None,
     };
-    let pinch_off_voltage_v = match (
-        points.iter().position(|p| !p.pockets.is_empty()),
-        pocket_mesh,
-    ) {
-        (Some(k), Some(mesh)) => {
-            let lo = if k > 0 { points[k - 1].voltage_v } else { 0.0 };
-            pinch_off_voltage(
-                &mesh,
-                det,
-                lo.max(1e-3 * points[k].voltage_v),
-                points[k].voltage_v,
-            )?
-        }
-        _ => None,
-    };
     Ok(CvCurve {
         points,
         depletion_voltage_v,
-        pinch_off_voltage_v,
     })
 }
 

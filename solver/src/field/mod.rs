@@ -1,7 +1,9 @@
 //! Field solves: potential with depletion, weighting potentials, capacitance matrix.
 
+mod adaptive;
 mod capacitance;
 mod cholesky;
+mod convergence;
 mod curve;
 mod depletion;
 mod front;
@@ -16,14 +18,19 @@ mod system;
 mod union_find;
 mod weighting;
 
+pub use adaptive::Accuracy;
 pub use capacitance::CapacitanceMatrix;
+pub use convergence::{ConvergenceRow, convergence_study};
 pub use curve::{CvCurve, CvPoint, cv_curve, normalise_voltages};
 pub use depletion::{PotentialSolution, solve_fast};
 pub use full_depletion::full_depletion_voltage;
 pub use mesh::{Mesh, NodeKind};
-pub use pinch_off::pinch_off_voltage;
+pub use pinch_off::{curve_pinch_off_voltage, pinch_off_voltage};
 pub use pockets::{Pocket, deepest_depression_v, deepest_empty_depression_v, find_pockets};
-pub use point::{FieldSettings, PointResult, PotentialPoint, Seed, solve_point, solve_potential};
+pub use point::{
+    FieldSettings, PointResult, PotentialPoint, Seed, solve_point, solve_point_on_grid,
+    solve_potential,
+};
 pub use report::{Backend, Method, SolveReport, Termination};
 pub use sor::{solve_sor, solve_sor_wgpu, weighting_potentials_wgpu};
 pub use weighting::{

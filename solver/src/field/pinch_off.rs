@@ -6,8 +6,10 @@
 //! bisected with full solves on one fixed mesh, each seeded by the last (the answer does not
 //! depend on the seed).
 
+use super::curve::CvCurve;
 use super::depletion::solve_fast;
 use super::mesh::Mesh;
+use super::point::{FieldSettings, solve_potential};
 use crate::{Detector, Result};
 
 /// Relative width to which the pinch-off voltage is bisected.
@@ -37,4 +39,27 @@ pub fn pinch_off_voltage(mesh: &Mesh, det: &Detector, lo_v: f64, hi_v: f64) -> R
         guess = s.phi_v;
     }
     Ok(Some(hi))
+}
+
+/// The pinch-off voltage of a C-V curve (V): bisected ([`pinch_off_voltage`]) between the last
+/// listed bias without a pocket (or 0.1% of the first with one) and the first with one, on the
+/// latter's refined grid; None when no listed bias holds a pocket. About 20 solves on that grid:
+/// asked for explicitly (`hpge-cv simulate` reports it), not part of every [`super::cv_curve`]
+/// (the training data and the fits' exact solves do not need it).
+pub fn curve_pinch_off_voltage(
+    det: &Detector,
+    curve: &CvCurve,
+    settings: &FieldSettings,
+) -> Result<Option<f64>> {
+    let Some(k) = curve.points.iter().position(|p| !p.pockets.is_empty()) else {
+        return Ok(None);
+    };
+    let hi = curve.points[k].voltage_v;
+    let lo = if k > 0 {
+        curve.points[k - 1].voltage_v
+    } else {
+        0.0
+    };
+    let p = solve_potential(det, hi, settings, None)?;
+    pinch_off_voltage(&p.mesh, det, lo.max(1e-3 * hi), hi)
 }

@@ -2,14 +2,12 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::adaptive::{Accuracy, Weighed, undepleted_nodes, weigh, weighting_marks};
 use super::capacitance::CapacitanceMatrix;
 use super::depletion::{PotentialSolution, solve_fast};
-use super::mesh::{Mesh, NodeKind};
+use super::mesh::Mesh;
 use super::report::{Backend, Method, SolveReport};
-use super::weighting::{
-    PAPER_EPSILON_FACTOR, WeightingMode, WeightingPotentials, paper_epsilon_mesh,
-    weighting_potentials,
-};
+use super::weighting::{WeightingMode, WeightingPotentials};
 use crate::gpu::Precision;
 use crate::grid::{Grid, GridSettings};
 use crate::{Detector, Error, Result};
@@ -48,6 +46,15 @@ impl Default for FieldSettings {
 }
 
 impl FieldSettings {
+    /// These settings with the detector's `[grid]` table in force (grid and accuracy settings of
+    /// that detector), where its file has one.
+    pub fn for_detector(&self, det: &Detector) -> FieldSettings {
+        FieldSettings {
+            grid: det.grid.clone().unwrap_or_else(|| self.grid.clone()),
+            ..self.clone()
+        }
+    }
+
     /// Checks all fields (the message names the field).
     pub fn validate(&self) -> Result<(), String> {
         self.grid.validate().map_err(|m| format!("grid: {m}"))?;
@@ -83,6 +90,8 @@ pub struct PointResult {
     pub contact_layers: usize,
     /// Reports of the potential solves (one per refinement pass).
     pub reports: Vec<SolveReport>,
+    /// The estimated error of c12 and the adaptive passes (`field::adaptive`).
+    pub accuracy: Accuracy,
 }
 
 impl PointResult {
@@ -176,7 +185,7 @@ pub struct PotentialPoint {
 /// Solves the potential at `bias_v` with refinement (div(eps grad phi) = -rho with the
 /// depletion bounds and pockets, paper Eq. (3)), without the weighting potentials: the state a
 /// user looks at when the weighting problem fails (an undepleted region shorting two contacts).
-/// The same mesh and potential as [`solve_point`] for the same arguments.
+/// The mesh and potential [`solve_point`] starts its adaptive passes from.
 pub fn solve_potential(
     det: &Detector,
     bias_v: f64,
@@ -186,7 +195,12 @@ pub fn solve_potential(
     refined_potential(det, bias_v, settings, seed)
 }
 
-/// Solves the potential at `bias_v` with refinement, then the weighting potentials and C*.
+/// Solves the potential at `bias_v` with refinement, then the weighting potentials and C*, and
+/// refines until the estimated relative error of c12 is below `settings.grid.tolerance`
+/// (`field::adaptive`; with `adaptive` off, one evaluation on the potential's grid, with its
+/// estimate). A point whose estimate stays above the tolerance (every interval to refine at
+/// `min_tick_distance_mm`, or `max_adaptive_passes` done: e.g. the neck of a pocket at
+/// pinch-off) is returned with `accuracy.reached` false; callers say so.
 ///
 /// `seed` may carry the solution at a neighbouring voltage: the initial grid is split down to
 /// `front_spacing_mm` where its front lay, and its potential seeds the active set.
@@ -196,63 +210,185 @@ pub fn solve_point(
     settings: &FieldSettings,
     seed: Option<&Seed>,
 ) -> Result<PointResult> {
-    let (a, b) = pair(det)?;
+    solve_point_with(det, bias_v, settings, seed, &mut None)
+}
+
+/// The weighting stage of a fully depleted point on its final grid: the same for every fully
+/// depleted bias of one detector and settings, so a C-V curve computes it once.
+#[derive(Clone)]
+pub(crate) struct DepletedStage {
+    grid: Grid,
+    weighed: Weighed,
+    accuracy: Accuracy,
+}
+
+/// [`solve_point`], reusing (and filling) `depleted`, the weighting stage of a fully depleted
+/// point at another bias.
+pub(crate) fn solve_point_with(
+    det: &Detector,
+    bias_v: f64,
+    settings: &FieldSettings,
+    seed: Option<&Seed>,
+    depleted: &mut Option<DepletedStage>,
+) -> Result<PointResult> {
+    let pair = pair(det)?;
+    let gs = &settings.grid;
     let PotentialPoint {
         mesh,
-        potential: pot,
-        reports,
+        potential,
+        mut reports,
         ..
     } = refined_potential(det, bias_v, settings, seed)?;
-    let weigh = |mesh: &Mesh, undepleted: &[bool]| match settings.backend {
-        Backend::Cpu => weighting_potentials(mesh, det, undepleted, bias_v),
-        Backend::Wgpu => super::sor::weighting_potentials_wgpu(
-            mesh,
-            det,
-            undepleted,
+    let solve =
+        |mesh: &Mesh, guess: Option<&[f64]>| potential_on(det, bias_v, settings, mesh, guess);
+    let fully_depleted = |mesh: &Mesh, pot: &PotentialSolution| {
+        undepleted_nodes(mesh, pot) == 0
+            && super::front::crossings(mesh, &pot.phi_v, &pot.undepleted, pot.bounds_v)
+                .iter()
+                .all(|c| !c.at_contact)
+    };
+    let finish = |mesh: Mesh, pot: PotentialSolution, w: Weighed, reports, accuracy| {
+        let undepleted_nodes = undepleted_nodes(&mesh, &pot);
+        PointResult {
             bias_v,
-            settings.gpu_precision,
-        ),
+            mesh,
+            potential: pot,
+            weighting: w.weighting,
+            capacitance: w.capacitance,
+            c12_pf: w.c12_pf,
+            undepleted_nodes,
+            contact_layers: w.contact_layers,
+            reports,
+            accuracy,
+        }
     };
-    let cross = super::front::crossings(&mesh, &pot.phi_v, &pot.undepleted, pot.bounds_v);
-    let (wmesh, weighting) = match settings.weighting {
-        WeightingMode::Conductor => {
-            // The weighting problem sees the conductors end at the sub-cell front.
-            let wmesh = if settings.subcell_front {
-                super::front::front_corrected(&mesh, &cross)
-            } else {
-                mesh.clone()
+    // A fully depleted point restarts from the detector's initial grid (or the grid another
+    // depleted bias ended on): its c12 then does not depend on the bias or on the neighbouring
+    // voltage.
+    let depleted_start = fully_depleted(&mesh, &potential);
+    let start_grid = match (depleted_start, depleted.as_ref()) {
+        (true, Some(stage)) => Some(stage.grid.clone()),
+        (true, None) => Some(Grid::initial(det, gs)),
+        (false, _) => None,
+    };
+    let (mut mesh, mut pot) = match start_grid {
+        Some(grid) if grid != mesh.grid => {
+            let guess = mesh.grid.interpolate_to(&potential.phi_v, &grid);
+            let m = Mesh::new(det, grid);
+            let p = solve(&m, Some(&guess))?;
+            reports.push(p.report.clone());
+            (m, p)
+        }
+        _ => (mesh, potential),
+    };
+    if let Some(stage) = depleted.as_ref()
+        && depleted_start
+        && stage.grid == mesh.grid
+        && fully_depleted(&mesh, &pot)
+    {
+        let (w, acc) = (stage.weighed.clone(), stage.accuracy);
+        return Ok(finish(mesh, pot, w, reports, acc));
+    }
+    let (keep_r, keep_z) = det.ticks();
+    let mut passes = 0;
+    loop {
+        passes += 1;
+        let w = weigh(det, settings, &mesh, &pot, bias_v, pair)?;
+        // The same point on the coarsened grid; a failure there (a short or a pocket the coarse
+        // grid cannot resolve) leaves the estimate unknown, i.e. refine.
+        let c12_err_pf = match mesh.grid.coarsened(&keep_r, &keep_z) {
+            Some(h) => {
+                let guess = mesh.grid.interpolate_to(&pot.phi_v, &h);
+                let hm = Mesh::new(det, h);
+                solve(&hm, Some(&guess))
+                    .and_then(|hp| weigh(det, settings, &hm, &hp, bias_v, pair))
+                    .map_or(f64::INFINITY, |hw| (w.c12_pf - hw.c12_pf).abs())
+            }
+            None => 0.0,
+        };
+        let rel = c12_err_pf / w.c12_pf.abs().max(f64::MIN_POSITIVE);
+        let reached = rel <= gs.tolerance;
+        let (a, b) = pair;
+        let finer = (gs.adaptive && !reached && passes < gs.max_adaptive_passes)
+            .then(|| {
+                let (sr, sz) =
+                    weighting_marks(&w.wmesh.grid, &[&w.weighting.w[a], &w.weighting.w[b]]);
+                mesh.grid.halved(&sr, &sz, gs)
+            })
+            .flatten();
+        let Some(finer) = finer else {
+            let accuracy = Accuracy {
+                c12_err_pf,
+                passes,
+                reached,
             };
-            let w = weigh(&wmesh, &pot.undepleted)?;
-            (wmesh, w)
-        }
-        WeightingMode::PaperEpsilon => {
-            let wmesh = paper_epsilon_mesh(&mesh, &pot.undepleted, PAPER_EPSILON_FACTOR);
-            let none = vec![false; mesh.kind.len()];
-            let w = weigh(&wmesh, &none)?;
-            (wmesh, w)
-        }
-    };
-    let names = det.contacts.iter().map(|c| c.name.clone()).collect();
-    let capacitance = CapacitanceMatrix::from_weighting(&wmesh, &weighting, names);
-    let c12_pf = capacitance.mutual_pf(a, b);
-    let contact_layers = cross.iter().filter(|c| c.at_contact).count();
-    let undepleted_nodes = pot
-        .undepleted
-        .iter()
-        .zip(&mesh.kind)
-        .filter(|(u, k)| **u && **k == NodeKind::Semiconductor)
-        .count();
+            if depleted_start && fully_depleted(&mesh, &pot) {
+                *depleted = Some(DepletedStage {
+                    grid: mesh.grid.clone(),
+                    weighed: w.clone(),
+                    accuracy,
+                });
+            }
+            return Ok(finish(mesh, pot, w, reports, accuracy));
+        };
+        let guess = mesh.grid.interpolate_to(&pot.phi_v, &finer);
+        mesh = Mesh::new(det, finer);
+        pot = solve(&mesh, Some(&guess))?;
+        reports.push(pot.report.clone());
+    }
+}
+
+/// One point on a given grid, without refinement of any kind (the reference solves of
+/// convergence checks): the potential with depletion on `grid` (seeded by `guess`, a node field
+/// on `guess_grid`, when given), the weighting potentials and C*. `accuracy.c12_err_pf` is NaN
+/// (no estimate).
+pub fn solve_point_on_grid(
+    det: &Detector,
+    bias_v: f64,
+    settings: &FieldSettings,
+    grid: Grid,
+    guess: Option<(&Grid, &[f64])>,
+) -> Result<PointResult> {
+    let pair = pair(det)?;
+    let seed = guess.map(|(g, phi)| g.interpolate_to(phi, &grid));
+    let mesh = Mesh::new(det, grid);
+    let pot = potential_on(det, bias_v, settings, &mesh, seed.as_deref())?;
+    let w = weigh(det, settings, &mesh, &pot, bias_v, pair)?;
+    let undepleted_nodes = undepleted_nodes(&mesh, &pot);
     Ok(PointResult {
         bias_v,
+        reports: vec![pot.report.clone()],
         mesh,
         potential: pot,
-        weighting,
-        capacitance,
-        c12_pf,
+        weighting: w.weighting,
+        capacitance: w.capacitance,
+        c12_pf: w.c12_pf,
         undepleted_nodes,
-        contact_layers,
-        reports,
+        contact_layers: w.contact_layers,
+        accuracy: Accuracy {
+            c12_err_pf: f64::NAN,
+            passes: 1,
+            reached: true,
+        },
     })
+}
+
+/// The potential with depletion on one mesh by the settings' method and backend.
+fn potential_on(
+    det: &Detector,
+    bias_v: f64,
+    settings: &FieldSettings,
+    mesh: &Mesh,
+    guess: Option<&[f64]>,
+) -> Result<PotentialSolution> {
+    match (settings.backend, settings.method) {
+        (Backend::Cpu, Method::Fast) => solve_fast(mesh, det, bias_v, guess),
+        (Backend::Cpu, Method::Sor) => super::sor::solve_sor(mesh, det, bias_v, guess),
+        // (Wgpu, Fast) is rejected by validate().
+        (Backend::Wgpu, _) => {
+            super::sor::solve_sor_wgpu(mesh, det, bias_v, guess, settings.gpu_precision)
+        }
+    }
 }
 
 /// The refined potential of [`solve_point`] and [`solve_potential`].
@@ -285,14 +421,8 @@ fn refined_potential(
         guess = Some(sd.grid.interpolate_to(&sd.phi_v, &grid));
     }
     let mut reports = Vec::new();
-    let solve = |mesh: &Mesh, guess: Option<&[f64]>| match (settings.backend, settings.method) {
-        (Backend::Cpu, Method::Fast) => solve_fast(mesh, det, bias_v, guess),
-        (Backend::Cpu, Method::Sor) => super::sor::solve_sor(mesh, det, bias_v, guess),
-        // (Wgpu, Fast) is rejected by validate().
-        (Backend::Wgpu, _) => {
-            super::sor::solve_sor_wgpu(mesh, det, bias_v, guess, settings.gpu_precision)
-        }
-    };
+    let solve =
+        |mesh: &Mesh, guess: Option<&[f64]>| potential_on(det, bias_v, settings, mesh, guess);
     let mut mesh = Mesh::new(det, grid.clone());
     let mut pot = solve(&mesh, guess.as_deref())?;
     reports.push(pot.report.clone());

@@ -5,5 +5,5 @@ mod axis;
 mod settings;
 mod tensor;
 
-pub use settings::GridSettings;
+pub use settings::{GridSettings, MIN_TOLERANCE};
 pub use tensor::Grid;

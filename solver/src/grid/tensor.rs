@@ -105,25 +105,7 @@ impl Grid {
                 }
             }
         }
-        let refine = |t: &[f64], split: &[bool]| -> (Vec<f64>, bool) {
-            let mut out = Vec::with_capacity(t.len() * 2);
-            let mut any = false;
-            for k in 0..t.len() - 1 {
-                out.push(t[k]);
-                if split[k] && (t[k + 1] - t[k]) / 2.0 >= s.min_tick_distance_mm {
-                    out.push(0.5 * (t[k] + t[k + 1]));
-                    any = true;
-                }
-            }
-            out.push(t[t.len() - 1]);
-            if any {
-                limit_ratio(&mut out, s.min_tick_distance_mm, s.max_distance_ratio);
-            }
-            (out, any)
-        };
-        let (r, ar) = refine(&self.r_mm, &split_r);
-        let (z, az) = refine(&self.z_mm, &split_z);
-        (ar || az).then_some(Grid { r_mm: r, z_mm: z })
+        self.halved(&split_r, &split_z, s)
     }
 
     /// Divides every r interval for which `split_r[i]` and every z interval for which
@@ -162,6 +144,77 @@ impl Grid {
         let (r, ar) = go(&self.r_mm, split_r);
         let (z, az) = go(&self.z_mm, split_z);
         (ar || az).then_some(Grid { r_mm: r, z_mm: z })
+    }
+
+    /// The grid with every other tick removed between ticks that must stay (`keep_r_mm`,
+    /// `keep_z_mm`: geometry edges; the axis ends always stay): in each run of removable ticks
+    /// between two kept ones, the 1st, 3rd, ... go. Spacings roughly double; geometry is
+    /// represented exactly as before. `None` when nothing can be removed.
+    pub fn coarsened(&self, keep_r_mm: &[f64], keep_z_mm: &[f64]) -> Option<Grid> {
+        let thin = |t: &[f64], keep: &[f64]| -> (Vec<f64>, bool) {
+            let must = |x: f64| keep.iter().any(|k| (k - x).abs() <= 1e-9 * (1.0 + x.abs()));
+            let mut out = Vec::with_capacity(t.len());
+            let mut run = 0usize;
+            for (k, &x) in t.iter().enumerate() {
+                if k == 0 || k + 1 == t.len() || must(x) {
+                    out.push(x);
+                    run = 0;
+                } else {
+                    run += 1;
+                    if run % 2 == 0 {
+                        out.push(x);
+                    }
+                }
+            }
+            let any = out.len() < t.len();
+            (out, any)
+        };
+        let (r, ar) = thin(&self.r_mm, keep_r_mm);
+        let (z, az) = thin(&self.z_mm, keep_z_mm);
+        (ar || az).then_some(Grid { r_mm: r, z_mm: z })
+    }
+
+    /// Halves every r interval with `split_r[i]` and z interval with `split_z[j]` (never below
+    /// `min_tick_distance_mm`), then restores the ratio limit. `None` when nothing was split.
+    pub fn halved(&self, split_r: &[bool], split_z: &[bool], s: &GridSettings) -> Option<Grid> {
+        let go = |t: &[f64], split: &[bool]| -> (Vec<f64>, bool) {
+            let mut out = Vec::with_capacity(t.len() * 2);
+            let mut any = false;
+            for k in 0..t.len() - 1 {
+                out.push(t[k]);
+                if split[k] && (t[k + 1] - t[k]) / 2.0 >= s.min_tick_distance_mm {
+                    out.push(0.5 * (t[k] + t[k + 1]));
+                    any = true;
+                }
+            }
+            out.push(t[t.len() - 1]);
+            if any {
+                limit_ratio(&mut out, s.min_tick_distance_mm, s.max_distance_ratio);
+            }
+            (out, any)
+        };
+        let (r, ar) = go(&self.r_mm, split_r);
+        let (z, az) = go(&self.z_mm, split_z);
+        (ar || az).then_some(Grid { r_mm: r, z_mm: z })
+    }
+
+    /// Every interval divided into `parts` equal ones (spacings / `parts`, nodes ~ `parts`^2 x):
+    /// the reference grids of convergence checks.
+    pub fn subdivided(&self, parts: usize) -> Grid {
+        let go = |t: &[f64]| -> Vec<f64> {
+            let mut out = Vec::with_capacity((t.len() - 1) * parts.max(1) + 1);
+            for w in t.windows(2) {
+                for p in 0..parts.max(1) {
+                    out.push(w[0] + (w[1] - w[0]) * p as f64 / parts.max(1) as f64);
+                }
+            }
+            out.push(t[t.len() - 1]);
+            out
+        };
+        Grid {
+            r_mm: go(&self.r_mm),
+            z_mm: go(&self.z_mm),
+        }
     }
 
     /// Bilinear interpolation of a node field of `self` onto the nodes of `finer` (whose
@@ -225,6 +278,17 @@ mod tests {
         let fi = g.interpolate_to(&f, &h);
         assert_eq!(fi, vec![0.0, 0.0, 0.5, 1.0, 0.0, 0.0, 0.5, 1.0]);
         assert!(Grid::new(vec![0.0], vec![0.0, 1.0]).is_err());
+        // Coarsening keeps the ends and the required ticks, drops every other one between.
+        let g = Grid::new(vec![0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0], vec![0.0, 1.0]).unwrap();
+        let c = g.coarsened(&[3.0], &[]).unwrap();
+        assert_eq!(c.r_mm(), &[0.0, 2.0, 3.0, 5.0, 6.0]);
+        assert_eq!(c.z_mm(), &[0.0, 1.0]);
+        assert!(
+            Grid::new(vec![0.0, 1.0], vec![0.0, 1.0])
+                .unwrap()
+                .coarsened(&[], &[])
+                .is_none()
+        );
         assert!(Grid::new(vec![0.0, 0.0], vec![0.0, 1.0]).is_err());
     }
 }

@@ -1,0 +1,146 @@
+//! Adaptive accuracy of c12: an a-posteriori error estimate and refinement driven by it.
+//!
+//! The estimate is a grid difference. For the grid h of a point, the grid H takes every other
+//! tick away between the ticks the geometry needs (`Grid::coarsened`: spacings roughly double, the
+//! geometry stays exact), and the whole point (potential with depletion and pockets, weighting
+//! potentials, capacitance) is solved again there:
+//!
+//!   err(c12_h) ~ |c12_h - c12_H| / (2^p - 1) <= |c12_h - c12_H|  for any order p >= 1,
+//!
+//! so the reported estimate `c12_err_pf = |c12_h - c12_H|` bounds the error of c12_h from above
+//! where the convergence is asymptotic (first order at a point contact's edge, up to second order
+//! for smooth fields). While it is above `tolerance * c12_h`, the intervals across which a
+//! weighting potential of the pair changes by more than half the largest such change are halved
+//! (the contact edges, small electrodes, the depletion front and pockets, wherever the error is),
+//! the potential is solved on the new grid from the old one, and the point is evaluated again.
+//!
+//! A fully depleted point starts from the detector's initial grid, not from the potential's
+//! (which depends on the bias and on the neighbouring voltage's front): its weighting potentials
+//! do not depend on the bias, so neither does its c12, exactly.
+
+use super::capacitance::CapacitanceMatrix;
+use super::depletion::PotentialSolution;
+use super::mesh::{Mesh, NodeKind};
+use super::point::FieldSettings;
+use super::report::Backend;
+use super::weighting::{
+    PAPER_EPSILON_FACTOR, WeightingMode, WeightingPotentials, paper_epsilon_mesh,
+    weighting_potentials,
+};
+use crate::grid::Grid;
+use crate::{Detector, Result};
+
+/// Share of the largest weighting-potential change above which an interval is halved.
+const MARK_FRACTION: f64 = 0.5;
+
+/// The weighting stage of one point on one mesh.
+#[derive(Clone)]
+pub(crate) struct Weighed {
+    /// The mesh the weighting potentials live on (front-corrected, or the paper's epsilon).
+    pub wmesh: Mesh,
+    /// Weighting potentials of all contacts.
+    pub weighting: WeightingPotentials,
+    /// Maxwell matrix, pF.
+    pub capacitance: CapacitanceMatrix,
+    /// c12 = -C*_ab, pF.
+    pub c12_pf: f64,
+    /// Undepleted layers in front of a contact found by the sub-cell front.
+    pub contact_layers: usize,
+}
+
+/// The weighting potentials and C* for the potential `pot` on `mesh` (contacts `a`, `b`).
+pub(crate) fn weigh(
+    det: &Detector,
+    settings: &FieldSettings,
+    mesh: &Mesh,
+    pot: &PotentialSolution,
+    bias_v: f64,
+    (a, b): (usize, usize),
+) -> Result<Weighed> {
+    let solve = |mesh: &Mesh, undepleted: &[bool]| match settings.backend {
+        Backend::Cpu => weighting_potentials(mesh, det, undepleted, bias_v),
+        Backend::Wgpu => super::sor::weighting_potentials_wgpu(
+            mesh,
+            det,
+            undepleted,
+            bias_v,
+            settings.gpu_precision,
+        ),
+    };
+    let cross = super::front::crossings(mesh, &pot.phi_v, &pot.undepleted, pot.bounds_v);
+    let (wmesh, weighting) = match settings.weighting {
+        WeightingMode::Conductor => {
+            // The weighting problem sees the conductors end at the sub-cell front.
+            let wmesh = if settings.subcell_front {
+                super::front::front_corrected(mesh, &cross)
+            } else {
+                mesh.clone()
+            };
+            let w = solve(&wmesh, &pot.undepleted)?;
+            (wmesh, w)
+        }
+        WeightingMode::PaperEpsilon => {
+            let wmesh = paper_epsilon_mesh(mesh, &pot.undepleted, PAPER_EPSILON_FACTOR);
+            let none = vec![false; mesh.kind.len()];
+            let w = solve(&wmesh, &none)?;
+            (wmesh, w)
+        }
+    };
+    let names = det.contacts.iter().map(|c| c.name.clone()).collect();
+    let capacitance = CapacitanceMatrix::from_weighting(&wmesh, &weighting, names);
+    let c12_pf = capacitance.mutual_pf(a, b);
+    Ok(Weighed {
+        wmesh,
+        weighting,
+        capacitance,
+        c12_pf,
+        contact_layers: cross.iter().filter(|c| c.at_contact).count(),
+    })
+}
+
+/// Number of undepleted semiconductor nodes of a potential.
+pub(crate) fn undepleted_nodes(mesh: &Mesh, pot: &PotentialSolution) -> usize {
+    pot.undepleted
+        .iter()
+        .zip(&mesh.kind)
+        .filter(|(u, k)| **u && **k == NodeKind::Semiconductor)
+        .count()
+}
+
+/// The intervals to halve: those across which W_a or W_b changes by more than
+/// `MARK_FRACTION` of the largest change across any interval of either axis.
+pub(crate) fn weighting_marks(grid: &Grid, fields: &[&[f64]]) -> (Vec<bool>, Vec<bool>) {
+    let (nr, nz) = (grid.nr(), grid.nz());
+    let mut dr = vec![0.0f64; nr - 1];
+    let mut dz = vec![0.0f64; nz - 1];
+    for w in fields {
+        for j in 0..nz {
+            for i in 0..nr {
+                let v = w[grid.index(i, j)];
+                if i + 1 < nr {
+                    dr[i] = dr[i].max((w[grid.index(i + 1, j)] - v).abs());
+                }
+                if j + 1 < nz {
+                    dz[j] = dz[j].max((w[grid.index(i, j + 1)] - v).abs());
+                }
+            }
+        }
+    }
+    let top = dr.iter().chain(&dz).copied().fold(0.0, f64::max);
+    let mark = |d: &[f64]| d.iter().map(|&x| x > MARK_FRACTION * top).collect();
+    (mark(&dr), mark(&dz))
+}
+
+/// The accuracy of one evaluated point: the estimate and the work it took.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Accuracy {
+    /// Estimated absolute error of c12, pF (|c12_h - c12_H|, see the module text).
+    pub c12_err_pf: f64,
+    /// Adaptive passes (evaluations on successively refined grids), at least 1.
+    pub passes: usize,
+    /// True when the estimated relative error is within the tolerance; false when refinement
+    /// stopped before (every interval to refine at `min_tick_distance_mm`, or
+    /// `max_adaptive_passes` done; e.g. the neck of a pocket at pinch-off), or when adaptivity is
+    /// off and the estimate is above it.
+    pub reached: bool,
+}

@@ -1,0 +1,116 @@
+//! `hpge-cv convergence`: c12 at one bias against the grid resolution, with the error estimate.
+
+use std::path::PathBuf;
+
+use anyhow::{Result, bail};
+use hpge_solver::convergence_study;
+use serde_json::json;
+
+use super::args::load_detector;
+use super::{DetectorInput, SolverArgs, WeightingArg};
+use crate::plot;
+
+/// Arguments of `convergence`.
+#[derive(Debug, clap::Args)]
+pub struct ConvergenceArgs {
+    #[command(flatten)]
+    pub input: DetectorInput,
+    /// Bias voltage in V.
+    #[arg(long, value_name = "U", allow_hyphen_values = true)]
+    pub voltage: f64,
+    /// Fixed grids: the spacings times 2, 1, 1/2, ... (this many).
+    #[arg(long, value_name = "N", default_value_t = 4)]
+    pub levels: usize,
+    #[command(flatten)]
+    pub solver: SolverArgs,
+    /// Print exactly one JSON object on stdout.
+    #[arg(long)]
+    pub json: bool,
+    /// Draw c12 against the grid nodes with the estimates (.svg or .png).
+    #[arg(long, value_name = "FILE")]
+    pub plot: Option<PathBuf>,
+}
+
+/// Runs the study and prints (and draws) it.
+pub fn run(a: &ConvergenceArgs) -> Result<()> {
+    if !(a.voltage.is_finite() && a.voltage > 0.0) {
+        bail!(
+            "--voltage {}: the bias must be a positive number of volts",
+            a.voltage
+        );
+    }
+    if !(1..=8).contains(&a.levels) {
+        bail!("--levels {}: give 1 to 8 fixed grids", a.levels);
+    }
+    if let Some(p) = &a.plot {
+        plot::check_output(p, "--plot")?;
+    }
+    let det = load_detector(&a.input)?;
+    let settings = a
+        .solver
+        .grid
+        .apply(&a.solver.settings(WeightingArg::Conductor), &det)?;
+    super::simulate::backend_json(&settings)?;
+    let rows = convergence_study(&det, a.voltage, &settings, a.levels)?;
+    let finest = rows
+        .iter()
+        .filter(|r| !r.adaptive)
+        .max_by_key(|r| r.nodes)
+        .map_or(f64::NAN, |r| r.c12_pf);
+    if let Some(p) = &a.plot {
+        let title = format!(
+            "{}: c12 at {} V against the grid ({} {})",
+            det.name,
+            a.voltage,
+            env!("CARGO_PKG_NAME"),
+            env!("CARGO_PKG_VERSION")
+        );
+        plot::convergence(&rows, &title, p)?;
+    }
+    if a.json {
+        let v = json!({
+            "detector": det.file.display().to_string(),
+            "voltage_V": a.voltage,
+            "tolerance": settings.grid.tolerance,
+            "rows": rows.iter().map(|r| json!({
+                "scale": r.scale,
+                "spacing_mm": r.spacing_mm,
+                "nodes": r.nodes,
+                "c12_pF": r.c12_pf,
+                "c12_err_pF": r.c12_err_pf,
+                "adaptive": r.adaptive,
+                "seconds": r.seconds,
+            })).collect::<Vec<_>>(),
+            "grid": settings.grid,
+            "parameters": det.parameters.iter().collect::<std::collections::BTreeMap<_, _>>(),
+            "version": env!("CARGO_PKG_VERSION"),
+        });
+        println!("{v}");
+    } else {
+        println!(
+            "{:>10} {:>12} {:>10} {:>14} {:>11} {:>14} {:>8}",
+            "grid", "spacing (mm)", "nodes", "c12 (pF)", "+- (pF)", "vs finest", "s"
+        );
+        for r in &rows {
+            println!(
+                "{:>10} {:>12.3} {:>10} {:>14.6} {:>11.2e} {:>13.3}% {:>8.2}",
+                if r.adaptive {
+                    "adaptive".to_string()
+                } else {
+                    format!("x{}", r.scale)
+                },
+                r.spacing_mm,
+                r.nodes,
+                r.c12_pf,
+                r.c12_err_pf,
+                100.0 * (r.c12_pf / finest - 1.0),
+                r.seconds
+            );
+        }
+        println!(
+            "adaptive: tolerance {:.2}% of c12; estimates are |c12(h) - c12(2h)| (an upper bound for order >= 1)",
+            100.0 * settings.grid.tolerance
+        );
+    }
+    Ok(())
+}
