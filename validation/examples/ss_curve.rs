@@ -19,9 +19,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let curve = cv_curve(&det, &volts, &s, |_, _| {})?;
     for p in &curve.points {
         println!(
-            "{:>6} V  c12 {:>9.4} pF  grid {:>3}x{:<3}  passes {:>2}  iterations {:>4}  potential {:.3} s  point {:.3} s",
+            "{:>6} V  c12 {:>9.4} pF +- {:.1e} ({} adaptive)  grid {:>3}x{:<3}  passes {:>2}  iterations {:>4}  potential {:.3} s  point {:.3} s",
             p.voltage_v,
             p.c12_pf,
+            p.c12_err_pf,
+            p.adaptive_passes,
             p.grid.0,
             p.grid.1,
             p.passes,

@@ -19,6 +19,8 @@ pub struct CvPoint {
     pub c12_err_pf: f64,
     /// True when the estimate is within the settings' tolerance (see `Accuracy::reached`).
     pub tolerance_reached: bool,
+    /// Adaptive passes (evaluations of the weighting stage on refined grids), at least 1.
+    pub adaptive_passes: usize,
     /// No undepleted semiconductor node at this bias.
     pub fully_depleted: bool,
     /// Final grid size (r ticks, z ticks).
@@ -107,6 +109,7 @@ pub fn cv_curve(
                     c12_pf: p.c12_pf,
                     c12_err_pf: p.accuracy.c12_err_pf,
                     tolerance_reached: p.accuracy.reached,
+                    adaptive_passes: p.accuracy.passes,
                     fully_depleted: p.fully_depleted(),
                     grid: (p.mesh.grid.nr(), p.mesh.grid.nz()),
                     passes: p.reports.len(),

@@ -161,7 +161,7 @@ impl Grid {
                     run = 0;
                 } else {
                     run += 1;
-                    if run % 2 == 0 {
+                    if run.is_multiple_of(2) {
                         out.push(x);
                     }
                 }

@@ -166,3 +166,28 @@ fn wgpu_agrees_with_fast_on_a_pocket() {
         b.level_v
     );
 }
+
+/// The full-depletion voltage of the ICPC is where its last pocket vanishes: just below it the
+/// nonlinear solution still holds a pocket (or undepleted volume), just above it there is none;
+/// the pinch-off voltage lies below it and a pocket exists just above the pinch-off voltage.
+#[test]
+fn icpc_full_depletion_is_where_the_last_pocket_vanishes() {
+    let det = icpc();
+    let mesh = coarse_mesh(&det);
+    let u_fd = crate::field::full_depletion_voltage(&mesh, &det, 500.0, 5000.0).unwrap();
+    let below = solve_fast(&mesh, &det, u_fd * 0.995, None).unwrap();
+    let above = solve_fast(&mesh, &det, u_fd * 1.005, None).unwrap();
+    assert!(
+        !below.pockets.is_empty() || undepleted_nodes(&mesh, &below) > 0,
+        "{u_fd} V: nothing undepleted just below"
+    );
+    assert!(above.pockets.is_empty() && undepleted_nodes(&mesh, &above) == 0);
+    assert!(depth(&mesh, &above) <= 1e-8);
+    let pinch = crate::field::pinch_off_voltage(&mesh, &det, 500.0, u_fd * 0.995)
+        .unwrap()
+        .expect("a pocket below full depletion");
+    assert!(pinch < u_fd, "pinch-off {pinch} V, full depletion {u_fd} V");
+    let just_above = solve_fast(&mesh, &det, pinch * 1.001, None).unwrap();
+    assert!(!just_above.pockets.is_empty());
+    eprintln!("coarse ICPC: pinch-off {pinch:.1} V, full depletion {u_fd:.1} V");
+}
