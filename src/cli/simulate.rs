@@ -111,7 +111,7 @@ pub fn run(o: &SimulateOptions<'_>) -> Result<()> {
         .collect();
     if settings.grid.adaptive && !missed.is_empty() && missed.len() == curve.points.len() {
         bail!(
-            "grid.tolerance {:e}: no bias reached it (estimated relative errors {:.1e} to {:.1e}); the grid cannot be refined that far with min_tick_distance_mm = {} mm in {} passes: raise --tolerance",
+            "grid.tolerance {:e}: no bias reached it (estimated relative errors {:.1e} to {:.1e}); the grid cannot be refined that far with min_tick_distance_mm = {} mm in {} passes and {} nodes: raise --tolerance (or --grid max_nodes=N)",
             settings.grid.tolerance,
             missed
                 .iter()
@@ -122,7 +122,8 @@ pub fn run(o: &SimulateOptions<'_>) -> Result<()> {
                 .map(|p| p.c12_err_pf / p.c12_pf)
                 .fold(0.0, f64::max),
             settings.grid.min_tick_distance_mm,
-            settings.grid.max_adaptive_passes
+            settings.grid.max_adaptive_passes,
+            settings.grid.max_nodes
         );
     }
     for p in &missed {

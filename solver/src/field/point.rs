@@ -2,7 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::adaptive::{Accuracy, GUARD_DIVISOR, Weighed, undepleted_nodes, weigh, weighting_marks};
+use super::adaptive::{Accuracy, Weighed, undepleted_nodes, weigh, weighting_marks};
 use super::capacitance::CapacitanceMatrix;
 use super::depletion::{PotentialSolution, solve_fast};
 use super::mesh::Mesh;
@@ -199,8 +199,8 @@ pub fn solve_potential(
 /// refines until the estimated relative error of c12 is below `settings.grid.tolerance`
 /// (`field::adaptive`; with `adaptive` off, one evaluation on the potential's grid, with its
 /// estimate). A point whose estimate stays above the tolerance (every interval to refine at
-/// `min_tick_distance_mm`, or `max_adaptive_passes` done: e.g. the neck of a pocket at
-/// pinch-off) is returned with `accuracy.reached` false; callers say so.
+/// `min_tick_distance_mm`, `max_adaptive_passes` done or the next grid above `max_nodes`: e.g.
+/// the neck of a pocket at pinch-off) is returned with `accuracy.reached` false; callers say so.
 ///
 /// `seed` may carry the solution at a neighbouring voltage: the initial grid is split down to
 /// `front_spacing_mm` where its front lay, and its potential seeds the active set.
@@ -294,28 +294,17 @@ pub(crate) fn solve_point_with(
     loop {
         passes += 1;
         let w = weigh(det, settings, &mesh, &pot, bias_v, pair)?;
-        // The same point on the coarsened grid H and on H coarsened again (`field::adaptive`);
-        // a failure there (a short or a pocket a coarse grid cannot resolve) leaves the estimate
-        // unknown, i.e. refine.
-        let coarse = |fine: &Grid, phi: &[f64]| -> Option<Result<(Grid, Vec<f64>, f64)>> {
-            let h = fine.coarsened(&keep_r, &keep_z)?;
-            let guess = fine.interpolate_to(phi, &h);
-            let hm = Mesh::new(det, h.clone());
-            Some(solve(&hm, Some(&guess)).and_then(|hp| {
-                let hw = weigh(det, settings, &hm, &hp, bias_v, pair)?;
-                Ok((h, hp.phi_v, hw.c12_pf))
-            }))
-        };
-        let c12_err_pf = match coarse(&mesh.grid, &pot.phi_v) {
-            None => 0.0,
-            Some(Err(_)) => f64::INFINITY,
-            Some(Ok((h, phi_h, c_h))) => {
-                let d1 = (w.c12_pf - c_h).abs();
-                match coarse(&h, &phi_h) {
-                    Some(Ok((_, _, c_hh))) => d1.max((c_h - c_hh).abs() / GUARD_DIVISOR),
-                    Some(Err(_)) | None => d1,
-                }
+        // The same point on the coarsened grid; a failure there (a short or a pocket the coarse
+        // grid cannot resolve) leaves the estimate unknown, i.e. refine.
+        let c12_err_pf = match mesh.grid.coarsened(&keep_r, &keep_z) {
+            Some(h) => {
+                let guess = mesh.grid.interpolate_to(&pot.phi_v, &h);
+                let hm = Mesh::new(det, h);
+                solve(&hm, Some(&guess))
+                    .and_then(|hp| weigh(det, settings, &hm, &hp, bias_v, pair))
+                    .map_or(f64::INFINITY, |hw| (w.c12_pf - hw.c12_pf).abs())
             }
+            None => 0.0,
         };
         let rel = c12_err_pf / w.c12_pf.abs().max(f64::MIN_POSITIVE);
         let reached = rel <= gs.tolerance;
@@ -326,7 +315,8 @@ pub(crate) fn solve_point_with(
                     weighting_marks(&w.wmesh.grid, &[&w.weighting.w[a], &w.weighting.w[b]]);
                 mesh.grid.halved(&sr, &sz, gs)
             })
-            .flatten();
+            .flatten()
+            .filter(|g| g.nr() * g.nz() <= gs.max_nodes);
         let Some(finer) = finer else {
             let accuracy = Accuracy {
                 c12_err_pf,
