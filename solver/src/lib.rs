@@ -34,11 +34,11 @@ pub use expr::Parameters;
 pub use field::{
     Accuracy, Backend, CapacitanceMatrix, ConvergenceRow, CvCurve, CvPoint, FieldSettings, Mesh,
     Method, NodeKind, PAPER_EPSILON_FACTOR, Pocket, PointResult, PotentialPoint, PotentialSolution,
-    Seed, SolveReport, Termination, WeightingMode, WeightingPotentials, convergence_study,
-    curve_pinch_off_voltage, cv_curve, deepest_depression_v, deepest_empty_depression_v,
-    find_pockets, full_depletion_voltage, normalise_voltages, pinch_off_voltage, solve_fast,
-    solve_point, solve_point_on_grid, solve_potential, solve_sor, solve_sor_wgpu,
-    weighting_potentials, weighting_potentials_wgpu,
+    Seed, SolveReport, Termination, WeightingMode, WeightingPotentials, contact_charge_c,
+    convergence_study, curve_pinch_off_voltage, cv_curve, deepest_depression_v,
+    deepest_empty_depression_v, find_pockets, full_depletion_voltage, normalise_voltages,
+    pinch_off_voltage, quasi_static_c12_pf, solve_fast, solve_point, solve_point_on_grid,
+    solve_potential, solve_sor, solve_sor_wgpu, weighting_potentials, weighting_potentials_wgpu,
 };
 pub use geometry::{BoundingBox, Primitive, Solid};
 pub use gpu::{AdapterReport, Precision, gpu_adapter, gpu_test_gate};

@@ -2,6 +2,7 @@
 
 mod adaptive;
 mod capacitance;
+mod charge;
 mod cholesky;
 mod convergence;
 mod curve;
@@ -20,6 +21,7 @@ mod weighting;
 
 pub use adaptive::Accuracy;
 pub use capacitance::CapacitanceMatrix;
+pub use charge::{contact_charge_c, quasi_static_c12_pf};
 pub use convergence::{ConvergenceRow, convergence_study};
 pub use curve::{CvCurve, CvPoint, cv_curve, normalise_voltages};
 pub use depletion::{PotentialSolution, solve_fast};
