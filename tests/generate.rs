@@ -32,6 +32,11 @@ fn generate(out: &Path, n: &str, extra: &[&str]) -> Output {
         n,
         "--out",
         out.to_str().unwrap(),
+        // The default grid without adaptive refinement: these tests pin sharding, merging and
+        // resuming, not the solver (4x faster; the space at the defaults: validation/tests/
+        // paper_space_no_shorts.rs).
+        "--grid",
+        "adaptive=false",
     ];
     args.extend_from_slice(extra);
     run(&args)
@@ -125,6 +130,8 @@ fn kill_and_resume_loses_and_duplicates_nothing() {
                 out.to_str().unwrap(),
                 "--threads",
                 "1",
+                "--grid",
+                "adaptive=false",
             ])
             .stdout(std::process::Stdio::null())
             .stderr(std::process::Stdio::null())
