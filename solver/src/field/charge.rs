@@ -24,7 +24,7 @@
 //! pulse or an AC period); below pinch-off and above full depletion the two agree, in the pinch-off
 //! window they differ (reports/pockets/).
 
-use super::depletion::{PotentialSolution, potential_dofs, solve_fast};
+use super::depletion::{PotentialSolution, solve_fast};
 use super::mesh::{Mesh, NodeKind};
 use crate::{Detector, Error, Result};
 
@@ -59,7 +59,7 @@ pub fn contact_charge_c(
             ),
         });
     }
-    let (_, (lo, hi)) = potential_dofs(mesh, det, bias_v);
+    let (lo, hi) = sol.bounds_v;
     let v = det.contacts[contact].potential_v(bias_v);
     let tol = 1e-9 * (hi - lo).abs().max(1.0);
     let (drains_holes, drains_electrons) = ((v - lo).abs() <= tol, (v - hi).abs() <= tol);
