@@ -32,6 +32,8 @@ pub(crate) struct Symbolic {
 pub(crate) struct Factor {
     sym: Arc<SymbolicCholesky<usize>>,
     values: Vec<f64>,
+    /// Scratch of the numeric factorisation, kept for [`Factor::refactor`].
+    scratch: MemBuffer,
 }
 
 /// Nested-dissection order of the grid nodes (nr x nz, node = j nr + i): the two halves of a box
@@ -124,28 +126,41 @@ impl Symbolic {
 
     /// Numeric factorisation of the matrix with this pattern and values `val`.
     pub fn factor(&self, col_ptr: &[usize], row_idx: &[usize], val: &[f64]) -> Result<Factor> {
-        let n = self.inner.nrows();
-        let pattern = SymbolicSparseColMatRef::new_checked(n, n, col_ptr, None, row_idx);
-        let mat = SparseColMatRef::new(pattern, val);
-        let mut values = vec![0.0; self.inner.len_val()];
         // Sequential: on these sizes faer's parallel supernodal kernels were slower (2.9 s vs
         // 4.7 s for the Super-Siegfried curve on 2 cores); curves parallelise over voltages.
-        let par = Par::Seq;
-        let mut mem = MemBuffer::try_new(
+        let scratch = MemBuffer::try_new(
             self.inner
-                .factorize_numeric_llt_scratch::<f64>(par, Default::default()),
+                .factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default()),
         )
         .map_err(|_| Error::Singular {
             reason: "out of memory for the Cholesky factor".into(),
         })?;
-        self.inner
+        let mut f = Factor {
+            sym: self.inner.clone(),
+            values: vec![0.0; self.inner.len_val()],
+            scratch,
+        };
+        f.refactor(col_ptr, row_idx, val)?;
+        Ok(f)
+    }
+}
+
+impl Factor {
+    /// Numeric factorisation of new values `val` with the same pattern, in place: the factor's
+    /// storage and scratch are reused (an active-set iteration refactorises 5-10 times per
+    /// point; fresh multi-megabyte buffers each time cost about 10% of a C-V curve, `perf`).
+    pub fn refactor(&mut self, col_ptr: &[usize], row_idx: &[usize], val: &[f64]) -> Result<()> {
+        let n = self.sym.nrows();
+        let pattern = SymbolicSparseColMatRef::new_checked(n, n, col_ptr, None, row_idx);
+        let mat = SparseColMatRef::new(pattern, val);
+        self.sym
             .factorize_numeric_llt(
-                &mut values,
+                &mut self.values,
                 mat,
                 Side::Lower,
                 Default::default(),
-                par,
-                MemStack::new(&mut mem),
+                Par::Seq,
+                MemStack::new(&mut self.scratch),
                 Default::default(),
             )
             .map_err(|e| Error::Singular {
@@ -153,14 +168,9 @@ impl Symbolic {
                     "the field matrix is not positive definite ({e:?}): is some region cut off from every fixed potential?"
                 ),
             })?;
-        Ok(Factor {
-            sym: self.inner.clone(),
-            values,
-        })
+        Ok(())
     }
-}
 
-impl Factor {
     /// Solves A x = rhs.
     pub fn solve(&self, rhs: &[f64]) -> Vec<f64> {
         let n = rhs.len();

@@ -11,7 +11,7 @@
 
 use std::time::Instant;
 
-use super::cholesky::Symbolic;
+use super::cholesky::{Factor, Symbolic};
 use super::mesh::{Mesh, NodeKind};
 use super::pockets::{self, Pocket, Ties, depression_depths_v, find_pockets};
 use super::report::{Backend, Method, SolveReport, Termination};
@@ -134,6 +134,8 @@ pub fn solve_fast(
         }
     }
     let sym = sys.symbolic()?;
+    // One factor's storage for every active-set iteration of every round.
+    let mut factor: Option<Factor> = None;
     let mut iterations = 0;
     let mut ties: Ties = vec![None; mesh.kind.len()];
     let mut rounds = 0;
@@ -150,7 +152,7 @@ pub fn solve_fast(
             bounds: (lo, hi),
             ties: pocket_ties(&sys, &ties, prev_phi.as_deref()),
         };
-        let (x, fell_back) = ctx.solve(&sym, &mut state, &mut iterations)?;
+        let (x, fell_back) = ctx.solve(&sym, &mut factor, &mut state, &mut iterations)?;
         let phi = sys.to_nodes(&x);
         let occupied: Vec<bool> = (0..mesh.kind.len())
             .map(|k| {
@@ -329,6 +331,7 @@ impl Round<'_> {
     fn solve(
         &self,
         sym: &Symbolic,
+        factor: &mut Option<Factor>,
         state: &mut [Bound],
         iterations: &mut usize,
     ) -> Result<(Vec<f64>, bool)> {
@@ -338,6 +341,7 @@ impl Round<'_> {
         let (member, pockets) = &self.ties;
         let mut local = 0;
         let mut fell_back = false;
+        let mut val = sys.val.clone();
         loop {
             *iterations += 1;
             local += 1;
@@ -350,7 +354,7 @@ impl Round<'_> {
             }
             // Active rows become identity rows (scaled by the diagonal) at their bound; a tied
             // active unknown's bound is its pocket's level (an unknown, by superposition).
-            let mut val = sys.val.clone();
+            val.copy_from_slice(&sys.val);
             let mut xa = vec![0.0; n];
             let mut active_in = vec![false; pockets.len()];
             for u in 0..n {
@@ -378,7 +382,13 @@ impl Round<'_> {
                     _ => None,
                 }
             };
-            let factor = sys.factor(sym, &val)?;
+            let factor = match factor {
+                Some(f) => {
+                    sys.refactor(f, &val)?;
+                    f
+                }
+                None => factor.insert(sys.factor(sym, &val)?),
+            };
             let ax = sys.matvec(&sys.val, &xa);
             let rhs: Vec<f64> = (0..n)
                 .map(|u| match state[u] {

@@ -88,21 +88,42 @@ impl System {
                 off.push((v, u, -w));
             }
         });
-        // Columns: (row, value) lists, sorted, duplicates merged (group unknowns).
-        let mut cols: Vec<Vec<(usize, f64)>> = (0..n).map(|c| vec![(c, diag[c])]).collect();
-        for (r, c, v) in off {
-            cols[c].push((r, v));
+        // Columns by counting sort: (row, value) pairs per column in one buffer, each column's
+        // segment sorted by row, duplicates merged (group unknowns). One allocation instead of a
+        // vector per column (those were ~8% of a C-V curve, `perf`).
+        let mut seg = vec![1usize; n + 1];
+        for &(_, c, _) in &off {
+            seg[c] += 1;
+        }
+        let mut acc = 0;
+        for s in seg.iter_mut() {
+            let k = *s;
+            *s = acc;
+            acc += k;
+        }
+        let mut fill: Vec<usize> = seg[..n].to_vec();
+        let mut pairs = vec![(0usize, 0.0f64); acc];
+        for (c, &d) in diag.iter().enumerate() {
+            pairs[fill[c]] = (c, d);
+            fill[c] += 1;
+        }
+        for &(r, c, v) in &off {
+            pairs[fill[c]] = (r, v);
+            fill[c] += 1;
         }
         let mut col_ptr = Vec::with_capacity(n + 1);
-        let mut row_idx = Vec::new();
-        let mut val = Vec::new();
+        let mut row_idx = Vec::with_capacity(acc);
+        let mut val = Vec::with_capacity(acc);
         let mut diag_pos = vec![0; n];
         col_ptr.push(0);
-        for (c, mut col) in cols.into_iter().enumerate() {
-            col.sort_by_key(|e| e.0);
-            for (r, v) in col {
-                if row_idx.len() > col_ptr[c] && *row_idx.last().unwrap_or(&usize::MAX) == r {
-                    *val.last_mut().expect("non-empty") += v;
+        for c in 0..n {
+            let col = &mut pairs[seg[c]..seg[c + 1]];
+            col.sort_unstable_by_key(|e| e.0);
+            for &(r, v) in col.iter() {
+                if row_idx.len() > col_ptr[c] && row_idx.last() == Some(&r) {
+                    if let Some(last) = val.last_mut() {
+                        *last += v;
+                    }
                 } else {
                     if r == c {
                         diag_pos[c] = row_idx.len();
@@ -181,6 +202,11 @@ impl System {
     /// Numeric Cholesky factorisation with values `val`.
     pub fn factor(&self, sym: &Symbolic, val: &[f64]) -> Result<Factor> {
         sym.factor(&self.col_ptr, &self.row_idx, val)
+    }
+
+    /// Numeric Cholesky factorisation with values `val` into an existing factor of this pattern.
+    pub fn refactor(&self, factor: &mut Factor, val: &[f64]) -> Result<()> {
+        factor.refactor(&self.col_ptr, &self.row_idx, val)
     }
 
     /// The right-hand side for other fixed potentials on the same fixed nodes (no charges):
