@@ -108,7 +108,7 @@ pub fn run(a: &ConvergenceArgs) -> Result<()> {
             );
         }
         println!(
-            "adaptive: tolerance {:.2}% of c12; estimates are |c12(h) - c12(2h)| (an upper bound for order >= 1)",
+            "adaptive: tolerance {:.2}% of c12; estimates are max |c12(h) - c12(2h)| over two coarsenings (an upper bound for order >= 1)",
             100.0 * settings.grid.tolerance
         );
     }

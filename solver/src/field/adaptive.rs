@@ -1,25 +1,32 @@
 //! Adaptive accuracy of c12: an a-posteriori error estimate and refinement driven by it.
 //!
-//! The estimate is a grid difference. For the grid h of a point, the grid H takes every other
-//! tick away between the ticks the geometry needs (`Grid::coarsened`: spacings roughly double, the
-//! geometry stays exact), and the whole point (potential with depletion and pockets, weighting
-//! potentials, capacitance) is solved again there:
+//! The estimate is a grid difference. For the grid h of a point, the grids H_0 and H_1 each take
+//! every other tick away between the ticks the geometry needs (`Grid::coarsened_phase`: H_0 the
+//! 1st, 3rd, ... tick of each run, H_1 the 2nd, 4th, ...; spacings roughly double, the geometry
+//! stays exact), and the whole point (potential with depletion and pockets, weighting potentials,
+//! capacitance) is solved again on both:
 //!
 //!   err(c12_h) ~ |c12_h - c12_H| / (2^p - 1) <= |c12_h - c12_H|  for any order p >= 1,
 //!
-//! so the reported estimate `c12_err_pf = |c12_h - c12_H|` bounds the error of c12_h from above
-//! where the convergence is asymptotic (first order at a point contact's edge, up to second order
-//! for smooth fields). While it is above `tolerance * c12_h`, the intervals across which a
+//! so the reported estimate `c12_err_pf = max_k |c12_h - c12_H_k|` bounds the error of c12_h from
+//! above where the convergence is asymptotic (first order at a point contact's edge, up to second
+//! order for smooth fields). While it is above `tolerance * c12_h`, the intervals across which a
 //! weighting potential of the pair changes by more than half the largest such change are halved
-//! (the contact edges, small electrodes, the depletion front and pockets, wherever the error is),
-//! the potential is solved on the new grid from the old one, and the point is evaluated again.
+//! (contact edges, small electrodes), and so are the cells the depletion front crosses (down to a
+//! quarter of `front_spacing_mm`: the weighting potentials change little across them, yet the
+//! front's sub-cell location is second order in their width); the potential is solved on the new
+//! grid from the old one, and the point is evaluated again.
 //!
-//! Two grids can agree by chance where the error changes sign between them: on the point-contact
-//! detector at 500 V the estimate is 5e-5 of c12 against an actual 2.2e-4 (both far below the
-//! default tolerance). A guard term |c12_H - c12_H2| / 4 (H coarsened once more) was tried on
-//! 2026-11-25 and dropped: on thin depletion layers H2 does not resolve the layer (planar p-n at
-//! 18.25 V: the guard said 2.4%, the refinement it forced ended 0.42% off the closed form, where
-//! the unrefined grid is 0.03% off) and it costs a third solve per pass.
+//! Why two coarse grids: one can agree with h by chance where the error changes sign between
+//! them. With H_0 alone, the point-contact detector at 500 V had an estimate of 5e-5 of c12
+//! against an actual 2.2e-4 (4x finer grid); with both, 4.6e-4 against 2.2e-4. The second solve
+//! costs about 10% of a C-V curve (Super-Siegfried's 60 points: 2.0 -> 2.2 s). Before the front
+//! marks, the larger estimate exposed a refinement that did not converge: on the planar p-n at 29
+//! V it refined only where the weighting potentials change most and ended 0.30% off the closed
+//! form (the unrefined grid is 0.002% off); with the front's cells halved too it stops at 0.002%.
+//! A guard term |c12_H - c12_H2| / 4 (H coarsened once more) was tried on 2026-11-25 and dropped:
+//! on thin depletion layers H2 does not resolve the layer (planar p-n at 18.25 V: the guard said
+//! 2.4%).
 //!
 //! A fully depleted point starts from the detector's initial grid, not from the potential's
 //! (which depends on the bias and on the neighbouring voltage's front): its weighting potentials

@@ -294,25 +294,45 @@ pub(crate) fn solve_point_with(
     loop {
         passes += 1;
         let w = weigh(det, settings, &mesh, &pot, bias_v, pair)?;
-        // The same point on the coarsened grid; a failure there (a short or a pocket the coarse
-        // grid cannot resolve) leaves the estimate unknown, i.e. refine.
-        let c12_err_pf = match mesh.grid.coarsened(&keep_r, &keep_z) {
-            Some(h) => {
+        // The same point on both complementary coarsenings (each leaves out every other
+        // removable tick, the two together every one): two grids agree with h by chance less
+        // often than one. A failure there (a short or a pocket the coarse grid cannot resolve)
+        // leaves the estimate unknown, i.e. refine.
+        let c12_err_pf = (0..2)
+            .filter_map(|phase| mesh.grid.coarsened_phase(&keep_r, &keep_z, phase))
+            .map(|h| {
                 let guess = mesh.grid.interpolate_to(&pot.phi_v, &h);
                 let hm = Mesh::new(det, h);
                 solve(&hm, Some(&guess))
                     .and_then(|hp| weigh(det, settings, &hm, &hp, bias_v, pair))
                     .map_or(f64::INFINITY, |hw| (w.c12_pf - hw.c12_pf).abs())
-            }
-            None => 0.0,
-        };
+            })
+            .fold(0.0, f64::max);
         let rel = c12_err_pf / w.c12_pf.abs().max(f64::MIN_POSITIVE);
         let reached = rel <= gs.tolerance;
         let (a, b) = pair;
         let finer = (gs.adaptive && !reached && passes < gs.max_adaptive_passes)
             .then(|| {
-                let (sr, sz) =
+                let (mut sr, mut sz) =
                     weighting_marks(&w.wmesh.grid, &[&w.weighting.w[a], &w.weighting.w[b]]);
+                // The depletion front's cells as well, down to a quarter of `front_spacing_mm`:
+                // its sub-cell location is second order in their width, and the weighting
+                // potentials change little across them (the conductor ends inside), so the marks
+                // above miss an error that sits there (planar p-n at 29 V: 0.30% off the closed
+                // form after refinement without them, 0.002% with them). The floor keeps a
+                // pocket's neck at pinch-off, which never reaches the tolerance, from taking
+                // every pass.
+                let (fr, fz) =
+                    super::front::front_splits(&mesh, &pot.phi_v, &pot.undepleted, pot.bounds_v);
+                let floor = 0.25 * gs.front_spacing_mm;
+                let wide = |t: &[f64], k: usize| t[k + 1] - t[k] > floor * (1.0 + 1e-9);
+                let (rt, zt) = (mesh.grid.r_mm(), mesh.grid.z_mm());
+                for (k, f) in fr.iter().enumerate() {
+                    sr[k] |= *f && wide(rt, k);
+                }
+                for (k, f) in fz.iter().enumerate() {
+                    sz[k] |= *f && wide(zt, k);
+                }
                 mesh.grid.halved(&sr, &sz, gs)
             })
             .flatten()

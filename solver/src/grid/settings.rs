@@ -34,8 +34,9 @@ pub struct GridSettings {
     /// 2.5e-4 at 0.05 mm, 9.8e-4 at 0.25 mm, 5.3e-3 at 0.5 mm (default 0.25 mm).
     pub front_spacing_mm: f64,
     /// Refine each point until the estimated relative error of c12 is below `tolerance`
-    /// (`field::adaptive`: the difference to the same problem on the grid with every other
-    /// non-geometry tick removed, intervals split where the weighting potentials change most).
+    /// (`field::adaptive`: the larger difference to the same problem on the two grids with every
+    /// other non-geometry tick removed, odd or even ones; intervals split where the weighting
+    /// potentials change most and across the depletion front).
     /// Off: c12 on the grid above, with its estimate all the same.
     pub adaptive: bool,
     /// Target relative error of c12 for the adaptive refinement (default 0.2%, issue 18: the

@@ -151,6 +151,18 @@ impl Grid {
     /// between two kept ones, the 1st, 3rd, ... go. Spacings roughly double; geometry is
     /// represented exactly as before. `None` when nothing can be removed.
     pub fn coarsened(&self, keep_r_mm: &[f64], keep_z_mm: &[f64]) -> Option<Grid> {
+        self.coarsened_phase(keep_r_mm, keep_z_mm, 0)
+    }
+
+    /// [`Grid::coarsened`] with the other half of each run removed when `phase` is odd (the
+    /// 2nd, 4th, ... tick of each run goes): the two coarsenings of one grid together leave out
+    /// every removable tick once.
+    pub fn coarsened_phase(
+        &self,
+        keep_r_mm: &[f64],
+        keep_z_mm: &[f64],
+        phase: usize,
+    ) -> Option<Grid> {
         let thin = |t: &[f64], keep: &[f64]| -> (Vec<f64>, bool) {
             let must = |x: f64| keep.iter().any(|k| (k - x).abs() <= 1e-9 * (1.0 + x.abs()));
             let mut out = Vec::with_capacity(t.len());
@@ -161,7 +173,7 @@ impl Grid {
                     run = 0;
                 } else {
                     run += 1;
-                    if run.is_multiple_of(2) {
+                    if (run + phase).is_multiple_of(2) {
                         out.push(x);
                     }
                 }
@@ -283,6 +295,8 @@ mod tests {
         let c = g.coarsened(&[3.0], &[]).unwrap();
         assert_eq!(c.r_mm(), &[0.0, 2.0, 3.0, 5.0, 6.0]);
         assert_eq!(c.z_mm(), &[0.0, 1.0]);
+        let c = g.coarsened_phase(&[3.0], &[], 1).unwrap();
+        assert_eq!(c.r_mm(), &[0.0, 1.0, 3.0, 4.0, 6.0]);
         assert!(
             Grid::new(vec![0.0, 1.0], vec![0.0, 1.0])
                 .unwrap()
