@@ -12,15 +12,14 @@
 //! above where the convergence is asymptotic (first order at a point contact's edge, up to second
 //! order for smooth fields). While it is above `tolerance * c12_h`, the intervals across which a
 //! weighting potential of the pair changes by more than half the largest such change are halved
-//! (contact edges, small electrodes), and so are the cells the depletion front crosses (down to a
-//! quarter of `front_spacing_mm`: the weighting potentials change little across them, yet the
-//! front's sub-cell location is second order in their width); the potential is solved on the new
+//! (contact edges, small electrodes), and so are the cells the depletion front crosses
+//! ([`refinement_marks`]); the potential is solved on the new
 //! grid from the old one, and the point is evaluated again.
 //!
 //! Why two coarse grids: one can agree with h by chance where the error changes sign between
 //! them. With H_0 alone, the point-contact detector at 500 V had an estimate of 5e-5 of c12
 //! against an actual 2.2e-4 (4x finer grid); with both, 4.6e-4 against 2.2e-4. The second solve
-//! costs about 10% of a C-V curve (Super-Siegfried's 60 points: 2.0 -> 2.2 s). Before the front
+//! costs about 10-15% of a C-V curve (Super-Siegfried's 60 points: 2.0 -> 2.3 s). Before the front
 //! marks, the larger estimate exposed a refinement that did not converge: on the planar p-n at 29
 //! V it refined only where the weighting potentials change most and ended 0.30% off the closed
 //! form (the unrefined grid is 0.002% off); with the front's cells halved too it stops at 0.002%.
@@ -121,9 +120,47 @@ pub(crate) fn undepleted_nodes(mesh: &Mesh, pot: &PotentialSolution) -> usize {
         .count()
 }
 
-/// The intervals to halve: those across which W_a or W_b changes by more than
-/// `MARK_FRACTION` of the largest change across any interval of either axis.
-pub(crate) fn weighting_marks(grid: &Grid, fields: &[&[f64]]) -> (Vec<bool>, Vec<bool>) {
+/// The intervals (r, z) an adaptive pass halves: where the pair's weighting potentials change
+/// most ([`weighting_marks`]), and the cells the depletion front crosses.
+///
+/// The front's cells: its sub-cell location is second order in their width, and the weighting
+/// potentials change little across them (the conductor ends inside), so the weighting marks miss
+/// an error that sits there (planar p-n at 29 V: 0.30% off the closed form after refinement
+/// without them, 0.002% with them). With the sub-cell front they are halved down to a quarter of
+/// `front_spacing_mm`, which keeps a pocket's neck at pinch-off (it never reaches the tolerance)
+/// from taking every pass; with the front on nodes (the paper's epsilon mode, or no sub-cell
+/// front) its error is first order and there is no floor (coax at 1025 V: 2.2%, 1.1%, 0.55% per
+/// halving).
+pub(crate) fn refinement_marks(
+    settings: &FieldSettings,
+    mesh: &Mesh,
+    pot: &PotentialSolution,
+    w: &Weighed,
+    (a, b): (usize, usize),
+) -> (Vec<bool>, Vec<bool>) {
+    let (mut sr, mut sz) = weighting_marks(&w.wmesh.grid, &[&w.weighting.w[a], &w.weighting.w[b]]);
+    let (fr, fz) = super::front::front_splits(mesh, &pot.phi_v, &pot.undepleted, pot.bounds_v);
+    let subcell = settings.subcell_front && settings.weighting == WeightingMode::Conductor;
+    let floor = if subcell {
+        0.25 * settings.grid.front_spacing_mm
+    } else {
+        0.0
+    };
+    let wide = |t: &[f64], k: usize| t[k + 1] - t[k] > floor * (1.0 + 1e-9);
+    for (marks, front, t) in [
+        (&mut sr, &fr, mesh.grid.r_mm()),
+        (&mut sz, &fz, mesh.grid.z_mm()),
+    ] {
+        for (k, f) in front.iter().enumerate() {
+            marks[k] |= *f && wide(t, k);
+        }
+    }
+    (sr, sz)
+}
+
+/// The intervals across which W_a or W_b changes by more than `MARK_FRACTION` of the largest
+/// change across any interval of either axis.
+fn weighting_marks(grid: &Grid, fields: &[&[f64]]) -> (Vec<bool>, Vec<bool>) {
     let (nr, nz) = (grid.nr(), grid.nz());
     let mut dr = vec![0.0f64; nr - 1];
     let mut dz = vec![0.0f64; nz - 1];

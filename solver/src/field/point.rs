@@ -2,7 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::adaptive::{Accuracy, Weighed, undepleted_nodes, weigh, weighting_marks};
+use super::adaptive::{Accuracy, Weighed, refinement_marks, undepleted_nodes, weigh};
 use super::capacitance::CapacitanceMatrix;
 use super::depletion::{PotentialSolution, solve_fast};
 use super::mesh::Mesh;
@@ -310,38 +310,9 @@ pub(crate) fn solve_point_with(
             .fold(0.0, f64::max);
         let rel = c12_err_pf / w.c12_pf.abs().max(f64::MIN_POSITIVE);
         let reached = rel <= gs.tolerance;
-        let (a, b) = pair;
         let finer = (gs.adaptive && !reached && passes < gs.max_adaptive_passes)
             .then(|| {
-                let (mut sr, mut sz) =
-                    weighting_marks(&w.wmesh.grid, &[&w.weighting.w[a], &w.weighting.w[b]]);
-                // The depletion front's cells as well, down to a quarter of `front_spacing_mm`:
-                // its sub-cell location is second order in their width, and the weighting
-                // potentials change little across them (the conductor ends inside), so the marks
-                // above miss an error that sits there (planar p-n at 29 V: 0.30% off the closed
-                // form after refinement without them, 0.002% with them). The floor keeps a
-                // pocket's neck at pinch-off, which never reaches the tolerance, from taking
-                // every pass.
-                let (fr, fz) =
-                    super::front::front_splits(&mesh, &pot.phi_v, &pot.undepleted, pot.bounds_v);
-                // With the front on nodes (the paper's epsilon mode, or no sub-cell front) the
-                // front's error is first order: no floor there (coax at 1025 V: 2.2%, 1.1%,
-                // 0.55% per halving).
-                let subcell =
-                    settings.subcell_front && settings.weighting == WeightingMode::Conductor;
-                let floor = if subcell {
-                    0.25 * gs.front_spacing_mm
-                } else {
-                    0.0
-                };
-                let wide = |t: &[f64], k: usize| t[k + 1] - t[k] > floor * (1.0 + 1e-9);
-                let (rt, zt) = (mesh.grid.r_mm(), mesh.grid.z_mm());
-                for (k, f) in fr.iter().enumerate() {
-                    sr[k] |= *f && wide(rt, k);
-                }
-                for (k, f) in fz.iter().enumerate() {
-                    sz[k] |= *f && wide(zt, k);
-                }
+                let (sr, sz) = refinement_marks(settings, &mesh, &pot, &w, pair);
                 mesh.grid.halved(&sr, &sz, gs)
             })
             .flatten()

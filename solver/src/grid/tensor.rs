@@ -148,15 +148,9 @@ impl Grid {
 
     /// The grid with every other tick removed between ticks that must stay (`keep_r_mm`,
     /// `keep_z_mm`: geometry edges; the axis ends always stay): in each run of removable ticks
-    /// between two kept ones, the 1st, 3rd, ... go. Spacings roughly double; geometry is
-    /// represented exactly as before. `None` when nothing can be removed.
-    pub fn coarsened(&self, keep_r_mm: &[f64], keep_z_mm: &[f64]) -> Option<Grid> {
-        self.coarsened_phase(keep_r_mm, keep_z_mm, 0)
-    }
-
-    /// [`Grid::coarsened`] with the other half of each run removed when `phase` is odd (the
-    /// 2nd, 4th, ... tick of each run goes): the two coarsenings of one grid together leave out
-    /// every removable tick once.
+    /// between two kept ones, the 1st, 3rd, ... go for an even `phase`, the 2nd, 4th, ... for an
+    /// odd one (the two phases together leave out every removable tick once). Spacings roughly
+    /// double; geometry is represented exactly as before. `None` when nothing can be removed.
     pub fn coarsened_phase(
         &self,
         keep_r_mm: &[f64],
@@ -292,7 +286,7 @@ mod tests {
         assert!(Grid::new(vec![0.0], vec![0.0, 1.0]).is_err());
         // Coarsening keeps the ends and the required ticks, drops every other one between.
         let g = Grid::new(vec![0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0], vec![0.0, 1.0]).unwrap();
-        let c = g.coarsened(&[3.0], &[]).unwrap();
+        let c = g.coarsened_phase(&[3.0], &[], 0).unwrap();
         assert_eq!(c.r_mm(), &[0.0, 2.0, 3.0, 5.0, 6.0]);
         assert_eq!(c.z_mm(), &[0.0, 1.0]);
         let c = g.coarsened_phase(&[3.0], &[], 1).unwrap();
@@ -300,7 +294,7 @@ mod tests {
         assert!(
             Grid::new(vec![0.0, 1.0], vec![0.0, 1.0])
                 .unwrap()
-                .coarsened(&[], &[])
+                .coarsened_phase(&[], &[], 0)
                 .is_none()
         );
         assert!(Grid::new(vec![0.0, 0.0], vec![0.0, 1.0]).is_err());
