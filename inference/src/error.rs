@@ -56,12 +56,57 @@ pub enum Error {
         /// What is wrong with it.
         message: String,
     },
+    /// The solver failed outside a model evaluation (reading a detector, the profiles at a mode).
+    #[error(transparent)]
+    Solver(#[from] hpge_solver::Error),
+    /// An error with what was being read or done when it happened (e.g. `--detector D.toml`).
+    #[error("{context}: {inner}")]
+    Context {
+        /// What was being read or done.
+        context: String,
+        /// The error itself.
+        inner: Box<Error>,
+    },
+    /// A command-line style option whose value is not one of the accepted ones.
+    #[error("{option}: {message}")]
+    BadOption {
+        /// The option with its value, e.g. `--sampler gibbs`.
+        option: String,
+        /// What is accepted.
+        message: String,
+    },
+    /// A surrogate trained for another detector than the one a fit is given.
+    #[error(
+        "{}: the model was trained for the detector {trained_file} (hash {trained_hash}), not for {} (hash {hash}); fit with the detector the training rows were generated for, or train a model for this one",
+        model.display(),
+        detector.display()
+    )]
+    DetectorMismatch {
+        /// The model file.
+        model: PathBuf,
+        /// The detector file recorded in the model.
+        trained_file: String,
+        /// Its hash as recorded.
+        trained_hash: String,
+        /// The detector file given.
+        detector: PathBuf,
+        /// Its hash.
+        hash: String,
+    },
 }
 
 /// Result alias of the inference crate.
 pub type Result<T, E = Error> = std::result::Result<T, E>;
 
 impl Error {
+    /// This error with what was being read or done when it happened.
+    pub fn context(self, context: impl Into<String>) -> Self {
+        Error::Context {
+            context: context.into(),
+            inner: Box::new(self),
+        }
+    }
+
     /// Shorthand for [`Error::Format`].
     pub fn format(file: impl Into<PathBuf>, message: impl Into<String>) -> Self {
         Error::Format {

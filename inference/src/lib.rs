@@ -9,7 +9,7 @@
 mod diagnostics;
 mod discover;
 mod error;
-mod fit;
+pub mod fit;
 mod measurement;
 mod model;
 mod posterior;
@@ -29,8 +29,9 @@ pub use discover::{
 };
 pub use error::{Error, Result};
 pub use fit::{
-    ExactCheck, Fit, FitSettings, FitSummary, LEVELS, ModeSummary, ParameterShift,
-    ParameterSummary, Predictive, draw_range, exact_check, fit, nelder_mead, predictive,
+    ExactCheck, Fit, FitFiles, FitJob, FitSettings, FitSummary, LEVELS, ModeSummary,
+    ParameterShift, ParameterSummary, Predictive, TruthRecord, ZetaAtMode, ZetaProfile, draw_range,
+    exact_check, fit, nelder_mead, predictive,
 };
 pub use measurement::{
     Circuit, CvData, Data, MeasureSettings, Measurement, PC_PER_KEV, PeakFit, Problem, PulseSet,

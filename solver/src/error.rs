@@ -112,6 +112,22 @@ pub enum Error {
         /// What is wrong with it.
         message: String,
     },
+    /// A grid option (`--grid KEY=VALUE`, `--tolerance`) that the grid settings refuse.
+    #[error("{option}: {message}")]
+    GridOption {
+        /// The option as given, e.g. `--grid` or `--tolerance 0`.
+        option: String,
+        /// Why the grid settings refuse it.
+        message: String,
+    },
+    /// A value that does not have the expected form (the message says which form).
+    #[error("{message}")]
+    Syntax {
+        /// The text as given.
+        text: String,
+        /// What was expected, quoting the text.
+        message: String,
+    },
 }
 
 /// Result alias of the solver crate.

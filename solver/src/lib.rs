@@ -42,7 +42,7 @@ pub use field::{
 };
 pub use geometry::{BoundingBox, Primitive, Solid};
 pub use gpu::{AdapterReport, Precision, gpu_adapter, gpu_test_gate};
-pub use grid::{Grid, GridSettings, MIN_TOLERANCE};
+pub use grid::{Grid, GridOverrides, GridSettings, MIN_TOLERANCE, parse_grid_setting};
 pub use impurity::{
     ClampedNaturalSpline, ConstantModel, ImpurityContext, ImpurityModel, ImpuritySpec,
     LinearZModel, LogTransform, ModelKind, PointDensity, RzModel,

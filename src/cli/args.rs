@@ -1,7 +1,7 @@
 //! Value parsers for command-line arguments, and loading a detector from them.
 
-use anyhow::{Context, Result, anyhow};
-use hpge_solver::{Detector, FieldSettings, Parameters};
+use anyhow::{Context, Result};
+use hpge_solver::{Detector, Parameters};
 
 use super::DetectorInput;
 
@@ -142,50 +142,8 @@ pub fn parse_param(text: &str) -> Result<(String, f64), String> {
     Parameters::parse_assignment(text)
 }
 
-/// Grid and accuracy options of every command that solves fields. Precedence: the program's
-/// defaults, then the detector file's `[grid]` table, then `--grid`, then `--tolerance`.
-#[derive(Debug, Clone, Default, clap::Args)]
-pub struct GridArgs {
-    /// Target relative error of c12 for the adaptive grid (the detector's [grid] table, else
-    /// 0.002 = 0.2%).
-    #[arg(long, value_name = "REL", allow_hyphen_values = true)]
-    pub tolerance: Option<f64>,
-    /// A grid setting as KEY=VALUE, VALUE in TOML syntax (e.g. front_spacing_mm=0.1,
-    /// adaptive=false, refinement_limits=[0.2,0.1]); repeatable. The keys are those of the
-    /// detector file's [grid] table (detectors/README.md).
-    #[arg(long = "grid", value_name = "KEY=VALUE", value_parser = parse_grid_setting)]
-    pub grid: Vec<(String, String)>,
-}
-
-impl GridArgs {
-    /// `base` with the detector's `[grid]` table, then these options, in force.
-    pub fn apply(&self, base: &FieldSettings, det: &Detector) -> Result<FieldSettings> {
-        let mut s = base.for_detector(det);
-        s.grid = s
-            .grid
-            .with_overrides(&self.grid)
-            .map_err(|m| anyhow!("--grid: {m}"))?;
-        if let Some(t) = self.tolerance {
-            s.grid.tolerance = t;
-            s.grid
-                .validate()
-                .map_err(|m| anyhow!("--tolerance {t}: {m}"))?;
-        }
-        Ok(s)
-    }
-}
-
-/// Parses KEY=VALUE for `--grid`.
-pub fn parse_grid_setting(text: &str) -> Result<(String, String), String> {
-    let (k, v) = text
-        .split_once('=')
-        .ok_or_else(|| format!("expected KEY=VALUE (e.g. front_spacing_mm=0.1), got `{text}`"))?;
-    let (k, v) = (k.trim(), v.trim());
-    if k.is_empty() || v.is_empty() {
-        return Err(format!("expected KEY=VALUE, got `{text}`"));
-    }
-    Ok((k.to_string(), v.to_string()))
-}
+/// Grid and accuracy options: declared once, in the solver library.
+pub use hpge_solver::GridOverrides as GridArgs;
 
 /// Loads the detector, applies parameter overrides and the impurity file.
 pub fn load_detector(input: &DetectorInput) -> Result<Detector> {

@@ -1,19 +1,14 @@
 //! `hpge-cv fit`: the posterior of an impurity model given a measured C-V curve (paper, section
 //! 8), with the files, figures and report a physicist reads.
 
-use std::collections::BTreeMap;
 use std::path::Path;
 
-use anyhow::{Context, Result, bail};
-use hpge_inference::{
-    CvData, CvModel, Data, ExactModel, Fit, FitSettings, Likelihood, NoiseKind, Posterior, Prior,
-    PriorSpec, SampleSettings, SamplerKind, Status, SurrogateModel, exact_check, fit,
-    interval_contains, load_data,
-};
-use hpge_surrogate::{ExactSolver, Surrogate, fnv1a};
+use anyhow::{Context, Result};
+use hpge_inference::fit::{FitFiles, FitJob, outputs, read_truth, truth_records};
+use hpge_inference::{CvModel, Fit, SamplerKind, Status};
 use indicatif::{ProgressBar, ProgressStyle};
 
-use super::fit_outputs::{TruthRecord, read_truth, write_outputs};
+use super::fit_outputs::write_outputs;
 
 /// A fit that did not reach its convergence targets (exit code 3).
 #[derive(Debug, thiserror::Error)]
@@ -22,45 +17,13 @@ use super::fit_outputs::{TruthRecord, read_truth, write_outputs};
 )]
 pub struct Unconverged(pub String);
 
-/// Options of `fit`.
-pub struct FitOptions<'a> {
-    pub data: &'a Path,
-    pub model: &'a Path,
-    pub prior: &'a Path,
-    pub detector: &'a Path,
-    pub out: &'a Path,
-    pub sampler: &'a str,
-    pub seed: u64,
-    pub json: bool,
-    pub allow_unconverged: bool,
-    pub no_exact_check: bool,
-    pub exact_draws: usize,
-    pub likelihood: &'a str,
-    pub chains: usize,
-    pub ess: f64,
-    pub rhat: f64,
-    pub max_seconds: f64,
-    pub truth: Option<&'a Path>,
-    pub no_plots: bool,
-    pub mode_starts: usize,
-    pub grid: &'a super::args::GridArgs,
-}
+pub use hpge_inference::fit::FitOptions;
 
-/// Everything a fit was set up from.
-pub struct Setup {
-    pub data: CvData,
-    pub surrogate: SurrogateModel,
-    pub prior: Prior,
-    pub likelihood: Likelihood,
-    pub exact: ExactSolver,
-    pub inputs: BTreeMap<String, String>,
-}
+/// Everything a fit was set up from (the library's fit job).
+pub type Setup = FitJob;
 
-fn file_hash(path: &Path) -> String {
-    std::fs::read(path).map_or_else(|_| "?".into(), |b| format!("{:016x}", fnv1a(&b)))
-}
-
-/// Reads and checks data, model, prior and detector against each other.
+/// Reads and checks data, model, prior and detector against each other ([`FitJob::from_files`]),
+/// printing the job's warnings.
 pub fn setup(
     data: &Path,
     model: &Path,
@@ -69,71 +32,22 @@ pub fn setup(
     noise: hpge_inference::NoiseSettings,
     grid: &super::args::GridArgs,
 ) -> Result<Setup> {
-    let data_curve = match load_data(data)? {
-        Data::Curve(c) => c,
-        Data::Raw(_) => bail!(
-            "{}: raw pulser data; make a C-V curve first: hpge-cv measure --raw {} --out cv.csv",
-            data.display(),
-            data.display()
-        ),
+    let files = FitFiles {
+        data: data.to_path_buf(),
+        model: model.to_path_buf(),
+        prior: prior.to_path_buf(),
+        detector: detector.to_path_buf(),
     };
-    let surrogate = Surrogate::load(model)?;
-    let det = hpge_solver::Detector::from_file(detector, &hpge_solver::Parameters::new())
-        .with_context(|| format!("--detector {}", detector.display()))?;
-    let settings = grid.apply(&hpge_solver::FieldSettings::default(), &det)?;
-    let exact = ExactSolver::new(surrogate.info.space.clone(), detector, settings)
-        .with_context(|| format!("--detector {}", detector.display()))?;
-    match &surrogate.info.detector {
-        Some(d) if d.hash != exact.detector_hash() => bail!(
-            "{}: the model was trained for the detector {} (hash {}), not for {} (hash {}); \
-             fit with the detector the training rows were generated for, or train a model for this one",
-            model.display(),
-            d.file,
-            d.hash,
-            detector.display(),
-            exact.detector_hash()
-        ),
-        Some(_) => {}
-        None => eprintln!(
-            "warning: {} records no detector (trained without --detector); it cannot be checked against {}",
-            model.display(),
-            detector.display()
-        ),
+    let job = FitJob::from_files(&files, noise, grid)?;
+    for w in &job.warnings {
+        eprintln!("warning: {w}");
     }
-    let describe = format!(
-        "{} (recipe {}, sigma_p {:.3}%)",
-        model.display(),
-        surrogate.info.recipe_name,
-        100.0 * surrogate.sigma_p()
-    );
-    let sm = SurrogateModel::new(surrogate, &data_curve.voltage_v, describe)
-        .with_context(|| format!("the voltages of {}", data.display()))?;
-    let spec = PriorSpec::from_file(prior)?;
-    let prior_b = Prior::bind(&spec, &sm.inputs(), &sm.domain())?;
-    let likelihood = Likelihood::new(&data_curve, noise, sm.sigma_rel())?;
-    let mut inputs = BTreeMap::new();
-    inputs.insert("data".into(), data.display().to_string());
-    inputs.insert("data_hash".into(), file_hash(data));
-    inputs.insert("model".into(), model.display().to_string());
-    inputs.insert("model_hash".into(), file_hash(model));
-    inputs.insert("prior".into(), prior.display().to_string());
-    inputs.insert("prior_hash".into(), file_hash(prior));
-    inputs.insert("detector".into(), detector.display().to_string());
-    inputs.insert("detector_hash".into(), exact.detector_hash());
-    Ok(Setup {
-        data: data_curve,
-        surrogate: sm,
-        prior: prior_b,
-        likelihood,
-        exact,
-        inputs,
-    })
+    Ok(job)
 }
 
 /// Parses the sampler name.
 pub fn sampler_kind(name: &str) -> Result<SamplerKind> {
-    SamplerKind::parse(name)
-        .with_context(|| format!("--sampler {name}: unknown sampler; use metropolis or nuts"))
+    Ok(hpge_inference::fit::sampler_kind(name)?)
 }
 
 /// A progress line on stderr: a spinner on a terminal, one line per update otherwise.
@@ -172,40 +86,24 @@ pub fn progress_printer(quiet: bool) -> (ProgressBar, impl Fn(&Status) + Sync) {
 
 /// The paper's noise constants with the likelihood named by `--likelihood`.
 pub fn noise_settings(likelihood: &str) -> Result<hpge_inference::NoiseSettings> {
-    let kind = NoiseKind::parse(likelihood)
-        .with_context(|| format!("--likelihood {likelihood}: use paper or covariance"))?;
-    Ok(hpge_inference::NoiseSettings {
-        kind,
-        ..Default::default()
-    })
+    Ok(hpge_inference::fit::noise_settings(likelihood)?)
 }
 
-/// Runs `fit`.
-pub fn run(o: &FitOptions) -> Result<()> {
-    let kind = sampler_kind(o.sampler)?;
-    let noise = noise_settings(o.likelihood)?;
-    let s = setup(o.data, o.model, o.prior, o.detector, noise, o.grid)?;
-    let truth = match o.truth {
+/// Runs `fit`: `json` prints the summary as one JSON object; `allow_unconverged` exits with 0
+/// when the convergence targets were not reached.
+pub fn run(o: &FitOptions, print_json: bool, allow_unconverged: bool) -> Result<()> {
+    let kind = o.sampler_kind()?;
+    let noise = o.noise()?;
+    let s = setup(&o.data, &o.model, &o.prior, &o.detector, noise, &o.grid)?;
+    let truth = match &o.truth {
         Some(p) => Some(read_truth(p, &s.prior)?),
         None => None,
     };
-    let mut sample = SampleSettings::for_sampler(kind);
-    sample.seed = o.seed;
-    sample.chains = o.chains;
-    sample.ess_min = o.ess;
-    sample.rhat_max = o.rhat;
-    sample.max_seconds = o.max_seconds;
-    sample.mode_starts = o.mode_starts;
-    sample.validate()?;
-    let settings = FitSettings {
-        sample,
-        noise,
-        ..FitSettings::default()
-    };
-    std::fs::create_dir_all(o.out)
-        .with_context(|| format!("--out {}: cannot create the folder", o.out.display()))?;
-    let posterior = Posterior::new(&s.surrogate, &s.prior, &s.likelihood)
-        .with_context(|| format!("{} with {}", o.data.display(), o.prior.display()))?;
+    let settings = o.settings()?;
+    let sample = settings.sample;
+    let out = o.out_dir();
+    std::fs::create_dir_all(&out)
+        .with_context(|| format!("--out {}: cannot create the folder", out.display()))?;
     eprintln!(
         "fitting {} ({} voltages) with {} and the prior {} ({} parameters), {} sampler, {} chains, seed {}",
         o.data.display(),
@@ -218,60 +116,35 @@ pub fn run(o: &FitOptions) -> Result<()> {
         o.seed
     );
     let (bar, progress) = progress_printer(false);
-    let mut result = fit(&posterior, &settings, s.inputs.clone(), &progress)?;
+    let mut result = s.run(&settings, &progress)?;
     bar.finish_and_clear();
     if !o.no_exact_check {
-        let exact = ExactModel::new(s.exact.clone(), &s.data.voltage_v)?;
         let pb = ProgressBar::new(o.exact_draws as u64 + 1);
         pb.set_style(
             ProgressStyle::with_template("exact check {bar:30} {pos}/{len} curves, {elapsed}")
                 .unwrap_or_else(|_| ProgressStyle::default_bar()),
         );
-        let check = exact_check(
-            &s.surrogate,
-            &exact,
-            &s.prior,
-            &s.likelihood,
-            &result.samples,
-            &result.mode,
-            o.exact_draws,
-            &|done, _| pb.set_position(done as u64),
-        )?;
+        s.check_exact(&mut result, o.exact_draws, &|done, _| {
+            pb.set_position(done as u64)
+        })?;
         pb.finish_and_clear();
-        result.summary.seconds += check.seconds;
-        result.summary.exact_check = Some(check);
     }
-    let truth_records = truth.as_ref().map(|t| {
-        result
-            .summary
-            .parameters
-            .iter()
-            .zip(t)
-            .filter_map(|(p, v)| {
-                v.map(|v| TruthRecord {
-                    name: p.name.clone(),
-                    value: v,
-                    inside_683: interval_contains(&p.smallest_intervals["0.683"], v),
-                    inside_955: interval_contains(&p.smallest_intervals["0.955"], v),
-                })
-            })
-            .collect::<Vec<_>>()
-    });
-    write_outputs(o, &s, &result, truth.as_deref(), truth_records.as_deref())?;
+    let truth_records = truth.as_ref().map(|t| truth_records(&result.summary, t));
+    write_outputs(
+        o,
+        &out,
+        &s,
+        &result,
+        truth.as_deref(),
+        truth_records.as_deref(),
+    )?;
     let sm = &result.summary;
-    let mut json = serde_json::to_value(sm)?;
-    if let (Some(t), Some(obj)) = (&truth_records, json.as_object_mut()) {
-        obj.insert("truth".into(), serde_json::to_value(t)?);
-    }
-    std::fs::write(
-        o.out.join("summary.json"),
-        serde_json::to_string_pretty(&json)? + "\n",
-    )
-    .with_context(|| format!("cannot write {}", o.out.join("summary.json").display()))?;
-    if o.json {
+    let json = outputs::summary_json(&result, truth_records.as_deref())?;
+    outputs::write_summary(&out.join("summary.json"), &json)?;
+    if print_json {
         println!("{}", serde_json::to_string(&json)?);
     } else {
-        print_summary(&result, o.out);
+        print_summary(&result, &out);
     }
     if !sm.converged {
         let worst = sm
@@ -291,7 +164,7 @@ pub fn run(o: &FitOptions) -> Result<()> {
             })
             .unwrap_or_default();
         let msg = format!("{worst}; stopped: {:?}", sm.stop);
-        if o.allow_unconverged {
+        if allow_unconverged {
             eprintln!("warning: the fit did not converge ({msg})");
         } else {
             return Err(Unconverged(msg).into());

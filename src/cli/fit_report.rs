@@ -35,6 +35,7 @@ fn intervals(v: &[[f64; 2]]) -> String {
 pub fn write_report(
     path: &Path,
     o: &FitOptions,
+    out: &Path,
     s: &Setup,
     fit: &Fit,
     figures: &[PathBuf],
@@ -65,7 +66,7 @@ pub fn write_report(
         o.sampler,
         o.seed,
         o.likelihood,
-        o.out.display()
+        out.display()
     );
     let _ = writeln!(r, "## Convergence\n");
     let _ = writeln!(

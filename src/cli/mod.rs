@@ -25,7 +25,7 @@ use std::path::PathBuf;
 use anyhow::Result;
 use clap::{Parser, Subcommand};
 
-pub use args::{GridArgs, parse_param, parse_point, parse_voltages};
+pub use args::{parse_param, parse_point, parse_voltages};
 pub use fit::Unconverged;
 pub use sensitivity::ScanPoint;
 
@@ -172,82 +172,18 @@ struct CoverageArgs {
 
 #[derive(Debug, clap::Args)]
 struct FitArgs {
-    /// The measured C-V curve (CSV with voltage_V, c12_pF, sigma_pF; its covariance is read from
-    /// <stem>.covariance.csv when present).
-    #[arg(
-        long,
-        value_name = "FILE",
-        default_value = "data/super-siegfried-k1/cv.csv"
-    )]
-    data: PathBuf,
-    /// The surrogate model (.safetensors).
-    #[arg(long, value_name = "FILE", default_value = DEFAULT_MODEL)]
-    model: PathBuf,
-    /// The prior (TOML): priors/b-rz.toml (the paper's B_RZ) or priors/b-z.toml (B_Z).
-    #[arg(long, value_name = "FILE", default_value = "priors/b-rz.toml")]
-    prior: PathBuf,
-    /// The detector the data were measured with (checked against the model's; used by the
-    /// exact-solver check and for zeta at the mode).
-    #[arg(
-        long,
-        value_name = "FILE",
-        default_value = "detectors/super-siegfried-k1.toml"
-    )]
-    detector: PathBuf,
-    /// Output folder [default: fits/<prior name>].
-    #[arg(long, value_name = "DIR")]
-    out: Option<PathBuf>,
-    /// Sampler: metropolis (adaptive, like BAT.jl's default) or nuts.
-    #[arg(long, default_value = "metropolis")]
-    sampler: String,
-    /// Seed of the sampler (starting points, proposals).
-    #[arg(long, default_value_t = 0)]
-    seed: u64,
+    #[command(flatten)]
+    options: fit::FitOptions,
     /// Print the summary as one JSON object on stdout (progress stays on stderr).
     #[arg(long)]
     json: bool,
     /// Exit with 0 even when the R-hat/ESS targets were not reached (otherwise exit code 3).
     #[arg(long)]
     allow_unconverged: bool,
-    /// Skip the exact-solver re-weighting check.
-    #[arg(long)]
-    no_exact_check: bool,
-    /// Posterior draws re-weighted with the exact solver (about 1 s of solver time each on 2
-    /// cores... 0.6 s per curve per core).
-    #[arg(long, default_value_t = 100)]
-    exact_draws: usize,
-    /// Likelihood: paper (independent, 3% measurement term) or covariance (the measured
-    /// covariance instead of the 3% term).
-    #[arg(long, default_value = "paper")]
-    likelihood: String,
-    /// Chains (run in parallel).
-    #[arg(long, default_value_t = 4)]
-    chains: usize,
-    /// Target bulk and tail ESS of every parameter.
-    #[arg(long, default_value_t = 1000.0)]
-    ess: f64,
-    /// Target R-hat (rank-normalised, split).
-    #[arg(long, default_value_t = 1.01)]
-    rhat: f64,
-    /// Stop sampling after this many seconds even if the targets are not reached.
-    #[arg(long, default_value_t = 300.0)]
-    max_seconds: f64,
-    /// Known parameter values (TOML NAME = VALUE) to mark on the figures and check against the
-    /// smallest intervals, e.g. data/super-siegfried-k1/truth-b-rz.toml.
-    #[arg(long, value_name = "FILE")]
-    truth: Option<PathBuf>,
-    /// Write no figures.
-    #[arg(long)]
-    no_plots: bool,
-    /// Nelder-Mead starts of the mode search before sampling (0: none).
-    #[arg(long, default_value_t = 24)]
-    mode_starts: usize,
-    #[command(flatten)]
-    grid: args::GridArgs,
 }
 
 /// The shipped surrogate `fit` uses by default.
-const DEFAULT_MODEL: &str = "models/super-siegfried-rz-split.safetensors";
+const DEFAULT_MODEL: &str = hpge_inference::fit::DEFAULT_MODEL;
 
 #[derive(Debug, clap::Args)]
 struct TrainArgs {
@@ -693,37 +629,7 @@ pub fn run(cli: Cli) -> Result<()> {
             quiet: false,
             detector: a.detector.as_deref(),
         }),
-        Command::Fit(a) => {
-            let out = a.out.clone().unwrap_or_else(|| {
-                let stem = a
-                    .prior
-                    .file_stem()
-                    .map_or("fit".into(), |s| s.to_string_lossy().to_string());
-                PathBuf::from("fits").join(stem)
-            });
-            fit::run(&fit::FitOptions {
-                data: &a.data,
-                model: &a.model,
-                prior: &a.prior,
-                detector: &a.detector,
-                out: &out,
-                sampler: &a.sampler,
-                seed: a.seed,
-                json: a.json,
-                allow_unconverged: a.allow_unconverged,
-                no_exact_check: a.no_exact_check,
-                exact_draws: a.exact_draws,
-                likelihood: &a.likelihood,
-                chains: a.chains,
-                ess: a.ess,
-                rhat: a.rhat,
-                max_seconds: a.max_seconds,
-                truth: a.truth.as_deref(),
-                no_plots: a.no_plots,
-                mode_starts: a.mode_starts,
-                grid: &a.grid,
-            })
-        }
+        Command::Fit(a) => fit::run(&a.options, a.json, a.allow_unconverged),
         Command::Discover(a) => discover::run(&a),
         Command::Report(a) => crate::report::run(&a),
         Command::Pulse(a) => pulse::run(&a),

@@ -55,7 +55,7 @@ pub use cross_section::cross_section;
 pub use cv::cv_curve;
 pub use discovery::discovery_figures;
 pub use field::field_map;
-pub use fit::{ZetaAtMode, ZetaProfile, fit_figures};
+pub use fit::fit_figures;
 pub use lines::{Corner, Curve, LineFigure, line_figure};
 pub use measure::measurement;
 pub use sensitivity::sensitivity;

@@ -44,28 +44,20 @@ pub(super) fn fit_dir(ctx: &Ctx, key: &str) -> PathBuf {
 /// Runs `fit` with the shipped defaults into fits/<key>; returns summary.json.
 fn run_fit(ctx: &Ctx, key: &str, prior: &Path, truth: Option<&Path>) -> Result<Value> {
     let out = fit_dir(ctx, key);
-    fit(&FitOptions {
-        data: &ctx.inputs.data,
-        model: &ctx.inputs.fit_model,
-        prior,
-        detector: &ctx.inputs.detector,
-        out: &out,
-        sampler: "metropolis",
-        seed: 0,
-        json: false,
-        allow_unconverged: true,
-        no_exact_check: !ctx.exact_check,
-        exact_draws: 100,
-        likelihood: "paper",
-        chains: 4,
-        ess: 1000.0,
-        rhat: 1.01,
-        max_seconds: 300.0,
-        truth,
-        no_plots: false,
-        mode_starts: 24,
-        grid: &crate::cli::GridArgs::default(),
-    })?;
+    fit(
+        &FitOptions {
+            data: ctx.inputs.data.clone(),
+            model: ctx.inputs.fit_model.clone(),
+            prior: prior.to_path_buf(),
+            detector: ctx.inputs.detector.clone(),
+            out: Some(out.clone()),
+            no_exact_check: !ctx.exact_check,
+            truth: truth.map(Path::to_path_buf),
+            ..FitOptions::default()
+        },
+        false,
+        true,
+    )?;
     let path = out.join("summary.json");
     let text = std::fs::read_to_string(&path)
         .with_context(|| format!("cannot read {}", path.display()))?;

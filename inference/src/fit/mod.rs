@@ -2,14 +2,26 @@
 //! the posterior predictive, the modes of a multimodal posterior, and the exact-solver check.
 
 mod exact_check;
+mod job;
 mod optimise;
+mod options;
+pub mod outputs;
 mod predictive;
 mod run;
 mod summary;
+mod truth;
+mod zeta;
 
 pub use exact_check::{ExactCheck, ParameterShift, exact_check};
+pub use job::{FitFiles, FitJob, file_hash};
 pub use optimise::nelder_mead;
+pub use options::{
+    DEFAULT_DATA, DEFAULT_DETECTOR, DEFAULT_MODEL, DEFAULT_PRIOR, FitOptions, noise_settings,
+    sampler_kind,
+};
 pub(crate) use predictive::thin_indices;
 pub use predictive::{Predictive, predictive};
 pub use run::{Fit, FitSettings, draw_range, fit};
 pub use summary::{FitSummary, LEVELS, ModeSummary, ParameterSummary};
+pub use truth::{TruthRecord, read_truth, truth_records};
+pub use zeta::{ZetaAtMode, ZetaProfile, zeta_at_mode};

@@ -2,8 +2,10 @@
 //! spacing ratio, refinement where neighbouring potential differences are large.
 
 mod axis;
+mod overrides;
 mod settings;
 mod tensor;
 
+pub use overrides::{GridOverrides, parse_grid_setting};
 pub use settings::{GridSettings, MIN_TOLERANCE};
 pub use tensor::Grid;

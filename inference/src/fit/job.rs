@@ -1,0 +1,208 @@
+//! A fit set up from its four input files: the measured curve, the surrogate, the prior and the
+//! detector, checked against each other (the model must have been trained for this detector,
+//! its voltages must cover the data's) and bound into one likelihood and one prior.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use hpge_solver::{Detector, FieldSettings, GridOverrides, Parameters};
+use hpge_surrogate::{ExactSolver, Surrogate, fnv1a};
+
+use super::exact_check::exact_check;
+use super::run::{Fit, FitSettings, fit};
+use super::zeta::{ZetaAtMode, zeta_at_mode};
+use crate::measurement::{CvData, Data, load_data};
+use crate::model::{CvModel, ExactModel, SurrogateModel};
+use crate::posterior::{Likelihood, NoiseSettings, Posterior};
+use crate::prior::{Prior, PriorSpec};
+use crate::sampler::Status;
+use crate::{Error, Result};
+
+/// The four input files of a fit.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct FitFiles {
+    /// The measured C-V curve (CSV, with or without its covariance file).
+    pub data: PathBuf,
+    /// The surrogate model file (safetensors with metadata).
+    pub model: PathBuf,
+    /// The prior (TOML).
+    pub prior: PathBuf,
+    /// The detector the model was trained for (TOML).
+    pub detector: PathBuf,
+}
+
+/// Everything a fit is set up from, checked and bound.
+pub struct FitJob {
+    /// The files it was read from.
+    pub files: FitFiles,
+    /// The measured curve.
+    pub data: CvData,
+    /// The surrogate at the data's voltages.
+    pub surrogate: SurrogateModel,
+    /// The prior bound to the surrogate's inputs.
+    pub prior: Prior,
+    /// The likelihood of the data.
+    pub likelihood: Likelihood,
+    /// The exact field solver of the same space and detector (for the exact-solver check and the
+    /// profiles at the mode).
+    pub exact: ExactSolver,
+    /// The inputs by name with their hashes (`data`, `data_hash`, `model`, ...), recorded in the
+    /// summary.
+    pub inputs: BTreeMap<String, String>,
+    /// Warnings for the user (e.g. a model that records no detector, so none could be checked).
+    pub warnings: Vec<String>,
+}
+
+/// FNV-1a hash of a file's bytes as 16 hex digits ("?" where the file cannot be read).
+pub fn file_hash(path: &Path) -> String {
+    std::fs::read(path).map_or_else(|_| "?".into(), |b| format!("{:016x}", fnv1a(&b)))
+}
+
+impl FitJob {
+    /// Reads and checks data, model, prior and detector against each other; `grid` sets the
+    /// exact solver's grid and accuracy on top of the detector file's `[grid]` table.
+    ///
+    /// # Errors
+    /// Raw pulser data instead of a curve ([`Error::Format`]), a model trained for another
+    /// detector ([`Error::DetectorMismatch`]), voltages outside the model's range, a prior that
+    /// does not fit the model's inputs, and every read or parse error, each naming its file.
+    pub fn from_files(
+        files: &FitFiles,
+        noise: NoiseSettings,
+        grid: &GridOverrides,
+    ) -> Result<Self> {
+        let FitFiles {
+            data,
+            model,
+            prior,
+            detector,
+        } = files;
+        let data_curve = match load_data(data)? {
+            Data::Curve(c) => c,
+            Data::Raw(_) => {
+                return Err(Error::format(
+                    data,
+                    format!(
+                        "raw pulser data; make a C-V curve first: hpge-cv measure --raw {} --out cv.csv",
+                        data.display()
+                    ),
+                ));
+            }
+        };
+        let surrogate = Surrogate::load(model)?;
+        let det_context = || format!("--detector {}", detector.display());
+        let det = Detector::from_file(detector, &Parameters::new())
+            .map_err(|e| Error::from(e).context(det_context()))?;
+        let settings = grid.apply(&FieldSettings::default(), &det)?;
+        let exact = ExactSolver::new(surrogate.info.space.clone(), detector, settings)
+            .map_err(|e| Error::from(e).context(det_context()))?;
+        let mut warnings = Vec::new();
+        match &surrogate.info.detector {
+            Some(d) if d.hash != exact.detector_hash() => {
+                return Err(Error::DetectorMismatch {
+                    model: model.clone(),
+                    trained_file: d.file.clone(),
+                    trained_hash: d.hash.clone(),
+                    detector: detector.clone(),
+                    hash: exact.detector_hash(),
+                });
+            }
+            Some(_) => {}
+            None => warnings.push(format!(
+                "{} records no detector (trained without --detector); it cannot be checked against {}",
+                model.display(),
+                detector.display()
+            )),
+        }
+        let describe = format!(
+            "{} (recipe {}, sigma_p {:.3}%)",
+            model.display(),
+            surrogate.info.recipe_name,
+            100.0 * surrogate.sigma_p()
+        );
+        let sm = SurrogateModel::new(surrogate, &data_curve.voltage_v, describe)
+            .map_err(|e| e.context(format!("the voltages of {}", data.display())))?;
+        let spec = PriorSpec::from_file(prior)?;
+        let prior_b = Prior::bind(&spec, &sm.inputs(), &sm.domain())?;
+        let likelihood = Likelihood::new(&data_curve, noise, sm.sigma_rel())?;
+        let mut inputs = BTreeMap::new();
+        inputs.insert("data".into(), data.display().to_string());
+        inputs.insert("data_hash".into(), file_hash(data));
+        inputs.insert("model".into(), model.display().to_string());
+        inputs.insert("model_hash".into(), file_hash(model));
+        inputs.insert("prior".into(), prior.display().to_string());
+        inputs.insert("prior_hash".into(), file_hash(prior));
+        inputs.insert("detector".into(), detector.display().to_string());
+        inputs.insert("detector_hash".into(), exact.detector_hash());
+        Ok(FitJob {
+            files: files.clone(),
+            data: data_curve,
+            surrogate: sm,
+            prior: prior_b,
+            likelihood,
+            exact,
+            inputs,
+            warnings,
+        })
+    }
+
+    /// The posterior of the data with the surrogate and the prior.
+    ///
+    /// # Errors
+    /// The surrogate's voltages and the likelihood's do not match.
+    pub fn posterior(&self) -> Result<Posterior<'_>> {
+        Posterior::new(&self.surrogate, &self.prior, &self.likelihood).map_err(|e| {
+            e.context(format!(
+                "{} with {}",
+                self.files.data.display(),
+                self.files.prior.display()
+            ))
+        })
+    }
+
+    /// Samples the posterior and summarises it ([`fit`]); `progress` sees every status update.
+    ///
+    /// # Errors
+    /// See [`FitJob::posterior`] and [`fit`].
+    pub fn run(&self, settings: &FitSettings, progress: &(dyn Fn(&Status) + Sync)) -> Result<Fit> {
+        let posterior = self.posterior()?;
+        fit(&posterior, settings, self.inputs.clone(), progress)
+    }
+
+    /// Re-weights `draws` thinned draws of `result` with the exact field solver
+    /// ([`exact_check`]: PSIS, Pareto k-hat, mean shifts) and records the check and its time in
+    /// the summary; `progress` sees (curves done, curves in all).
+    ///
+    /// # Errors
+    /// The exact model cannot be set up at the data's voltages, or a non-recoverable solver
+    /// failure.
+    pub fn check_exact(
+        &self,
+        result: &mut Fit,
+        draws: usize,
+        progress: &(dyn Fn(usize, usize) + Sync),
+    ) -> Result<()> {
+        let exact = ExactModel::new(self.exact.clone(), &self.data.voltage_v)?;
+        let check = exact_check(
+            &self.surrogate,
+            &exact,
+            &self.prior,
+            &self.likelihood,
+            &result.samples,
+            &result.mode,
+            draws,
+            progress,
+        )?;
+        result.summary.seconds += check.seconds;
+        result.summary.exact_check = Some(check);
+        Ok(())
+    }
+
+    /// zeta at the global mode of `result` ([`zeta_at_mode`]).
+    ///
+    /// # Errors
+    /// The detector cannot be built at the mode.
+    pub fn zeta_at_mode(&self, result: &Fit) -> Result<ZetaAtMode> {
+        zeta_at_mode(&self.exact, &self.prior, &result.mode)
+    }
+}

@@ -1,0 +1,201 @@
+//! The options of a fit as a user states them: the four input files, the sampler and its
+//! targets, the likelihood, the exact-solver check and the output folder. The command line
+//! flattens this struct (feature `clap`), so every option and default is declared here once.
+
+use std::path::PathBuf;
+
+use hpge_solver::GridOverrides;
+
+use super::job::FitFiles;
+use super::run::FitSettings;
+use crate::posterior::{NoiseKind, NoiseSettings};
+use crate::sampler::{SampleSettings, SamplerKind};
+use crate::{Error, Result};
+
+/// The shipped Super-Siegfried curve (a stand-in made by this program; data/super-siegfried-k1/).
+pub const DEFAULT_DATA: &str = "data/super-siegfried-k1/cv.csv";
+/// The shipped surrogate a fit uses by default (the `split` recipe, models/README.md).
+pub const DEFAULT_MODEL: &str = "models/super-siegfried-rz-split.safetensors";
+/// The paper's B_RZ prior (section 8.2).
+pub const DEFAULT_PRIOR: &str = "priors/b-rz.toml";
+/// The detector of the shipped data.
+pub const DEFAULT_DETECTOR: &str = "detectors/super-siegfried-k1.toml";
+
+/// Everything a user chooses about a fit.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "clap", derive(clap::Args))]
+pub struct FitOptions {
+    /// The measured C-V curve (CSV with voltage_V, c12_pF, sigma_pF; its covariance is read from
+    /// <stem>.covariance.csv when present).
+    #[cfg_attr(feature = "clap", arg(long, value_name = "FILE", default_value = DEFAULT_DATA))]
+    pub data: PathBuf,
+    /// The surrogate model (.safetensors).
+    #[cfg_attr(feature = "clap", arg(long, value_name = "FILE", default_value = DEFAULT_MODEL))]
+    pub model: PathBuf,
+    /// The prior (TOML): priors/b-rz.toml (the paper's B_RZ) or priors/b-z.toml (B_Z).
+    #[cfg_attr(feature = "clap", arg(long, value_name = "FILE", default_value = DEFAULT_PRIOR))]
+    pub prior: PathBuf,
+    /// The detector the data were measured with (checked against the model's; used by the
+    /// exact-solver check and for zeta at the mode).
+    #[cfg_attr(
+        feature = "clap",
+        arg(long, value_name = "FILE", default_value = DEFAULT_DETECTOR)
+    )]
+    pub detector: PathBuf,
+    /// Output folder [default: fits/<prior name>].
+    #[cfg_attr(feature = "clap", arg(long, value_name = "DIR"))]
+    pub out: Option<PathBuf>,
+    /// Sampler: metropolis (adaptive, like BAT.jl's default) or nuts.
+    #[cfg_attr(feature = "clap", arg(long, default_value = "metropolis"))]
+    pub sampler: String,
+    /// Seed of the sampler (starting points, proposals).
+    #[cfg_attr(feature = "clap", arg(long, default_value_t = 0))]
+    pub seed: u64,
+    /// Skip the exact-solver re-weighting check.
+    #[cfg_attr(feature = "clap", arg(long))]
+    pub no_exact_check: bool,
+    /// Posterior draws re-weighted with the exact solver (about 1 s of solver time each on 2
+    /// cores... 0.6 s per curve per core).
+    #[cfg_attr(feature = "clap", arg(long, default_value_t = 100))]
+    pub exact_draws: usize,
+    /// Likelihood: paper (independent, 3% measurement term) or covariance (the measured
+    /// covariance instead of the 3% term).
+    #[cfg_attr(feature = "clap", arg(long, default_value = "paper"))]
+    pub likelihood: String,
+    /// Chains (run in parallel).
+    #[cfg_attr(feature = "clap", arg(long, default_value_t = 4))]
+    pub chains: usize,
+    /// Target bulk and tail ESS of every parameter.
+    #[cfg_attr(feature = "clap", arg(long, default_value_t = 1000.0))]
+    pub ess: f64,
+    /// Target R-hat (rank-normalised, split).
+    #[cfg_attr(feature = "clap", arg(long, default_value_t = 1.01))]
+    pub rhat: f64,
+    /// Stop sampling after this many seconds even if the targets are not reached.
+    #[cfg_attr(feature = "clap", arg(long, default_value_t = 300.0))]
+    pub max_seconds: f64,
+    /// Known parameter values (TOML NAME = VALUE) to mark on the figures and check against the
+    /// smallest intervals, e.g. data/super-siegfried-k1/truth-b-rz.toml.
+    #[cfg_attr(feature = "clap", arg(long, value_name = "FILE"))]
+    pub truth: Option<PathBuf>,
+    /// Write no figures.
+    #[cfg_attr(feature = "clap", arg(long))]
+    pub no_plots: bool,
+    /// Nelder-Mead starts of the mode search before sampling (0: none).
+    #[cfg_attr(feature = "clap", arg(long, default_value_t = 24))]
+    pub mode_starts: usize,
+    /// The exact solver's grid and accuracy.
+    #[cfg_attr(feature = "clap", command(flatten))]
+    pub grid: GridOverrides,
+}
+
+impl Default for FitOptions {
+    /// The shipped defaults (the same as the command line's).
+    fn default() -> Self {
+        Self {
+            data: DEFAULT_DATA.into(),
+            model: DEFAULT_MODEL.into(),
+            prior: DEFAULT_PRIOR.into(),
+            detector: DEFAULT_DETECTOR.into(),
+            out: None,
+            sampler: "metropolis".into(),
+            seed: 0,
+            no_exact_check: false,
+            exact_draws: 100,
+            likelihood: "paper".into(),
+            chains: 4,
+            ess: 1000.0,
+            rhat: 1.01,
+            max_seconds: 300.0,
+            truth: None,
+            no_plots: false,
+            mode_starts: 24,
+            grid: GridOverrides::default(),
+        }
+    }
+}
+
+impl FitOptions {
+    /// The four input files.
+    pub fn files(&self) -> FitFiles {
+        FitFiles {
+            data: self.data.clone(),
+            model: self.model.clone(),
+            prior: self.prior.clone(),
+            detector: self.detector.clone(),
+        }
+    }
+
+    /// The output folder: `out`, else `fits/<prior file stem>`.
+    pub fn out_dir(&self) -> PathBuf {
+        self.out.clone().unwrap_or_else(|| {
+            let stem = self
+                .prior
+                .file_stem()
+                .map_or("fit".into(), |s| s.to_string_lossy().to_string());
+            PathBuf::from("fits").join(stem)
+        })
+    }
+
+    /// The sampler named by `sampler`.
+    ///
+    /// # Errors
+    /// [`Error::BadOption`] for an unknown name.
+    pub fn sampler_kind(&self) -> Result<SamplerKind> {
+        sampler_kind(&self.sampler)
+    }
+
+    /// The paper's noise constants with the likelihood named by `likelihood`.
+    ///
+    /// # Errors
+    /// [`Error::BadOption`] for an unknown name.
+    pub fn noise(&self) -> Result<NoiseSettings> {
+        noise_settings(&self.likelihood)
+    }
+
+    /// The fit's settings: the sampler's defaults with these targets, checked.
+    ///
+    /// # Errors
+    /// An unknown sampler or likelihood, or targets [`SampleSettings::validate`] refuses.
+    pub fn settings(&self) -> Result<FitSettings> {
+        let mut sample = SampleSettings::for_sampler(self.sampler_kind()?);
+        sample.seed = self.seed;
+        sample.chains = self.chains;
+        sample.ess_min = self.ess;
+        sample.rhat_max = self.rhat;
+        sample.max_seconds = self.max_seconds;
+        sample.mode_starts = self.mode_starts;
+        sample.validate()?;
+        Ok(FitSettings {
+            sample,
+            noise: self.noise()?,
+            ..FitSettings::default()
+        })
+    }
+}
+
+/// The sampler of a name (`metropolis`, `nuts`).
+///
+/// # Errors
+/// [`Error::BadOption`] naming `--sampler` for an unknown name.
+pub fn sampler_kind(name: &str) -> Result<SamplerKind> {
+    SamplerKind::parse(name).ok_or_else(|| Error::BadOption {
+        option: format!("--sampler {name}"),
+        message: "unknown sampler; use metropolis or nuts".into(),
+    })
+}
+
+/// The paper's noise constants with the likelihood of a name (`paper`, `covariance`).
+///
+/// # Errors
+/// [`Error::BadOption`] naming `--likelihood` for an unknown name.
+pub fn noise_settings(likelihood: &str) -> Result<NoiseSettings> {
+    let kind = NoiseKind::parse(likelihood).ok_or_else(|| Error::BadOption {
+        option: format!("--likelihood {likelihood}"),
+        message: "use paper or covariance".into(),
+    })?;
+    Ok(NoiseSettings {
+        kind,
+        ..Default::default()
+    })
+}

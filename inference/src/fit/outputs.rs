@@ -1,0 +1,121 @@
+//! The tables a fit writes beside its summary: `samples.csv` (every draw), `predictive.csv`
+//! (c_p - c_m bands per voltage), `zeta-mode.csv` (the profiles at the global mode) and
+//! `summary.json`; each CSV starts with one `#` line naming the program version and the inputs.
+
+use std::io::Write as _;
+use std::path::Path;
+
+use super::Fit;
+use super::job::FitFiles;
+use super::truth::TruthRecord;
+use super::zeta::ZetaAtMode;
+use crate::{Error, Result};
+
+/// The `#` line that heads every table of a fit: program version, inputs, sampler, seed and
+/// likelihood.
+pub fn output_header(files: &FitFiles, sampler: &str, seed: u64, likelihood: &str) -> String {
+    format!(
+        "# hpge-cv {} fit: data {} model {} prior {} detector {} sampler {} seed {} likelihood {}",
+        env!("CARGO_PKG_VERSION"),
+        files.data.display(),
+        files.model.display(),
+        files.prior.display(),
+        files.detector.display(),
+        sampler,
+        seed,
+        likelihood
+    )
+}
+
+/// Writes `lines` (already newline-terminated) to `path`.
+fn write_text(path: &Path, text: &str) -> Result<()> {
+    let mut f = std::fs::File::create(path).map_err(|source| Error::Io {
+        file: path.to_path_buf(),
+        action: "cannot create the file",
+        source,
+    })?;
+    f.write_all(text.as_bytes()).map_err(|source| Error::Io {
+        file: path.to_path_buf(),
+        action: "cannot write the file",
+        source,
+    })
+}
+
+/// `samples.csv`: `chain,draw,<parameters>,ln_posterior`, one row per draw.
+pub fn write_samples(path: &Path, header: &str, fit: &Fit) -> Result<()> {
+    let mut w = String::new();
+    w.push_str(&format!("{header}\n"));
+    w.push_str(&format!(
+        "chain,draw,{},ln_posterior\n",
+        fit.samples.names.join(",")
+    ));
+    for (c, ch) in fit.samples.chains.iter().enumerate() {
+        for (i, (t, l)) in ch.theta.iter().zip(&ch.ln_posterior).enumerate() {
+            let vals: Vec<String> = t.iter().map(|v| format!("{v}")).collect();
+            w.push_str(&format!("{c},{i},{},{l}\n", vals.join(",")));
+        }
+    }
+    write_text(path, &w)
+}
+
+/// `predictive.csv`: per voltage the data, the curve at the global mode, sigma, the pull at the
+/// mode and the median and 68.3/95.5/99.7% bands of c_p - c_m over the posterior.
+pub fn write_predictive(path: &Path, header: &str, fit: &Fit) -> Result<()> {
+    let p = &fit.predictive;
+    let mut w = format!("{header}\n");
+    w.push_str(
+        "voltage_V,c_m_pF,c_mode_pF,sigma_pF,pull_at_mode,diff_median_pF,diff_lo683_pF,diff_hi683_pF,diff_lo955_pF,diff_hi955_pF,diff_lo997_pF,diff_hi997_pF\n",
+    );
+    for k in 0..p.voltage_v.len() {
+        let b: Vec<String> = p.bands_pf[k]
+            .iter()
+            .flat_map(|[a, c]| [format!("{a}"), format!("{c}")])
+            .collect();
+        w.push_str(&format!(
+            "{},{},{},{},{},{},{}\n",
+            p.voltage_v[k],
+            p.c_m_pf[k],
+            p.c_mode_pf[k],
+            p.sigma_pf[k],
+            (p.c_mode_pf[k] - p.c_m_pf[k]) / p.sigma_pf[k],
+            p.median_pf[k],
+            b.join(",")
+        ));
+    }
+    write_text(path, &w)
+}
+
+/// `zeta-mode.csv`: `profile,label,coordinate_mm,zeta_cm3` (profiles `along_z`, `along_r`).
+pub fn write_zeta(path: &Path, header: &str, zeta: &ZetaAtMode) -> Result<()> {
+    let mut w = format!("{header}\nprofile,label,coordinate_mm,zeta_cm3\n");
+    for (kind, list) in [("along_z", &zeta.along_z), ("along_r", &zeta.along_r)] {
+        for prof in list {
+            for (x, v) in prof.x_mm.iter().zip(&prof.zeta_cm3) {
+                w.push_str(&format!("{kind},{},{x},{v}\n", prof.label));
+            }
+        }
+    }
+    write_text(path, &w)
+}
+
+/// The summary as JSON, with the truth records (`truth`) where a truth was given.
+pub fn summary_json(fit: &Fit, truth: Option<&[TruthRecord]>) -> Result<serde_json::Value> {
+    let to_value = |e: serde_json::Error| Error::Numerical {
+        what: "the summary as JSON".into(),
+        message: e.to_string(),
+    };
+    let mut json = serde_json::to_value(&fit.summary).map_err(to_value)?;
+    if let (Some(t), Some(obj)) = (truth, json.as_object_mut()) {
+        obj.insert("truth".into(), serde_json::to_value(t).map_err(to_value)?);
+    }
+    Ok(json)
+}
+
+/// Writes `summary.json` (pretty, newline-terminated).
+pub fn write_summary(path: &Path, json: &serde_json::Value) -> Result<()> {
+    let text = serde_json::to_string_pretty(json).map_err(|e| Error::Numerical {
+        what: "the summary as JSON".into(),
+        message: e.to_string(),
+    })?;
+    write_text(path, &(text + "\n"))
+}
