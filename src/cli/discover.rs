@@ -22,7 +22,7 @@ pub struct DiscoverArgs {
     #[arg(
         long,
         value_name = "FILE",
-        default_value = "data/super-siegfried-k1/cv.csv"
+        default_value = hpge_inference::fit::DEFAULT_DATA
     )]
     pub data: PathBuf,
     /// The detector the data were measured with (checked against the model's; the exact solver
@@ -30,7 +30,7 @@ pub struct DiscoverArgs {
     #[arg(
         long,
         value_name = "FILE",
-        default_value = "detectors/super-siegfried-k1.toml"
+        default_value = hpge_inference::fit::DEFAULT_DETECTOR
     )]
     pub detector: PathBuf,
     /// The start model: a prior file, or the name of one in priors/ (b-z: the paper's B_Z).
@@ -40,7 +40,7 @@ pub struct DiscoverArgs {
     #[arg(
         long,
         value_name = "FILE",
-        default_value = "models/super-siegfried-rz-split.safetensors"
+        default_value = hpge_inference::fit::DEFAULT_MODEL
     )]
     pub model: PathBuf,
     /// Output folder [default: discoveries/<start model>].

@@ -123,7 +123,7 @@ struct CoverageArgs {
     #[arg(long)]
     json: bool,
     /// The prior (truths are drawn from it).
-    #[arg(long, value_name = "FILE", default_value = "priors/b-rz.toml")]
+    #[arg(long, value_name = "FILE", default_value = hpge_inference::fit::DEFAULT_PRIOR)]
     prior: PathBuf,
     /// The surrogate that is fitted.
     #[arg(long, value_name = "FILE", default_value = DEFAULT_MODEL)]
@@ -132,14 +132,14 @@ struct CoverageArgs {
     #[arg(
         long,
         value_name = "FILE",
-        default_value = "data/super-siegfried-k1/cv.csv"
+        default_value = hpge_inference::fit::DEFAULT_DATA
     )]
     data: PathBuf,
     /// The detector (for --exact and the model check).
     #[arg(
         long,
         value_name = "FILE",
-        default_value = "detectors/super-siegfried-k1.toml"
+        default_value = hpge_inference::fit::DEFAULT_DETECTOR
     )]
     detector: PathBuf,
     /// Simulate the data with the exact field solver instead of the surrogate (what surrogate

@@ -42,14 +42,14 @@ pub struct DiscoveryArgs {
     #[arg(
         long,
         value_name = "FILE",
-        default_value = "models/super-siegfried-rz-split.safetensors"
+        default_value = hpge_inference::fit::DEFAULT_MODEL
     )]
     pub model: PathBuf,
     /// The detector.
     #[arg(
         long,
         value_name = "FILE",
-        default_value = "detectors/super-siegfried-k1.toml"
+        default_value = hpge_inference::fit::DEFAULT_DETECTOR
     )]
     pub detector: PathBuf,
     /// The start model's prior.
@@ -59,7 +59,7 @@ pub struct DiscoveryArgs {
     #[arg(
         long,
         value_name = "FILE",
-        default_value = "data/super-siegfried-k1/cv.csv"
+        default_value = hpge_inference::fit::DEFAULT_DATA
     )]
     pub data: PathBuf,
     /// Print the summary as JSON on stdout.

@@ -1,0 +1,122 @@
+//! The fit's application layer at the library level: a job set up from the shipped files, and
+//! the inputs it refuses (the same cases the command's end-to-end test feeds the binary).
+
+use std::path::{Path, PathBuf};
+
+use hpge_inference::fit::{FitJob, FitOptions, read_truth, sampler_kind};
+use hpge_inference::{CvModel, Error};
+
+fn repo(p: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join(p)
+}
+
+fn temp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("hpge-fit-job-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn shipped(prior: &str) -> FitOptions {
+    FitOptions {
+        data: repo(hpge_inference::fit::DEFAULT_DATA),
+        model: repo(hpge_inference::fit::DEFAULT_MODEL),
+        prior: repo(prior),
+        detector: repo(hpge_inference::fit::DEFAULT_DETECTOR),
+        ..FitOptions::default()
+    }
+}
+
+#[test]
+fn shipped_files_make_a_job_with_hashed_inputs() {
+    let o = shipped("priors/b-z.toml");
+    let job = FitJob::from_files(&o.files(), o.noise().unwrap(), &o.grid).unwrap();
+    assert_eq!(job.prior.dim(), 3);
+    assert_eq!(job.surrogate.voltages().len(), job.data.voltage_v.len());
+    assert!(job.warnings.is_empty());
+    for key in ["data_hash", "model_hash", "prior_hash", "detector_hash"] {
+        let h = &job.inputs[key];
+        assert_eq!(h.len(), 16, "{key} = {h}");
+    }
+    // The posterior is finite at the prior's centre of the bound parameters.
+    let posterior = job.posterior().unwrap();
+    let theta: Vec<f64> = job
+        .prior
+        .parameters
+        .iter()
+        .map(|p| 0.5 * (p.support[0] + p.support[1]))
+        .collect();
+    assert!(posterior.evaluate(&theta).unwrap().ln_posterior.is_finite());
+    // The options' settings carry the sampler's defaults with the targets.
+    let s = o.settings().unwrap();
+    assert_eq!(s.sample.chains, 4);
+    assert_eq!(s.sample.max_seconds, 300.0);
+    assert_eq!(o.out_dir(), PathBuf::from("fits/b-z"));
+}
+
+#[test]
+fn a_model_for_another_detector_is_refused() {
+    let d = temp("det");
+    let det = d.join("other-detector.toml");
+    let text = std::fs::read_to_string(repo(hpge_inference::fit::DEFAULT_DETECTOR)).unwrap();
+    std::fs::write(&det, text + "\n# another detector\n").unwrap();
+    let o = FitOptions {
+        detector: det,
+        ..shipped("priors/b-z.toml")
+    };
+    let err = FitJob::from_files(&o.files(), o.noise().unwrap(), &o.grid)
+        .err()
+        .unwrap();
+    assert!(matches!(err, Error::DetectorMismatch { .. }), "{err}");
+    let msg = err.to_string();
+    assert!(msg.contains("trained for the detector") && msg.contains("other-detector.toml"));
+}
+
+#[test]
+fn bad_names_and_files_are_named() {
+    let e = sampler_kind("gibbs").unwrap_err().to_string();
+    assert!(e.contains("--sampler gibbs"), "{e}");
+    let o = FitOptions {
+        likelihood: "student".into(),
+        ..shipped("priors/b-z.toml")
+    };
+    assert!(o.noise().unwrap_err().to_string().contains("student"));
+    let o = FitOptions {
+        data: "nope.csv".into(),
+        ..shipped("priors/b-z.toml")
+    };
+    let e = FitJob::from_files(&o.files(), o.noise().unwrap(), &o.grid)
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(e.contains("nope.csv"), "{e}");
+    // Fewer voltages than parameters.
+    let d = temp("short");
+    let data = d.join("short.csv");
+    std::fs::write(&data, "voltage_V,c12_pF,sigma_pF\n500,130,4\n2000,43,1.3\n").unwrap();
+    let o = FitOptions {
+        data,
+        ..shipped("priors/b-z.toml")
+    };
+    let e = FitJob::from_files(&o.files(), o.noise().unwrap(), &o.grid)
+        .and_then(|j| j.posterior().map(|_| ()))
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
+    assert!(e.contains("2 voltages") && e.contains("3 parameters"), "{e}");
+}
+
+#[test]
+fn truth_files_map_to_the_prior_order() {
+    let o = shipped("priors/b-z.toml");
+    let job = FitJob::from_files(&o.files(), o.noise().unwrap(), &o.grid).unwrap();
+    let d = temp("truth");
+    let t = d.join("truth.toml");
+    std::fs::write(&t, "y_top = 0.5\nunknown = 3\n").unwrap();
+    let v = read_truth(&t, &job.prior).unwrap();
+    let names = job.prior.names();
+    for (n, x) in names.iter().zip(&v) {
+        assert_eq!(x.is_some(), n == "y_top", "{n}");
+    }
+    std::fs::write(&t, "y_top = \"high\"\n").unwrap();
+    assert!(read_truth(&t, &job.prior).is_err());
+}
