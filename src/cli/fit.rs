@@ -6,10 +6,10 @@ use std::path::Path;
 
 use anyhow::{Context, Result, bail};
 use hpge_inference::{
-    CvData, CvModel, Data, ExactModel, Fit, FitSettings, Likelihood, NoiseKind, Posterior, Prior,
-    PriorSpec, SampleSettings, SamplerKind, Status, SurrogateModel, exact_check, fit,
-    interval_contains, load_data,
+    CvModel, ExactModel, Fit, FitSettings, Likelihood, NoiseKind, Posterior, Prior, PriorSpec,
+    SampleSettings, SamplerKind, Status, SurrogateModel, exact_check, fit, interval_contains,
 };
+use hpge_measurement::{CvData, Data, load_data};
 use hpge_surrogate::{ExactSolver, Surrogate, fnv1a};
 use indicatif::{ProgressBar, ProgressStyle};
 
