@@ -8,9 +8,10 @@ use std::hint::black_box;
 
 use criterion::Criterion;
 use hpge_inference::{
-    CvModel, Data, FitSettings, Likelihood, NoiseKind, NoiseSettings, Posterior, Prior, PriorSpec,
-    SampleSettings, SamplerKind, SurrogateModel, fit, load_data,
+    CvModel, FitSettings, Likelihood, NoiseKind, NoiseSettings, Posterior, Prior, PriorSpec,
+    SampleSettings, SamplerKind, SurrogateModel, fit,
 };
+use hpge_measurement::{Data, load_data};
 use hpge_surrogate::Surrogate;
 use hpge_validation::repo_path;
 

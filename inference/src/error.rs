@@ -56,6 +56,9 @@ pub enum Error {
         /// What is wrong with it.
         message: String,
     },
+    /// Reading a measured curve failed.
+    #[error(transparent)]
+    Measurement(#[from] hpge_measurement::Error),
     /// The solver failed outside a model evaluation (reading a detector, the profiles at a mode).
     #[error(transparent)]
     Solver(#[from] hpge_solver::Error),

@@ -1,16 +1,16 @@
 //! # hpge-inference
 //!
-//! The statistics side of hpge-cv (paper, sections 4 and 8): measured data (raw pulser data to a
-//! C-V curve with its covariance), priors, the likelihood with parameter-dependent uncertainties,
-//! samplers and their diagnostics, posterior summaries and predictive checks, and the
-//! model-discovery workflow. It sees a model only through one narrow trait, implemented by both
-//! the exact solver and the surrogate. Filled in by the measurement and inference issues.
+//! The statistics side of hpge-cv (paper, sections 4 and 8): priors, the likelihood with
+//! parameter-dependent uncertainties, samplers and their diagnostics, posterior summaries and
+//! predictive checks, and the model-discovery workflow. It sees a model only through one narrow
+//! trait, implemented by both the exact solver and the surrogate, and the measured curve only as
+//! a [`CvData`] (from the measurement crate, hpge-measurement, which turns raw pulser data into
+//! a C-V curve with its covariance). Filled in by the measurement and inference issues.
 
 mod diagnostics;
 mod discover;
 mod error;
 pub mod fit;
-mod measurement;
 mod model;
 mod posterior;
 mod prior;
@@ -33,13 +33,7 @@ pub use fit::{
     ParameterShift, ParameterSummary, Predictive, TruthRecord, ZetaAtMode, ZetaProfile, draw_range,
     exact_check, fit, nelder_mead, predictive,
 };
-pub use measurement::{
-    Circuit, CvData, Data, MeasureSettings, Measurement, PC_PER_KEV, PeakFit, Problem, PulseSet,
-    RawProblem, RawRun, Sidecar, SynthSettings, SynthVoltage, TailFailure, TailFit, TailSettings,
-    Uncertainties, VoltagePoint, depletion_voltage, fit_peak, fit_tail, load_data, measure,
-    measure_voltage, negative_slopes, read_curve, read_pulses, read_raw_dir, synthesize_voltage,
-    voltage_seed, write_curve, write_curve_with_comments, write_pulses,
-};
+pub use hpge_measurement::CvData;
 pub use model::{CvModel, ExactModel, SurrogateModel};
 pub use posterior::{Cholesky, Evaluation, Likelihood, NoiseKind, NoiseSettings, Posterior};
 pub use prior::{ParameterSpec, Prior, PriorDistribution, PriorParameter, PriorSpec};

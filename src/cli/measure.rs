@@ -4,9 +4,10 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
-use hpge_inference::{
+use hpge_measurement::synth::voltage_seed;
+use hpge_measurement::{
     MeasureSettings, Measurement, PulseSet, RawProblem, SynthSettings, depletion_voltage, measure,
-    read_raw_dir, synthesize_voltage, voltage_seed, write_curve_with_comments, write_pulses,
+    read_raw_dir, synthesize_voltage, write_curve_with_comments, write_pulses,
 };
 use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::json;

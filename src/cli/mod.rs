@@ -695,7 +695,7 @@ pub fn run(cli: Cli) -> Result<()> {
             json: a.json,
         }),
         Command::Synthesize(a) => {
-            let mut settings = hpge_inference::SynthSettings::default();
+            let mut settings = hpge_measurement::SynthSettings::default();
             if let Some(n) = a.pulses {
                 settings.pulser_pulses = n;
             }

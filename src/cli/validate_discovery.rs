@@ -10,8 +10,8 @@ use std::sync::Arc;
 use anyhow::{Context, Result};
 use hpge_inference::{
     CvModel, DiscoverSettings, FitSettings, PriorSpec, SampleSettings, SamplerKind,
-    write_curve_with_comments,
 };
+use hpge_measurement::write_curve_with_comments;
 use hpge_validation::{HiddenOutcome, hidden_effects, run_hidden, simulate_hidden};
 use serde::Serialize;
 

@@ -5,7 +5,9 @@
 use std::path::Path;
 
 use anyhow::Result;
-use hpge_inference::{Measurement, PulseSet, VoltagePoint, negative_slopes};
+use hpge_measurement::slope::negative_slopes;
+use hpge_measurement::synth::PC_PER_KEV;
+use hpge_measurement::{Measurement, PulseSet, VoltagePoint};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
@@ -191,7 +193,7 @@ fn spectra<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, m: &Measurement) -
             }))
             .map_err(err)?;
     }
-    let tl = 2614.5 * hpge_inference::PC_PER_KEV;
+    let tl = 2614.5 * PC_PER_KEV;
     chart
         .draw_series(LineSeries::new([(tl, ylo), (tl, yhi)], RED.mix(0.6)))
         .map_err(err)?

@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use anyhow::{Result, bail};
-use hpge_inference::{Data, load_data};
+use hpge_measurement::{Data, load_data};
 use hpge_solver::{CvCurve, Detector, FieldSettings, Parameters, cv_curve};
 use plotters::coord::Shift;
 use plotters::prelude::*;

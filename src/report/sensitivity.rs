@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use anyhow::{Context, Result, bail};
-use hpge_inference::{Data, load_data};
+use hpge_measurement::{Data, load_data};
 use hpge_solver::{Detector, FieldSettings, ImpuritySpec, Parameters, solve_point};
 use serde_json::json;
 

@@ -3,7 +3,8 @@
 
 use std::time::Instant;
 
-use hpge_inference::{PriorSpec, read_curve};
+use hpge_inference::PriorSpec;
+use hpge_measurement::read_curve;
 use hpge_solver::FieldSettings;
 use hpge_surrogate::{ExactSolver, Surrogate};
 use hpge_validation::{hidden_curve, hidden_effects, repo_path};

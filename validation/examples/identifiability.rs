@@ -9,9 +9,10 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use hpge_inference::{
-    CvData, CvModel, ExactModel, LaplaceSettings, Likelihood, NoiseSettings, Posterior, Prior,
-    PriorSpec, laplace_fit, read_curve,
+    CvModel, ExactModel, LaplaceSettings, Likelihood, NoiseSettings, Posterior, Prior, PriorSpec,
+    laplace_fit,
 };
+use hpge_measurement::{CvData, read_curve};
 use hpge_solver::FieldSettings;
 use hpge_surrogate::{ExactSolver, Surrogate};
 use hpge_validation::{BASE_TRUTH, HiddenEffect, hidden_curve, repo_path};

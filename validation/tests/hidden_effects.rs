@@ -11,8 +11,9 @@ use std::sync::Arc;
 
 use hpge_inference::{
     CvModel, DiscoverSettings, FitSettings, PriorSpec, Progress, SampleSettings, SamplerKind,
-    Status, SurrogateModel, read_curve,
+    Status, SurrogateModel,
 };
+use hpge_measurement::read_curve;
 use hpge_solver::FieldSettings;
 use hpge_surrogate::{ExactSolver, Surrogate};
 use hpge_validation::{hidden_effects, repo_path, run_hidden, simulate_hidden};

@@ -11,7 +11,7 @@ use hpge_surrogate::{ExactSolver, Surrogate, fnv1a};
 use super::exact_check::exact_check;
 use super::run::{Fit, FitSettings, fit};
 use super::zeta::{ZetaAtMode, zeta_at_mode};
-use crate::measurement::{CvData, Data, load_data};
+use hpge_measurement::{CvData, Data, load_data};
 use crate::model::{CvModel, ExactModel, SurrogateModel};
 use crate::posterior::{Likelihood, NoiseSettings, Posterior};
 use crate::prior::{Prior, PriorSpec};

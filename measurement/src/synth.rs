@@ -88,8 +88,8 @@ impl Default for SynthSettings {
 }
 
 impl SynthSettings {
-    /// Checks ranges (the message names the key).
-    pub fn validate(&self) -> std::result::Result<(), String> {
+    /// Checks ranges ([`Error::Setting`] names the key).
+    pub fn validate(&self) -> Result<()> {
         for (k, v) in [
             ("sampling_period_ns", self.sampling_period_ns),
             ("trace_ns", self.trace_ns),
@@ -99,7 +99,7 @@ impl SynthSettings {
             ("slow_tau_ns", self.slow_tau_ns),
         ] {
             if !(v.is_finite() && v > 0.0) {
-                return Err(format!("{k} must be positive, got {v}"));
+                return Err(Error::setting(k, format!("must be positive, got {v}")));
             }
         }
         for (k, v) in [
@@ -109,20 +109,23 @@ impl SynthSettings {
             ("jitter_pc", self.jitter_pc),
         ] {
             if !(v.is_finite() && v >= 0.0) {
-                return Err(format!("{k} must be >= 0, got {v}"));
+                return Err(Error::setting(k, format!("must be >= 0, got {v}")));
             }
         }
         if !(0.0..1.0).contains(&self.slow_fraction) {
-            return Err(format!(
-                "slow_fraction must lie in [0, 1), got {}",
-                self.slow_fraction
+            return Err(Error::setting(
+                "slow_fraction",
+                format!("must lie in [0, 1), got {}", self.slow_fraction),
             ));
         }
         if self.pulser_pulses < 10 || self.decimate == 0 {
-            return Err("pulser_pulses must be >= 10 and decimate >= 1".into());
+            return Err(Error::setting(
+                "pulser_pulses",
+                "must be >= 10 and decimate >= 1",
+            ));
         }
         if self.edge_ns >= self.trace_ns {
-            return Err("edge_ns must lie inside the trace".into());
+            return Err(Error::setting("edge_ns", "must lie inside the trace"));
         }
         self.circuit.validate()
     }
@@ -173,9 +176,9 @@ pub fn synthesize_voltage(
     s: &SynthSettings,
     seed: u64,
 ) -> Result<SynthVoltage> {
-    s.validate().map_err(|m| Error::Argument {
+    s.validate().map_err(|e| Error::Argument {
         name: "synth settings".into(),
-        message: m,
+        message: e.to_string(),
     })?;
     if !(c12_pf.is_finite() && c12_pf > 0.0 && bias_v.is_finite() && depletion_v > 0.0) {
         return Err(Error::Argument {

@@ -4,9 +4,11 @@
 
 use std::path::Path;
 
-use hpge_inference::{
-    Circuit, MeasureSettings, SynthSettings, TailSettings, depletion_voltage, fit_tail, measure,
-    synthesize_voltage, voltage_seed,
+use hpge_measurement::circuit::Circuit;
+use hpge_measurement::synth::voltage_seed;
+use hpge_measurement::tail::{TailSettings, fit_tail};
+use hpge_measurement::{
+    MeasureSettings, SynthSettings, depletion_voltage, measure, synthesize_voltage,
 };
 
 /// A Super-Siegfried-like truth: c12 falls from ~980 pF and flattens at 38 pF from 2600 V.
@@ -174,14 +176,14 @@ fn one_bad_voltage_leaves_the_others() {
 #[test]
 fn shipped_curve_loads_with_its_covariance() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../data/super-siegfried-k1/cv.csv");
-    let hpge_inference::Data::Curve(c) = hpge_inference::load_data(&path).unwrap() else {
+    let hpge_measurement::Data::Curve(c) = hpge_measurement::load_data(&path).unwrap() else {
         panic!("a .csv is a curve");
     };
     assert_eq!(c.voltage_v.len(), 60);
     let cov = c.covariance_pf2.expect("the sibling covariance is found");
     assert_eq!(cov.len(), 60);
     let raw = Path::new(env!("CARGO_MANIFEST_DIR")).join("../data/super-siegfried-k1/raw");
-    let hpge_inference::Data::Raw(run) = hpge_inference::load_data(&raw).unwrap() else {
+    let hpge_measurement::Data::Raw(run) = hpge_measurement::load_data(&raw).unwrap() else {
         panic!("a directory is a raw run");
     };
     assert_eq!(run.sets.len(), 60);

@@ -2,9 +2,11 @@
 
 use std::path::{Path, PathBuf};
 
-use super::{MEASUREMENT_FILE, VOLTAGE_TOLERANCE_V, read_pulses, sidecar};
+use super::files::{MEASUREMENT_FILE, VOLTAGE_TOLERANCE_V};
+use super::npy::read_pulses;
+use super::sidecar;
 use crate::error::{Error, Result};
-use crate::measurement::PulseSet;
+use crate::types::PulseSet;
 
 /// The pulse files of a raw-data directory, read as far as possible.
 #[derive(Debug, Clone)]

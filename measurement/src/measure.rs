@@ -46,21 +46,21 @@ impl Default for MeasureSettings {
 }
 
 impl MeasureSettings {
-    /// Checks every field (the message names the key).
-    pub fn validate(&self) -> std::result::Result<(), String> {
+    /// Checks every field ([`Error::Setting`] names the key).
+    pub fn validate(&self) -> Result<()> {
         self.circuit.validate()?;
         self.uncertainties.validate()?;
         self.tail.validate()?;
         if !(self.depletion_slope_pf_per_v.is_finite() && self.depletion_slope_pf_per_v > 0.0) {
-            return Err(format!(
-                "depletion_slope_pF_per_V must be positive, got {}",
-                self.depletion_slope_pf_per_v
+            return Err(Error::setting(
+                "depletion_slope_pF_per_V",
+                format!("must be positive, got {}", self.depletion_slope_pf_per_v),
             ));
         }
         if let Some(v) = &self.voltages_v
             && v.iter().any(|x| !x.is_finite())
         {
-            return Err("voltages_V must be finite numbers".into());
+            return Err(Error::setting("voltages_V", "must be finite numbers"));
         }
         Ok(())
     }
@@ -74,8 +74,13 @@ impl MeasureSettings {
         })?;
         let s: Self = toml::from_str(&text)
             .map_err(|e| Error::format(path, e.to_string().trim_end().to_string()))?;
-        s.validate()
-            .map_err(|m| Error::invalid(path, m.split(' ').next().unwrap_or(""), m.clone()))?;
+        s.validate().map_err(|e| match e {
+            Error::Setting { key, message } => {
+                let message = format!("{key} {message}");
+                Error::invalid(path, key, message)
+            }
+            other => other,
+        })?;
         Ok(s)
     }
 }
@@ -181,9 +186,9 @@ pub fn measure_voltage(set: &PulseSet, s: &MeasureSettings) -> Result<VoltagePoi
 /// Measures every bias (in parallel); a bias that fails becomes a [`Problem`], the others
 /// points. Errors only when no bias gives a point. `source` names the run for the curve.
 pub fn measure(sets: &[PulseSet], s: &MeasureSettings, source: &Path) -> Result<Measurement> {
-    s.validate().map_err(|m| Error::Argument {
+    s.validate().map_err(|e| Error::Argument {
         name: "measurement settings".into(),
-        message: m,
+        message: e.to_string(),
     })?;
     let results: Vec<Result<VoltagePoint>> =
         sets.par_iter().map(|set| measure_voltage(set, s)).collect();

@@ -13,6 +13,7 @@
 //! Every error names the file and, where it applies, the key, column, line or pulse at fault.
 
 mod curve;
+mod files;
 mod npy;
 mod raw_dir;
 mod sidecar;
@@ -23,14 +24,10 @@ pub use curve::{read_curve, write_curve, write_curve_with_comments};
 pub use npy::{read_pulses, write_pulses};
 pub use raw_dir::{RawProblem, RawRun, read_raw_dir};
 
+use files::{MEASUREMENT_FILE, read_text, toml_message};
+
 use crate::error::{Error, Result};
-use crate::measurement::CvData;
-
-/// Name of the run's settings file inside a raw-data directory; it is not a sidecar.
-pub(crate) const MEASUREMENT_FILE: &str = "measurement.toml";
-
-/// Tolerance when matching two bias voltages, V.
-pub(crate) const VOLTAGE_TOLERANCE_V: f64 = 1e-6;
+use crate::types::CvData;
 
 /// Either kind of measured input, as found by [`load_data`].
 #[derive(Debug, Clone)]
@@ -114,37 +111,4 @@ fn expected_voltages(file: &Path) -> Result<Option<Vec<f64>>> {
         })
         .collect::<Result<Vec<f64>>>()
         .map(Some)
-}
-
-/// Reads a text file, naming it in the error.
-pub(crate) fn read_text(file: &Path) -> Result<String> {
-    std::fs::read_to_string(file).map_err(|source| Error::Io {
-        file: file.to_path_buf(),
-        action: "cannot read the file",
-        source,
-    })
-}
-
-/// Writes a file, naming it in the error.
-pub(crate) fn write_file(file: &Path, contents: &[u8]) -> Result<()> {
-    std::fs::write(file, contents).map_err(|source| Error::Io {
-        file: file.to_path_buf(),
-        action: "cannot write the file",
-        source,
-    })
-}
-
-/// A TOML parse error as one line: "line L, column C: message".
-pub(crate) fn toml_message(text: &str, err: &toml::de::Error) -> String {
-    let message = err.message().trim();
-    match err.span() {
-        Some(span) => {
-            let start = span.start.min(text.len());
-            let before = text.get(..start).unwrap_or("");
-            let line = before.matches('\n').count() + 1;
-            let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
-            format!("line {line}, column {column}: {message}")
-        }
-        None => message.to_string(),
-    }
 }

@@ -6,7 +6,7 @@ use std::fmt::Debug;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-use hpge_inference::{
+use hpge_measurement::{
     CvData, Data, PulseSet, load_data, read_curve, read_pulses, read_raw_dir, write_curve,
     write_curve_with_comments, write_pulses,
 };
@@ -49,7 +49,7 @@ fn temp_dir(name: &str) -> TempDir {
 
 /// The error message of a result that must be an error naming `file` and every one of `needles`.
 fn expect_err<T: Debug>(
-    result: hpge_inference::Result<T>,
+    result: hpge_measurement::Result<T>,
     file: &Path,
     needles: &[&str],
 ) -> String {

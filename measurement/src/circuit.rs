@@ -3,6 +3,8 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::{Error, Result};
+
 /// The pulser circuit: a rectangular pulse of amplitude U_PG from a generator with internal
 /// resistance R_PG, through R1 onto the p+ contact terminated by R2 to ground.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -45,8 +47,8 @@ impl Circuit {
         c12_pf * self.injected_v()
     }
 
-    /// Checks that every value is finite and positive (the message names the key).
-    pub fn validate(&self) -> Result<(), String> {
+    /// Checks that every value is finite and positive ([`Error::Setting`] names the key).
+    pub fn validate(&self) -> Result<()> {
         for (k, v) in [
             ("r_pg_ohm", self.r_pg_ohm),
             ("r1_ohm", self.r1_ohm),
@@ -54,7 +56,10 @@ impl Circuit {
             ("u_pg_mv", self.u_pg_mv),
         ] {
             if !(v.is_finite() && v > 0.0) {
-                return Err(format!("circuit.{k} must be a positive number, got {v}"));
+                return Err(Error::setting(
+                    format!("circuit.{k}"),
+                    format!("must be a positive number, got {v}"),
+                ));
             }
         }
         Ok(())
@@ -95,8 +100,8 @@ impl Default for Uncertainties {
 }
 
 impl Uncertainties {
-    /// Checks ranges (the message names the key).
-    pub fn validate(&self) -> Result<(), String> {
+    /// Checks ranges ([`Error::Setting`] names the key).
+    pub fn validate(&self) -> Result<()> {
         for (k, v) in [
             ("q_rel", self.q_rel),
             ("r_pg_rel", self.r_pg_rel),
@@ -105,13 +110,16 @@ impl Uncertainties {
             ("u_pg_rel", self.u_pg_rel),
         ] {
             if !(v.is_finite() && v >= 0.0) {
-                return Err(format!("uncertainties.{k} must be >= 0, got {v}"));
+                return Err(Error::setting(
+                    format!("uncertainties.{k}"),
+                    format!("must be >= 0, got {v}"),
+                ));
             }
         }
         if !(0.0..=1.0).contains(&self.q_correlation) {
-            return Err(format!(
-                "uncertainties.q_correlation must lie in [0, 1], got {}",
-                self.q_correlation
+            return Err(Error::setting(
+                "uncertainties.q_correlation",
+                format!("must lie in [0, 1], got {}", self.q_correlation),
             ));
         }
         Ok(())

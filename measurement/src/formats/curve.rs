@@ -4,9 +4,9 @@
 use std::ffi::OsString;
 use std::path::{Path, PathBuf};
 
-use super::{VOLTAGE_TOLERANCE_V, read_text, write_file};
+use super::files::{VOLTAGE_TOLERANCE_V, read_text, write_file};
 use crate::error::{Error, Result};
-use crate::measurement::CvData;
+use crate::types::CvData;
 
 /// The header of a curve file.
 const HEADER: [&str; 3] = ["voltage_V", "c12_pF", "sigma_pF"];

@@ -3,9 +3,9 @@
 
 use std::path::{Path, PathBuf};
 
-use super::{read_text, toml_message, write_file};
+use super::files::{read_text, toml_message, write_file};
 use crate::error::{Error, Result};
-use crate::measurement::Sidecar;
+use crate::types::Sidecar;
 
 /// Picocoulombs per unit of each accepted `charge_unit`.
 const CHARGE_UNITS: [(&str, f64); 2] = [("pC", 1.0), ("fC", 1e-3)];

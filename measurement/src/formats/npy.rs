@@ -24,9 +24,10 @@ use ndarray::Array2;
 use ndarray_npy::WriteNpyExt;
 use ndarray_npy::npy::header::{Header, Layout};
 
-use super::{sidecar, write_file};
+use super::files::write_file;
+use super::sidecar;
 use crate::error::{Error, Result};
-use crate::measurement::PulseSet;
+use crate::types::PulseSet;
 
 /// The magic string every `.npy` file starts with.
 const MAGIC: &[u8; 6] = b"\x93NUMPY";

@@ -10,6 +10,8 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::{Error, Result};
+
 /// Settings of the tail fit.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -40,15 +42,18 @@ impl Default for TailSettings {
 }
 
 impl TailSettings {
-    /// Checks ranges (the message names the key).
-    pub fn validate(&self) -> Result<(), String> {
+    /// Checks ranges ([`Error::Setting`] names the key).
+    pub fn validate(&self) -> Result<()> {
         let positive = [
             ("baseline_ns", self.baseline_ns),
             ("tau_max_windows", self.tau_max_windows),
         ];
         for (k, v) in positive {
             if !(v.is_finite() && v > 0.0) {
-                return Err(format!("tail.{k} must be positive, got {v}"));
+                return Err(Error::setting(
+                    format!("tail.{k}"),
+                    format!("must be positive, got {v}"),
+                ));
             }
         }
         for (k, v) in [
@@ -56,7 +61,10 @@ impl TailSettings {
             ("flat_penalty", self.flat_penalty),
         ] {
             if !(v.is_finite() && v >= 0.0) {
-                return Err(format!("tail.{k} must be >= 0, got {v}"));
+                return Err(Error::setting(
+                    format!("tail.{k}"),
+                    format!("must be >= 0, got {v}"),
+                ));
             }
         }
         Ok(())
