@@ -34,8 +34,8 @@
 use super::capacitance::CapacitanceMatrix;
 use super::depletion::PotentialSolution;
 use super::mesh::{Mesh, NodeKind};
-use super::point::FieldSettings;
 use super::report::Backend;
+use super::settings::FieldSettings;
 use super::weighting::{
     PAPER_EPSILON_FACTOR, WeightingMode, WeightingPotentials, paper_epsilon_mesh,
     weighting_potentials,

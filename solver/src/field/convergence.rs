@@ -3,7 +3,8 @@
 
 use serde::Serialize;
 
-use super::point::{FieldSettings, solve_point};
+use super::point::solve_point;
+use super::settings::FieldSettings;
 use crate::{Detector, Result};
 
 /// One resolution of a convergence study.

@@ -5,7 +5,8 @@ use serde::Serialize;
 use super::full_depletion::full_depletion_voltage;
 use super::mesh::Mesh;
 use super::pockets::Pocket;
-use super::point::{FieldSettings, Seed, solve_point_with};
+use super::point::{Seed, solve_point_with};
+use super::settings::FieldSettings;
 use crate::{Detector, Error, Result};
 
 /// One point of a C-V curve.

@@ -9,7 +9,8 @@
 use super::curve::CvCurve;
 use super::depletion::solve_fast;
 use super::mesh::Mesh;
-use super::point::{FieldSettings, solve_potential};
+use super::point::solve_potential;
+use super::settings::FieldSettings;
 use crate::{Detector, Result};
 
 /// Relative width to which the pinch-off voltage is bisected.

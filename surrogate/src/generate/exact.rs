@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use hpge_solver::{Detector, FieldSettings, ImpuritySpec, Parameters, cv_curve, solve_point};
 
-use super::setup::fnv1a;
+use crate::hash::fnv1a;
 use crate::space::{ParameterSpace, Target};
 use crate::{Error, Result};
 

@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::generate::fnv1a;
+use crate::hash::fnv1a;
 use crate::space::{ParameterSpace, Target};
 use crate::{Error, Result};
 

@@ -343,7 +343,8 @@ fn parallel_and_sequential_sweeps_agree() {
 /// through every refinement pass) ends on the same grid with the same c12 as `Method::Fast`.
 #[test]
 fn solve_point_with_sor_matches_fast() {
-    use crate::field::point::{FieldSettings, solve_point};
+    use crate::field::point::solve_point;
+    use crate::field::settings::FieldSettings;
     let det = detector("coax-analytic.toml");
     let fast = FieldSettings::default();
     let sor = FieldSettings {
@@ -425,7 +426,8 @@ fn omega_scan() {
 #[test]
 #[ignore = "measurement: sweeps against omega on refined meshes of solve_point"]
 fn omega_scan_refined() {
-    use crate::field::point::{FieldSettings, solve_point};
+    use crate::field::point::solve_point;
+    use crate::field::settings::FieldSettings;
     for (name, v) in [
         ("coax-analytic.toml", 1025.0),
         ("coax-analytic.toml", 25.0),
