@@ -5,7 +5,8 @@ use serde::Serialize;
 
 use super::point::solve_point;
 use super::settings::FieldSettings;
-use crate::{Detector, Result};
+use crate::detector::Detector;
+use crate::error::Result;
 
 /// One resolution of a convergence study.
 #[derive(Debug, Clone, PartialEq, Serialize)]

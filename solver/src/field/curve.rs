@@ -7,7 +7,8 @@ use super::mesh::Mesh;
 use super::pockets::Pocket;
 use super::point::{Seed, solve_point_with};
 use super::settings::FieldSettings;
-use crate::{Detector, Error, Result};
+use crate::detector::Detector;
+use crate::error::{Error, Result};
 
 /// One point of a C-V curve.
 #[derive(Debug, Clone, PartialEq, Serialize)]

@@ -11,7 +11,8 @@ use super::depletion::solve_fast;
 use super::mesh::Mesh;
 use super::point::solve_potential;
 use super::settings::FieldSettings;
-use crate::{Detector, Result};
+use crate::detector::Detector;
+use crate::error::Result;
 
 /// Relative width to which the pinch-off voltage is bisected.
 const RELATIVE_TOLERANCE: f64 = 1e-5;

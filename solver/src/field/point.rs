@@ -7,8 +7,9 @@ use super::mesh::Mesh;
 use super::report::{Backend, Method, SolveReport};
 use super::settings::FieldSettings;
 use super::weighting::WeightingPotentials;
+use crate::detector::Detector;
+use crate::error::{Error, Result};
 use crate::grid::Grid;
-use crate::{Detector, Error, Result};
 
 /// Everything computed at one bias.
 #[derive(Debug, Clone)]

@@ -5,5 +5,6 @@ mod axis;
 mod settings;
 mod tensor;
 
+pub(crate) use axis::{AxisRule, build_axis};
 pub use settings::{GridSettings, MIN_TOLERANCE};
 pub use tensor::Grid;

@@ -7,10 +7,10 @@ use hpge_solver::FieldSettings;
 use serde::{Deserialize, Serialize};
 
 use super::exact::ExactSolver;
+use crate::error::{Error, Result};
 use crate::hash::fnv1a;
 use crate::sequence::{Sequence, SequenceKind};
 use crate::space::ParameterSpace;
-use crate::{Error, Result};
 
 /// Shard K of M: indices offset + i with i % M == K (strided, so every shard sees the whole
 /// sequence and takes about the same time).

@@ -3,6 +3,9 @@ use std::time::Instant;
 
 use super::sweep::{Coef, Layout, half_sweep};
 use super::{SorSettings, default_omega, solve_sor, solve_sor_with};
+use crate::detector::Detector;
+use crate::error::Error;
+use crate::expr::Parameters;
 use crate::field::capacitance::CapacitanceMatrix;
 use crate::field::depletion::PotentialSolution;
 use crate::field::depletion::solve_fast;
@@ -11,7 +14,6 @@ use crate::field::point::pair;
 use crate::field::report::{Method, SolveReport, Termination};
 use crate::field::weighting::weighting_potentials;
 use crate::grid::{Grid, GridSettings};
-use crate::{Detector, Error, Parameters};
 
 pub(super) fn detector_path(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
