@@ -8,6 +8,7 @@
 //! Units at the interfaces: lengths in mm, potentials in V, impurity densities in cm^-3 (signed:
 //! positive is n-type), capacitances in pF. SI inside the numerics.
 
+mod carrier;
 mod detector;
 mod drift;
 mod error;
@@ -18,6 +19,7 @@ mod gpu;
 mod grid;
 mod impurity;
 mod material;
+mod relaxation;
 
 pub mod constants;
 

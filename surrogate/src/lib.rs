@@ -11,15 +11,17 @@
 
 mod error;
 mod generate;
+mod hash;
 mod model;
 mod sequence;
 mod space;
 
 pub use error::{Error, Result};
 pub use generate::{
-    ExactSolver, Fingerprint, Generator, MergeReport, RunInfo, RunReport, Sample, Shard, fnv1a,
+    ExactSolver, Fingerprint, Generator, MergeReport, RunInfo, RunReport, Sample, Shard,
     format_row, merge, read_rows, run,
 };
+pub use hash::fnv1a;
 pub use model::{
     Architecture, Cycle, DataInfo, DataSet, Dense, DetectorInfo, EpochRecord, FORMAT,
     FORMAT_VERSION, Figures, Loss, Member, ModelInfo, Network, OutputTransform, Polynomial,

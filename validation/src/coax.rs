@@ -13,7 +13,7 @@ use hpge_solver::constants::{
     CM3_TO_M3, ELEMENTARY_CHARGE_C, EPS_R_GERMANIUM, VACUUM_PERMITTIVITY_F_PER_M,
 };
 
-use crate::{Error, Result};
+use crate::error::{Error, Result};
 
 /// The closed-form numbers of `../shared/reference/coax-1d-reference.md` (computed outside this
 /// project) for the validation coax: (U_B in V, r_d in mm, c' in pF/mm), rounded to 4 and 5 decimals.

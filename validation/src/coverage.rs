@@ -18,7 +18,7 @@ use rand::rngs::StdRng;
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::Result;
+use crate::error::Result;
 
 /// Nominal levels of the coverage curve (the 0.683 and 0.955 of the pass test among them).
 pub const COVERAGE_LEVELS: [f64; 11] = [0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.683, 0.8, 0.9, 0.955, 0.99];

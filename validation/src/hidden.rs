@@ -24,7 +24,7 @@ use rand::rngs::StdRng;
 use serde::Serialize;
 use statrs::distribution::{ChiSquared, ContinuousCDF};
 
-use crate::{Error, Result};
+use crate::error::{Error, Result};
 
 /// The base (z-only) truth in B_Z's parameters.
 pub const BASE_TRUTH: [(&str, f64); 3] = [

@@ -20,7 +20,7 @@ use hpge_solver::constants::{
     CM3_TO_M3, ELEMENTARY_CHARGE_C, EPS_R_GERMANIUM, VACUUM_PERMITTIVITY_F_PER_M,
 };
 
-use crate::{Error, Result};
+use crate::error::{Error, Result};
 
 /// The planar p-n detector: lengths in mm, density in cm^-3 (n-type, > 0), eps_r dimensionless.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -7,9 +7,11 @@ use std::sync::Arc;
 
 use super::spec::{DetectorSpec, MaterialSpec, PotentialSpec};
 use super::{Contact, ContactPotential, Detector, Passive, PassiveKind, Semiconductor, World};
+use crate::error::{Error, Result};
 use crate::expr::Parameters;
 use crate::geometry::{BOUNDARY_TOL_MM, Solid, common_point};
-use crate::{Error, ImpurityContext, ImpurityModel, ImpuritySpec, Material, Result};
+use crate::impurity::{ImpurityContext, ImpurityModel, ImpuritySpec};
+use crate::material::Material;
 
 /// Shrinkage (mm) used when testing for interior overlap.
 const INTERIOR_TOL_MM: f64 = 1e-6;

@@ -1,6 +1,7 @@
 //! Detector descriptions: the TOML format, its evaluation and checks, and the resulting model.
 
 mod build;
+mod initial_grid;
 mod model;
 mod spec;
 
@@ -11,8 +12,9 @@ pub use model::{
     World, WorldSide,
 };
 
+use crate::error::{Error, Result};
 use crate::expr::Parameters;
-use crate::{Error, ImpuritySpec, Result};
+use crate::impurity::ImpuritySpec;
 
 impl Detector {
     /// Reads, evaluates and checks a detector file; `overrides` replace values of its

@@ -7,7 +7,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::expr::Parameters;
 use crate::geometry::{BOUNDARY_TOL_MM, BoundingBox, Solid};
-use crate::{ImpurityContext, ImpurityModel, ImpuritySpec, Material};
+use crate::impurity::{ImpurityContext, ImpurityModel, ImpuritySpec};
+use crate::material::Material;
 
 /// Boundary condition on one side of the world box.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -205,8 +206,8 @@ pub struct Detector {
     /// Passive objects.
     pub passives: Vec<Passive>,
     /// The file's `[grid]` table (grid and accuracy settings for this detector), if it has one;
-    /// [`crate::FieldSettings::for_detector`] puts it into force.
-    pub grid: Option<crate::GridSettings>,
+    /// [`FieldSettings::for_detector`](crate::field::FieldSettings::for_detector) puts it into force.
+    pub grid: Option<crate::grid::GridSettings>,
 }
 
 impl Detector {

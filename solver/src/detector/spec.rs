@@ -9,9 +9,9 @@ use serde::de::{self, Visitor};
 use serde::{Deserialize, Deserializer, Serialize};
 
 use super::{BoundaryKind, PassiveKind};
-use crate::ImpuritySpec;
 use crate::expr::Quantity;
 use crate::geometry::SolidSpec;
+use crate::impurity::ImpuritySpec;
 
 /// Top level of a detector file.
 #[derive(Debug, Clone, Deserialize, Serialize)]

@@ -15,8 +15,11 @@
 //! so the field at a contact's surface comes from the semiconductor side only and never
 //! averages across a kink of the potential. E_r = 0 on the axis by symmetry.
 
+use crate::detector::Detector;
+use crate::field::{Mesh, NodeKind, PointResult, PotentialSolution};
 use crate::geometry::BOUNDARY_TOL_MM;
-use crate::{Detector, Grid, Mesh, NodeKind, PointResult, PotentialSolution, Solid};
+use crate::geometry::Solid;
+use crate::grid::Grid;
 
 /// E = -grad phi of one bias point, V/m, on the (r, z) grid of its mesh.
 #[derive(Debug, Clone)]

@@ -6,7 +6,10 @@ use super::ElectricField;
 use crate::constants::{
     CM3_TO_M3, ELEMENTARY_CHARGE_C, EPS_R_GERMANIUM, VACUUM_PERMITTIVITY_F_PER_M,
 };
-use crate::{Detector, FieldSettings, GridSettings, Parameters, PointResult, solve_point};
+use crate::detector::Detector;
+use crate::expr::Parameters;
+use crate::field::{FieldSettings, PointResult, solve_point};
+use crate::grid::GridSettings;
 
 /// The long coax of `detectors/coax-analytic.toml`: a = 6 mm, b = 37.5 mm, N = 1e10 cm^-3 n-type,
 /// reflecting ends (no z dependence), bias on the inner contact.

@@ -6,10 +6,12 @@ use std::time::Instant;
 
 use super::field_tests::{A_M, B_M, alpha_v_per_m2, closed_form, coax, solve};
 use super::{AdlModel, Carrier, DriftModel, DriftSettings, StopReason, pulse};
-use crate::{
-    Detector, Error, FieldSettings, GridSettings, ImpuritySpec, Parameters, PointResult,
-    solve_point,
-};
+use crate::detector::Detector;
+use crate::error::Error;
+use crate::expr::Parameters;
+use crate::field::{FieldSettings, PointResult, solve_point};
+use crate::grid::GridSettings;
+use crate::impurity::ImpuritySpec;
 
 /// Constant, isotropic mobilities (m^2/Vs): v = -mu_e E for electrons, v = mu_h E for holes.
 struct ConstantMobility {

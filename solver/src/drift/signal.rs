@@ -17,7 +17,9 @@
 
 use super::trajectory::{Drift, StopReason, drift_carrier};
 use super::{Carrier, DriftModel, DriftSettings, ElectricField};
-use crate::{Detector, Error, PointResult, Result};
+use crate::detector::Detector;
+use crate::error::{Error, Result};
+use crate::field::PointResult;
 
 /// The induced charge on one contact.
 #[derive(Debug, Clone, PartialEq)]

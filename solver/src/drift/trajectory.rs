@@ -12,7 +12,8 @@
 //! not slid along passivated surfaces: reaching one ends the drift (`StopReason::Surface`).
 
 use super::{Carrier, DriftModel, DriftSettings, ElectricField, norm3};
-use crate::{Detector, Error, Region, Result};
+use crate::detector::{Detector, Region};
+use crate::error::{Error, Result};
 
 /// Speeds below this (m/s) count as stopped (no field).
 const MIN_SPEED_M_PER_S: f64 = 1e-3;

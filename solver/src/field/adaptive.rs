@@ -34,14 +34,15 @@
 use super::capacitance::CapacitanceMatrix;
 use super::depletion::PotentialSolution;
 use super::mesh::{Mesh, NodeKind};
-use super::point::FieldSettings;
 use super::report::Backend;
+use super::settings::FieldSettings;
 use super::weighting::{
     PAPER_EPSILON_FACTOR, WeightingMode, WeightingPotentials, paper_epsilon_mesh,
     weighting_potentials,
 };
+use crate::detector::Detector;
+use crate::error::Result;
 use crate::grid::Grid;
-use crate::{Detector, Result};
 
 /// Share of the largest weighting-potential change above which an interval is halved.
 const MARK_FRACTION: f64 = 0.5;

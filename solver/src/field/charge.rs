@@ -26,7 +26,8 @@
 
 use super::depletion::{PotentialSolution, solve_fast};
 use super::mesh::{Mesh, NodeKind};
-use crate::{Detector, Error, Result};
+use crate::detector::Detector;
+use crate::error::{Error, Result};
 
 /// Free charge r_n (C) of every node of `sol` on `mesh` (see the module text).
 pub(crate) fn free_charges_c(mesh: &Mesh, sol: &PotentialSolution) -> Vec<f64> {
@@ -108,7 +109,7 @@ pub fn quasi_static_c12_pf(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::Parameters;
+    use crate::expr::Parameters;
     use crate::field::{FieldSettings, solve_point};
 
     fn detector(file: &str) -> Detector {

@@ -20,7 +20,7 @@ use faer::sparse::linalg::cholesky::{
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, Mat, Par, Side};
 
-use crate::{Error, Result};
+use crate::error::{Error, Result};
 
 /// The symbolic analysis of one sparsity pattern, reusable for any values.
 #[derive(Clone)]

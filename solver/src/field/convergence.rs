@@ -3,8 +3,10 @@
 
 use serde::Serialize;
 
-use super::point::{FieldSettings, solve_point};
-use crate::{Detector, Result};
+use super::point::solve_point;
+use super::settings::FieldSettings;
+use crate::detector::Detector;
+use crate::error::Result;
 
 /// One resolution of a convergence study.
 #[derive(Debug, Clone, PartialEq, Serialize)]

@@ -5,8 +5,10 @@ use serde::Serialize;
 use super::full_depletion::full_depletion_voltage;
 use super::mesh::Mesh;
 use super::pockets::Pocket;
-use super::point::{FieldSettings, Seed, solve_point_with};
-use crate::{Detector, Error, Result};
+use super::point::{Seed, solve_point_with};
+use super::settings::FieldSettings;
+use crate::detector::Detector;
+use crate::error::{Error, Result};
 
 /// One point of a C-V curve.
 #[derive(Debug, Clone, PartialEq, Serialize)]

@@ -16,8 +16,9 @@ use super::mesh::{Mesh, NodeKind};
 use super::pockets::{self, Pocket, Ties, depression_depths_v, find_pockets};
 use super::report::{Backend, Method, SolveReport, Termination};
 use super::system::{Dof, System};
-use crate::Carrier;
-use crate::{Detector, Error, Result};
+use crate::carrier::Carrier;
+use crate::detector::Detector;
+use crate::error::{Error, Result};
 
 /// Largest number of active-set iterations before giving up.
 pub const MAX_ACTIVE_SET_ITERATIONS: usize = 200;

@@ -26,7 +26,8 @@ use super::depletion::potential_dofs;
 use super::mesh::{Mesh, NodeKind};
 use super::pockets::{CARRIERS, deepest_depression_v};
 use super::system::{Dof, System};
-use crate::{Detector, Result};
+use crate::detector::Detector;
+use crate::error::Result;
 
 /// Relative width to which the full-depletion voltage is bisected.
 const RELATIVE_TOLERANCE: f64 = 1e-7;

@@ -17,8 +17,8 @@
 //! line by symmetry.
 
 use crate::constants::{CM3_TO_M3, ELEMENTARY_CHARGE_C, VACUUM_PERMITTIVITY_F_PER_M};
+use crate::detector::{BoundaryKind, Detector, PassiveKind, Region, WorldSide};
 use crate::grid::Grid;
-use crate::{BoundaryKind, Detector, PassiveKind, Region, WorldSide};
 
 /// What a node is electrically.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -14,6 +14,7 @@ mod pinch_off;
 pub(crate) mod pockets;
 mod point;
 mod report;
+mod settings;
 pub(crate) mod sor;
 mod system;
 mod union_find;
@@ -30,10 +31,10 @@ pub use mesh::{Mesh, NodeKind};
 pub use pinch_off::{curve_pinch_off_voltage, pinch_off_voltage};
 pub use pockets::{Pocket, deepest_depression_v, deepest_empty_depression_v, find_pockets};
 pub use point::{
-    FieldSettings, PointResult, PotentialPoint, Seed, solve_point, solve_point_on_grid,
-    solve_potential,
+    PointResult, PotentialPoint, Seed, solve_point, solve_point_on_grid, solve_potential,
 };
 pub use report::{Backend, Method, SolveReport, Termination};
+pub use settings::FieldSettings;
 pub use sor::{solve_sor, solve_sor_wgpu, weighting_potentials_wgpu};
 pub use weighting::{
     PAPER_EPSILON_FACTOR, WeightingMode, WeightingPotentials, weighting_potentials,

@@ -9,8 +9,10 @@
 use super::curve::CvCurve;
 use super::depletion::solve_fast;
 use super::mesh::Mesh;
-use super::point::{FieldSettings, solve_potential};
-use crate::{Detector, Result};
+use super::point::solve_potential;
+use super::settings::FieldSettings;
+use crate::detector::Detector;
+use crate::error::Result;
 
 /// Relative width to which the pinch-off voltage is bisected.
 const RELATIVE_TOLERANCE: f64 = 1e-5;

@@ -1,72 +1,15 @@
 //! One bias point: grid refinement, potential with depletion, weighting potentials, C*.
 
-use serde::{Deserialize, Serialize};
-
 use super::adaptive::{Accuracy, Weighed, refinement_marks, undepleted_nodes, weigh};
 use super::capacitance::CapacitanceMatrix;
 use super::depletion::{PotentialSolution, solve_fast};
 use super::mesh::Mesh;
 use super::report::{Backend, Method, SolveReport};
-use super::weighting::{WeightingMode, WeightingPotentials};
-use crate::gpu::Precision;
-use crate::grid::{Grid, GridSettings};
-use crate::{Detector, Error, Result};
-
-/// Settings of a field calculation.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct FieldSettings {
-    /// Grid construction and refinement.
-    pub grid: GridSettings,
-    /// Potential method.
-    pub method: Method,
-    /// Locate the depletion front inside its cell and carry it into the weighting potentials
-    /// (see `field/front.rs`); off: the front sits on nodes, as in SolidStateDetectors.jl.
-    /// Used by `WeightingMode::Conductor` only.
-    pub subcell_front: bool,
-    /// How undepleted semiconductor enters the weighting potentials.
-    pub weighting: WeightingMode,
-    /// Where the potential and weighting potentials are solved; `Wgpu` runs the `Sor` method.
-    pub backend: Backend,
-    /// Arithmetic on the wgpu backend.
-    pub gpu_precision: Precision,
-}
-
-impl Default for FieldSettings {
-    fn default() -> Self {
-        Self {
-            grid: GridSettings::default(),
-            method: Method::Fast,
-            subcell_front: true,
-            weighting: WeightingMode::Conductor,
-            backend: Backend::Cpu,
-            gpu_precision: Precision::Auto,
-        }
-    }
-}
-
-impl FieldSettings {
-    /// These settings with the detector's `[grid]` table in force (grid and accuracy settings of
-    /// that detector), where its file has one.
-    pub fn for_detector(&self, det: &Detector) -> FieldSettings {
-        FieldSettings {
-            grid: det.grid.clone().unwrap_or_else(|| self.grid.clone()),
-            ..self.clone()
-        }
-    }
-
-    /// Checks all fields (the message names the field).
-    pub fn validate(&self) -> Result<(), String> {
-        self.grid.validate().map_err(|m| format!("grid: {m}"))?;
-        if self.backend == Backend::Wgpu && self.method != Method::Sor {
-            return Err(format!(
-                "method: the wgpu backend runs the sor method; `{}` (sparse Cholesky) runs on the cpu backend only",
-                self.method.as_str()
-            ));
-        }
-        Ok(())
-    }
-}
+use super::settings::FieldSettings;
+use super::weighting::WeightingPotentials;
+use crate::detector::Detector;
+use crate::error::{Error, Result};
+use crate::grid::Grid;
 
 /// Everything computed at one bias.
 #[derive(Debug, Clone)]

@@ -4,7 +4,7 @@
 
 use super::Mesh;
 use super::cholesky::{Factor, Symbolic, nested_dissection};
-use crate::Result;
+use crate::error::Result;
 
 /// Role of a node in one linear problem.
 #[derive(Debug, Clone, Copy, PartialEq)]

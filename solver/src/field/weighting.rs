@@ -13,7 +13,8 @@ use serde::{Deserialize, Serialize};
 use super::mesh::{Mesh, NodeKind};
 use super::system::{Dof, System};
 use super::union_find::UnionFind;
-use crate::{Detector, Error, Result};
+use crate::detector::Detector;
+use crate::error::{Error, Result};
 
 /// How undepleted semiconductor enters the weighting potentials (a closed set).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]

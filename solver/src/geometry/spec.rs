@@ -16,8 +16,8 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 
 use super::{Primitive, Solid};
+use crate::error::{Error, Result};
 use crate::expr::{Parameters, Quantity};
-use crate::{Error, Result};
 
 /// One geometry entry as written in a file (dimensions may be expressions).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -9,8 +9,8 @@ use wgpu::util::DeviceExt;
 
 use super::context::{Gpu, WORKGROUP};
 use super::stencil::StencilProblem;
-use crate::field::sor::{SorSettings, StopRule};
-use crate::{Error, Result};
+use crate::error::{Error, Result};
+use crate::relaxation::{SorSettings, StopRule};
 
 /// Uniform parameters of one dispatch (layout of `Params` in sor.wgsl).
 #[repr(C)]

@@ -3,7 +3,7 @@
 //! HPGE_REQUIRE_GPU=1.
 
 use super::{BlockRows, ColourRows, Precision, StencilProblem, gpu_test_gate, run, shared};
-use crate::field::sor::SorSettings;
+use crate::relaxation::SorSettings;
 
 /// u = x^2 - y^2 + 2 z + 1 is discretely harmonic for the 7-point stencil on a uniform grid, so
 /// the SOR solution with u on the boundary is u at every interior node (up to the tolerance).

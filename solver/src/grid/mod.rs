@@ -7,5 +7,6 @@ mod settings;
 mod tensor;
 
 pub use overrides::{GridOverrides, parse_grid_setting};
+pub(crate) use axis::{AxisRule, build_axis};
 pub use settings::{GridSettings, MIN_TOLERANCE};
 pub use tensor::Grid;

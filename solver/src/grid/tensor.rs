@@ -1,10 +1,12 @@
 //! The tensor grid: ticks in r and z (mm), node index n = j * nr + i.
 
 use super::GridSettings;
-use super::axis::{AxisRule, build_axis, limit_ratio};
-use crate::Detector;
+use super::axis::limit_ratio;
 
 /// A non-uniform tensor grid over the world; node (i, j) sits at (r\[i\], z\[j\]) in mm.
+///
+/// A detector's initial grid is [`Grid::initial`] (in `detector/initial_grid.rs`: it reads the
+/// detector, which this module does not know).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Grid {
     r_mm: Vec<f64>,
@@ -29,27 +31,9 @@ impl Grid {
         Ok(Self { r_mm, z_mm })
     }
 
-    /// The initial grid of a detector: a tick on every geometry edge, spacing limited by the
-    /// settings (fine over the semiconductor's extent), neighbour ratio limited.
-    pub fn initial(det: &Detector, s: &GridSettings) -> Self {
-        let (rt, zt) = det.ticks();
-        let sb = det.semiconductor.geometry.bbox();
-        let w = &det.world;
-        let rule = |range: (f64, f64)| AxisRule {
-            fine_range: range,
-            fine: s.max_spacing_semiconductor_mm,
-            coarse: s.max_spacing_mm,
-            min_tick: s.min_tick_distance_mm,
-            max_ratio: s.max_distance_ratio,
-        };
-        let r = build_axis(&rt, 0.0, w.r_max_mm, &rule((sb.r_min_mm, sb.r_max_mm)));
-        let z = build_axis(
-            &zt,
-            w.z_min_mm,
-            w.z_max_mm,
-            &rule((sb.z_min_mm, sb.z_max_mm)),
-        );
-        Self { r_mm: r, z_mm: z }
+    /// A grid from ticks built by the axis rules (strictly increasing by construction).
+    pub(crate) fn from_ticks(r_mm: Vec<f64>, z_mm: Vec<f64>) -> Self {
+        Self { r_mm, z_mm }
     }
 
     /// r ticks in mm.

@@ -5,7 +5,7 @@ use std::path::Path;
 use super::model::{ConstantModel, ImpurityModel, LinearZModel};
 use super::rz::RzModel;
 use super::transform::LogTransform;
-use crate::{Error, Result};
+use crate::error::{Error, Result};
 
 /// Which impurity model a spec describes (the TOML `model` key).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]

@@ -6,9 +6,9 @@ use std::path::{Path, PathBuf};
 
 use hpge_solver::{Detector, FieldSettings, ImpuritySpec, Parameters, cv_curve, solve_point};
 
-use super::setup::fnv1a;
+use crate::error::{Error, Result};
+use crate::hash::fnv1a;
 use crate::space::{ParameterSpace, Target};
-use crate::{Error, Result};
 
 /// A detector whose parameters and impurity model are set from points of a parameter space.
 #[derive(Debug, Clone)]

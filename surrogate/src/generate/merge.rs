@@ -5,7 +5,7 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use super::run::{RunInfo, read_folder};
-use crate::{Error, Result};
+use crate::error::{Error, Result};
 
 /// What a merge wrote.
 #[derive(Debug, Clone, PartialEq)]

@@ -9,4 +9,4 @@ mod setup;
 pub use exact::ExactSolver;
 pub use merge::{MergeReport, merge};
 pub use run::{RunInfo, RunReport, format_row, read_rows, run};
-pub use setup::{Fingerprint, Generator, Sample, Shard, fnv1a};
+pub use setup::{Fingerprint, Generator, Sample, Shard};

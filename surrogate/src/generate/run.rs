@@ -18,7 +18,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::setup::{Fingerprint, Generator, Sample, Shard};
-use crate::{Error, Result};
+use crate::error::{Error, Result};
 
 /// The sidecar of a generation folder.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -7,19 +7,10 @@ use hpge_solver::FieldSettings;
 use serde::{Deserialize, Serialize};
 
 use super::exact::ExactSolver;
+use crate::error::{Error, Result};
+use crate::hash::fnv1a;
 use crate::sequence::{Sequence, SequenceKind};
 use crate::space::ParameterSpace;
-use crate::{Error, Result};
-
-/// FNV-1a 64-bit hash (stable across platforms and versions; identifies inputs, not security).
-pub fn fnv1a(bytes: &[u8]) -> u64 {
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    for &b in bytes {
-        h ^= u64::from(b);
-        h = h.wrapping_mul(0x0100_0000_01b3);
-    }
-    h
-}
 
 /// Shard K of M: indices offset + i with i % M == K (strided, so every shard sees the whole
 /// sequence and takes about the same time).

@@ -4,9 +4,9 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::generate::fnv1a;
+use crate::error::{Error, Result};
+use crate::hash::fnv1a;
 use crate::space::{ParameterSpace, Target};
-use crate::{Error, Result};
 
 /// A data set of (p, U_B) -> c12 samples.
 #[derive(Debug, Clone)]

@@ -9,7 +9,7 @@ use safetensors::tensor::{Dtype, SafeTensors, TensorView};
 use super::network::{Dense, Network};
 use super::polynomial::{Polynomial, monomials};
 use super::surrogate::{FORMAT, FORMAT_VERSION, ModelInfo, Predictor, Surrogate};
-use crate::{Error, Result};
+use crate::error::{Error, Result};
 
 const META_KEY: &str = "hpge-cv";
 

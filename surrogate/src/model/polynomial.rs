@@ -5,7 +5,7 @@
 use faer::Mat;
 use faer::linalg::solvers::Solve;
 
-use crate::{Error, Result};
+use crate::error::{Error, Result};
 
 /// A polynomial in z: sum_k a_k prod_{i in m_k} z_i, each monomial m_k a multiset of input
 /// indices of size <= degree.

@@ -3,7 +3,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::{Error, Result};
+use crate::error::{Error, Result};
 
 /// Layer widths. Inputs are standard-normal coordinates: the model parameters p go through the
 /// `trunk` (none for the paper), then [h(p), z_U] goes through the `head`, then one linear output.

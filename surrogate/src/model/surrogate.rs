@@ -11,8 +11,8 @@ use super::network::Network;
 use super::polynomial::Polynomial;
 use super::recipe::{OutputTransform, Recipe};
 use super::transform::{physical_to_z, unit_to_z};
+use crate::error::{Error, Result};
 use crate::space::{Dimension, ParameterSpace};
-use crate::{Error, Result};
 
 /// Name of the model-file format (safetensors metadata key `format`).
 pub const FORMAT: &str = "hpge-cv-surrogate";

@@ -13,7 +13,7 @@ use super::dataset::DataSet;
 use super::network::{Dense, Network};
 use super::recipe::{Architecture, Loss, OutputTransform, Recipe};
 use super::transform::unit_to_z;
-use crate::{Error, Result};
+use crate::error::{Error, Result};
 
 /// One point of the learning curves.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

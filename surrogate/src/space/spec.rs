@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use super::normal::{normal_cdf, normal_quantile};
-use crate::{Error, Result};
+use crate::error::{Error, Result};
 
 /// How a dimension is distributed over its range (a closed set).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]

@@ -2,7 +2,7 @@
 //! nested bracketed solve), and the bracketed root search they use.
 
 use super::layers::{End, Fronts};
-use crate::Result;
+use crate::error::Result;
 
 impl<'p, 'z> Fronts<'p, 'z> {
     /// Front s (m) facing a contact (r_c, phi_c): root of phi_c - beta + (q/eps) psi_s(r_c) in

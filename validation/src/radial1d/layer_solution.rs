@@ -4,7 +4,7 @@
 use hpge_solver::constants::CM3_TO_M3;
 
 use super::layers::{End, Fronts, Layer};
-use crate::Result;
+use crate::error::Result;
 
 impl<'p, 'z> Fronts<'p, 'z> {
     /// r phi'(r) (V) of a layer's solution.

@@ -2,7 +2,7 @@
 //! set of coarser grids.
 
 use super::profile::{Grid, Profile};
-use crate::{Error, Result};
+use crate::error::{Error, Result};
 
 /// Coarse grids of the active-set start stop below this many nodes.
 const COARSEST_NODES: usize = 64;

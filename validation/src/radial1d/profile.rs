@@ -5,7 +5,7 @@ use std::cell::Cell;
 
 use hpge_solver::constants::CM3_TO_M3;
 
-use crate::{Error, Result};
+use crate::error::{Error, Result};
 
 /// Adaptive quadrature: maximal bisection depth and Gauss-Legendre evaluations per call.
 const QUAD_MAX_DEPTH: u32 = 60;

@@ -8,7 +8,7 @@ use hpge_solver::constants::{ELEMENTARY_CHARGE_C, EPS_R_GERMANIUM, VACUUM_PERMIT
 use super::layers::{End, Fronts, Layer};
 use super::obstacle::{initial_status, solve_obstacle};
 use super::profile::Profile;
-use crate::{Error, Result};
+use crate::error::{Error, Result};
 
 /// Default number of nodes (contacts included): 4001, i.e. 7.9 um on the validation coax. The exact
 /// fronts do not need that many; it makes the grid-only estimate agree with them to 1.2e-6 relative

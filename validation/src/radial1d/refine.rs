@@ -2,7 +2,7 @@
 //! or removed and squeezed islands merged until the topology settles.
 
 use super::layers::{End, Fronts, Layer, WINDOW_CELLS};
-use crate::Result;
+use crate::error::Result;
 
 /// Passes of the topology repair before giving up on exact fronts.
 const MAX_PASSES: usize = 8;

@@ -5,7 +5,7 @@ use hpge_solver::constants::{
 use super::RadialReference;
 use super::obstacle::{Obstacle, Status, apply_row, initial_status, solve_obstacle};
 use super::profile::{Grid, Profile};
-use crate::Error;
+use crate::error::Error;
 
 fn kq() -> f64 {
     ELEMENTARY_CHARGE_C / (VACUUM_PERMITTIVITY_F_PER_M * EPS_R_GERMANIUM)

@@ -24,7 +24,7 @@ use std::collections::BinaryHeap;
 
 use crate::field::mesh::{Mesh, NodeKind};
 
-use crate::Carrier;
+use crate::carrier::Carrier;
 
 /// A level with a total order (for the heap); ties broken by node index (deterministic).
 #[derive(Debug, Clone, Copy, PartialEq)]

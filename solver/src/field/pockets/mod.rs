@@ -25,7 +25,7 @@ use serde::{Deserialize, Serialize};
 
 use std::collections::HashMap;
 
-use crate::Carrier;
+use crate::carrier::Carrier;
 use crate::field::mesh::{Mesh, NodeKind};
 use crate::field::union_find::UnionFind;
 

@@ -4,12 +4,13 @@
 use std::path::Path;
 
 use super::{CARRIERS, deepest_depression_v};
-use crate::Carrier;
+use crate::carrier::Carrier;
+use crate::detector::Detector;
+use crate::expr::Parameters;
 use crate::field::depletion::{PotentialSolution, solve_fast};
 use crate::field::mesh::{Mesh, NodeKind};
 use crate::field::sor::solve_sor;
 use crate::grid::{Grid, GridSettings};
-use crate::{Detector, Parameters};
 
 fn icpc() -> Detector {
     let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../detectors/icpc-example.toml");

@@ -12,7 +12,7 @@
 
 use std::collections::HashMap;
 
-use crate::Carrier;
+use crate::carrier::Carrier;
 use crate::field::pockets::{Tie, Ties};
 use crate::field::system::Dof;
 

@@ -23,10 +23,8 @@
 
 mod levels;
 mod residual;
-mod settings;
 mod solve;
 pub(crate) mod stencil;
-mod stop;
 mod sweep;
 #[cfg(test)]
 mod tests;
@@ -35,12 +33,10 @@ mod wgpu;
 mod wgpu_tests;
 
 pub use solve::solve_sor;
-pub(crate) use stop::StopRule;
 pub use wgpu::{solve_sor_wgpu, weighting_potentials_wgpu};
 // The rest of the SOR interface, at the same paths as when this was one file; only the tests
 // use it so far (outside them the field module needs `solve_sor` alone).
 #[allow(unused_imports)]
-pub use self::{
-    settings::{SorSettings, default_omega},
-    solve::solve_sor_with,
-};
+pub use self::solve::solve_sor_with;
+#[allow(unused_imports)]
+pub use crate::relaxation::{SorSettings, default_omega};

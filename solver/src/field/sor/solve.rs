@@ -5,16 +5,16 @@ use std::time::Instant;
 
 use super::levels::{Levels, MAX_LEVEL_ROUNDS, next_levels, settled, tied_bounds};
 use super::residual::{projected_residual, projected_residual_within};
-use super::settings::{SorSettings, default_omega};
 use super::stencil::{groups, initial, inverse_sum, undepleted_within, weights};
-use super::stop::StopRule;
 use super::sweep::{Block, Coef, Layout, PARALLEL_MIN_NODES, half_sweep, to_nodes, update_blocks};
+use crate::detector::Detector;
+use crate::error::{Error, Result};
 use crate::field::depletion::{POCKET_TOL, PotentialSolution, potential_dofs};
 use crate::field::mesh::{Mesh, NodeKind};
 use crate::field::pockets::{self, Ties, find_pockets};
 use crate::field::report::{Backend, Method, SolveReport, Termination};
 use crate::field::system::Dof;
-use crate::{Detector, Error, Result};
+use crate::relaxation::{SorSettings, StopRule, default_omega};
 
 /// Solves for the potential with depletion by red-black projected SOR with default settings
 /// (`SorSettings::default()`): the same discrete solution as

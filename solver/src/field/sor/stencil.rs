@@ -2,10 +2,10 @@
 //! and neighbours, floating conductors, the initial iterate, the KKT readout of undepleted nodes,
 //! and the device-side problem (`gpu::StencilProblem`) of the wgpu backend.
 
+use crate::error::{Error, Result};
 use crate::field::mesh::{Mesh, NodeKind};
 use crate::field::system::Dof;
 use crate::gpu::{BlockRows, ColourRows, StencilProblem};
-use crate::{Error, Result};
 
 /// Conductances (F) to the left (i - 1), right (i + 1), lower (j - 1), upper (j + 1) neighbour
 /// of node n; 0 where there is none.

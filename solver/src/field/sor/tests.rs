@@ -3,6 +3,9 @@ use std::time::Instant;
 
 use super::sweep::{Coef, Layout, half_sweep};
 use super::{SorSettings, default_omega, solve_sor, solve_sor_with};
+use crate::detector::Detector;
+use crate::error::Error;
+use crate::expr::Parameters;
 use crate::field::capacitance::CapacitanceMatrix;
 use crate::field::depletion::PotentialSolution;
 use crate::field::depletion::solve_fast;
@@ -11,7 +14,6 @@ use crate::field::point::pair;
 use crate::field::report::{Method, SolveReport, Termination};
 use crate::field::weighting::weighting_potentials;
 use crate::grid::{Grid, GridSettings};
-use crate::{Detector, Error, Parameters};
 
 pub(super) fn detector_path(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -343,7 +345,8 @@ fn parallel_and_sequential_sweeps_agree() {
 /// through every refinement pass) ends on the same grid with the same c12 as `Method::Fast`.
 #[test]
 fn solve_point_with_sor_matches_fast() {
-    use crate::field::point::{FieldSettings, solve_point};
+    use crate::field::point::solve_point;
+    use crate::field::settings::FieldSettings;
     let det = detector("coax-analytic.toml");
     let fast = FieldSettings::default();
     let sor = FieldSettings {
@@ -425,7 +428,8 @@ fn omega_scan() {
 #[test]
 #[ignore = "measurement: sweeps against omega on refined meshes of solve_point"]
 fn omega_scan_refined() {
-    use crate::field::point::{FieldSettings, solve_point};
+    use crate::field::point::solve_point;
+    use crate::field::settings::FieldSettings;
     for (name, v) in [
         ("coax-analytic.toml", 1025.0),
         ("coax-analytic.toml", 25.0),

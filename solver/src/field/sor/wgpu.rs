@@ -6,8 +6,9 @@ use std::time::Instant;
 
 use super::levels::{Levels, MAX_LEVEL_ROUNDS, next_levels, settled, tied_bounds};
 use super::residual::projected_residual_within;
-use super::settings::{SorSettings, default_omega};
 use super::stencil::{device_problem, undepleted_within};
+use crate::detector::Detector;
+use crate::error::{Error, Result};
 use crate::field::depletion::{POCKET_TOL, PotentialSolution, potential_dofs};
 use crate::field::mesh::Mesh;
 use crate::field::pockets::{self, Ties, find_pockets};
@@ -15,7 +16,7 @@ use crate::field::report::{Backend, Method, SolveReport, Termination};
 use crate::field::system::Dof;
 use crate::field::weighting::{Owner, WeightingPotentials, owners};
 use crate::gpu::{self, Precision};
-use crate::{Detector, Error, Result};
+use crate::relaxation::{SorSettings, default_omega};
 
 fn omega_for(mesh: &Mesh, settings: &SorSettings) -> Result<f64> {
     let omega = settings
@@ -173,7 +174,7 @@ pub(crate) fn solve_sor_wgpu_with(
 }
 
 /// Weighting potentials of all contacts on the wgpu backend: the problem of
-/// [`weighting_potentials`](crate::weighting_potentials) (W_k = 1 on contact k and the
+/// [`weighting_potentials`](crate::field::weighting_potentials) (W_k = 1 on contact k and the
 /// undepleted region attached to it, 0 on the other conductors, floating conductors at zero net
 /// charge, Laplace's equation elsewhere) solved by SOR on the device from W = 0, one solve per
 /// contact; the stencil is uploaded per solve.

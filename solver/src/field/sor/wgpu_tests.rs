@@ -6,14 +6,16 @@ use super::stencil::device_problem;
 use super::tests::{detector, ring_detector};
 use super::wgpu::solve_sor_wgpu_with;
 use super::{SorSettings, default_omega, solve_sor, solve_sor_wgpu, weighting_potentials_wgpu};
+use crate::detector::Detector;
+use crate::error::Error;
 use crate::field::depletion::{potential_dofs, solve_fast};
 use crate::field::mesh::Mesh;
-use crate::field::point::{FieldSettings, solve_point};
+use crate::field::point::solve_point;
 use crate::field::report::{Backend, Method};
+use crate::field::settings::FieldSettings;
 use crate::field::weighting::weighting_potentials;
 use crate::gpu::{self, Precision, gpu_test_gate};
 use crate::grid::{Grid, GridSettings};
-use crate::{Detector, Error};
 
 fn coarse_mesh(det: &Detector) -> Mesh {
     let gs = GridSettings {
