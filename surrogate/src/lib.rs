@@ -11,6 +11,7 @@
 
 mod error;
 mod generate;
+pub mod job;
 mod model;
 mod sequence;
 mod space;
