@@ -64,6 +64,54 @@ pub enum Error {
         /// What is wrong.
         message: String,
     },
+    /// A file of a training run (learning curves, checkpoints) could not be read, written or
+    /// removed. The text names the action and the file; the operating system's reason is the
+    /// error's source (error-chain printers add it after a colon).
+    #[error("{action} {}", file.display())]
+    RunFile {
+        /// What was attempted, e.g. `cannot write the learning curves`.
+        action: &'static str,
+        /// The file or folder.
+        file: PathBuf,
+        /// The operating system's reason.
+        #[source]
+        source: std::io::Error,
+    },
+    /// The path a model file is to be written to is unusable (not `.safetensors`, its folder
+    /// missing).
+    #[error("{}: {message}", file.display())]
+    ModelPath {
+        /// The model file asked for.
+        file: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+    /// A checkpoint of an interrupted training run (`NAME.partial/member-M.safetensors`) that this
+    /// run cannot take (another recipe, seed or data; not a network).
+    #[error("{}: {message}", file.display())]
+    Checkpoint {
+        /// The checkpoint file.
+        file: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+    /// A data set that does not fit the model it is evaluated with (the model's space named).
+    #[error("{error}\n(the model {} was trained on space `{space}`)", model.display())]
+    DataForModel {
+        /// Why the data set was refused.
+        error: Box<Error>,
+        /// The model file.
+        model: PathBuf,
+        /// Name of the model's parameter space.
+        space: String,
+    },
+    /// A parameter list (NAME=VALUE pairs, or bare values in the model's order) that does not
+    /// fit the model's inputs.
+    #[error("{message}")]
+    Parameters {
+        /// What is wrong (names the item and the model's parameters).
+        message: String,
+    },
 }
 
 /// Result alias of the surrogate crate.

@@ -12,6 +12,7 @@
 mod error;
 mod generate;
 mod hash;
+pub mod job;
 mod model;
 mod sequence;
 mod space;

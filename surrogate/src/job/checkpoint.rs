@@ -1,0 +1,140 @@
+//! The files of a training run beside its model: the learning curves (`NAME.curves.csv`) and the
+//! checkpoints of finished ensemble members (`NAME.partial/member-M.safetensors` with
+//! `member-M.curves.csv`), from which an interrupted run resumes.
+
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+
+use crate::model::{EpochRecord, Member, ModelInfo, Predictor, Surrogate};
+use crate::{Error, Result};
+
+/// The learning-curve CSV beside a model: models/NAME.safetensors -> models/NAME.curves.csv.
+pub fn curves_path(model: &Path) -> PathBuf {
+    model.with_extension("curves.csv")
+}
+
+/// Where finished ensemble members of an unfinished run wait: models/NAME.partial/.
+pub fn partial_dir(model: &Path) -> PathBuf {
+    model.with_extension("partial")
+}
+
+/// Writes learning curves: a comment line naming `model` and this program's version, the header
+/// `member,epoch,cycle,lr,train_loss,test_loss,test_rel_rms,seconds`, one line per epoch (losses
+/// in `{:e}`, seconds with 3 decimals).
+pub fn write_curves(path: &Path, curves: &[EpochRecord], model: &Path) -> Result<()> {
+    let failed = |source| Error::RunFile {
+        action: "cannot write the learning curves",
+        file: path.into(),
+        source,
+    };
+    let mut f = std::fs::File::create(path).map_err(failed)?;
+    let mut text = format!(
+        "# learning curves of {} (hpge-cv {}): mean loss over each set after every epoch\n\
+         member,epoch,cycle,lr,train_loss,test_loss,test_rel_rms,seconds\n",
+        model.display(),
+        env!("CARGO_PKG_VERSION")
+    );
+    for r in curves {
+        text += &format!(
+            "{},{},{},{:e},{:e},{:e},{:e},{:.3}\n",
+            r.member, r.epoch, r.cycle, r.lr, r.train_loss, r.test_loss, r.test_rel_rms, r.seconds
+        );
+    }
+    f.write_all(text.as_bytes()).map_err(failed)
+}
+
+/// Reads the learning curves of checkpoint member `m` (the lines [`write_curves`] writes).
+fn read_curves(path: &Path, m: usize) -> Result<Vec<EpochRecord>> {
+    let text = std::fs::read_to_string(path).map_err(|source| Error::RunFile {
+        action: "cannot read",
+        file: path.into(),
+        source,
+    })?;
+    let mut records = Vec::new();
+    for line in text
+        .lines()
+        .filter(|l| !l.starts_with('#') && !l.starts_with("member"))
+    {
+        let v: Vec<f64> = line.split(',').filter_map(|x| x.parse().ok()).collect();
+        if v.len() != 8 {
+            return Err(Error::Parse {
+                file: path.into(),
+                message: format!("malformed line `{line}`"),
+            });
+        }
+        records.push(EpochRecord {
+            member: m,
+            epoch: v[1] as usize,
+            cycle: v[2] as usize,
+            lr: v[3],
+            train_loss: v[4],
+            test_loss: v[5],
+            test_rel_rms: v[6],
+            seconds: v[7],
+        });
+    }
+    Ok(records)
+}
+
+/// Checkpoints member m in `dir` (a one-member model file plus its learning curves).
+pub fn save_member(dir: &Path, info: &ModelInfo, m: usize, member: &Member) -> Result<()> {
+    std::fs::create_dir_all(dir).map_err(|source| Error::RunFile {
+        action: "cannot create the checkpoint folder",
+        file: dir.into(),
+        source,
+    })?;
+    let mut one = info.clone();
+    if let Some(r) = one.recipe.as_mut() {
+        r.members = 1;
+    }
+    let file = dir.join(format!("member-{m}.safetensors"));
+    Surrogate::new(one, Predictor::Networks(vec![member.0.clone()]))?.save(&file)?;
+    write_curves(
+        &dir.join(format!("member-{m}.curves.csv")),
+        &member.1,
+        &file,
+    )
+}
+
+/// Members finished by an interrupted run with the same recipe, seed and data (members 0, 1, ...
+/// as long as both files of each are in `dir`; none without the folder). Refuses a checkpoint of
+/// other settings ([`Error::Checkpoint`]).
+pub fn resume_members(dir: &Path, info: &ModelInfo) -> Result<Vec<Member>> {
+    let mut done = Vec::new();
+    loop {
+        let m = done.len();
+        let file = dir.join(format!("member-{m}.safetensors"));
+        let curves = dir.join(format!("member-{m}.curves.csv"));
+        if !file.is_file() || !curves.is_file() {
+            return Ok(done);
+        }
+        let s = Surrogate::load(&file)?;
+        let same = s.info.recipe_name == info.recipe_name
+            && s.info.seed == info.seed
+            && s.info.training.hash == info.training.hash
+            && s.info.test.hash == info.test.hash
+            && s.info.space.dimensions == info.space.dimensions;
+        if !same {
+            return Err(Error::Checkpoint {
+                message: format!(
+                    "a checkpoint of another run (recipe, seed or data differ); remove the \
+                     folder {} or choose another --out",
+                    dir.display()
+                ),
+                file,
+            });
+        }
+        let net = match s.predictor {
+            Predictor::Networks(nets) => nets.into_iter().next(),
+            Predictor::Polynomial(_) => None,
+        };
+        let Some(net) = net else {
+            return Err(Error::Checkpoint {
+                file,
+                message: "not a network checkpoint".into(),
+            });
+        };
+        let records = read_curves(&curves, m)?;
+        done.push((net, records));
+    }
+}

@@ -1,0 +1,157 @@
+//! The accuracy of a model on a data set of its space, as `hpge-cv evaluate` reports it: the
+//! figures of the relative errors and the worst samples; [`EvaluationJson`] is its `--json`
+//! record.
+
+use std::path::Path;
+
+use serde::Serialize;
+
+use crate::model::{DataSet, Figures, Surrogate};
+use crate::{Error, Result};
+
+/// One of the worst samples (largest |relative error|).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Worst {
+    /// Sample index (the data set's `index` column).
+    pub index: u64,
+    /// The model's inputs (name, physical value) in network order.
+    pub inputs: Vec<(String, f64)>,
+    /// The solver's c12 (pF).
+    pub c12_solver_pf: f64,
+    /// The surrogate's c12 (pF).
+    pub c12_surrogate_pf: f64,
+    /// (c_p - c_s)/c_s.
+    pub rel: f64,
+}
+
+/// A model's accuracy on a data set.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Evaluation {
+    /// Error figures (relative values as fractions).
+    pub figures: Figures,
+    /// Rows of the data set without c12, left out.
+    pub excluded: usize,
+    /// FNV-1a hash (hex) of the data file's bytes.
+    pub data_hash: String,
+    /// The model's recipe name.
+    pub recipe: String,
+    /// The model's sigma_p.
+    pub sigma_p: f64,
+    /// The worst samples, worst first.
+    pub worst: Vec<Worst>,
+    /// The model's c12 (pF) of every sample (for plots).
+    pub predictions: Vec<f64>,
+}
+
+/// `evaluate --json`: the fields first, then the rest (the field order is the JSON's).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct EvaluationJson<'a> {
+    /// Samples.
+    pub n: usize,
+    /// Gaussian sigma of the relative error.
+    pub rel_sigma: f64,
+    /// Its mean.
+    pub rel_mean: f64,
+    /// Median of |relative error|.
+    pub abs_rel_q50: f64,
+    /// 90% quantile of |relative error|.
+    pub abs_rel_q90: f64,
+    /// 99% quantile of |relative error|.
+    pub abs_rel_q99: f64,
+    /// Largest |relative error|.
+    pub abs_rel_max: f64,
+    /// 99.9% quantile of |relative error|.
+    pub abs_rel_q999: f64,
+    /// Root mean square of the relative error.
+    pub rel_rms: f64,
+    /// Root mean square of c_p - c_s (pF).
+    pub abs_rms_pf: f64,
+    /// Rows without c12, left out.
+    pub excluded: usize,
+    /// The model file as given.
+    pub model: String,
+    /// The data file as given.
+    pub data: String,
+    /// FNV-1a hash (hex) of the data file.
+    pub data_hash: &'a str,
+    /// The model's recipe name.
+    pub recipe: &'a str,
+    /// The model's sigma_p.
+    pub sigma_p: f64,
+    /// The worst samples, worst first.
+    pub worst: &'a [Worst],
+    /// This program's version.
+    pub program_version: &'static str,
+}
+
+/// Reads a data set against the space of `model` (loaded from `model_file`); a refusal names the
+/// model and its space ([`Error::DataForModel`]).
+pub fn read_for_model(model: &Surrogate, model_file: &Path, data: &Path) -> Result<DataSet> {
+    DataSet::read(data, &model.info.space).map_err(|e| Error::DataForModel {
+        error: Box::new(e),
+        model: model_file.into(),
+        space: model.info.space.name.clone(),
+    })
+}
+
+impl Evaluation {
+    /// The figures of `model` on `data` and its `worst` worst samples (by |relative error|;
+    /// ties keep the data set's order).
+    pub fn new(model: &Surrogate, data: &DataSet, worst: usize) -> Self {
+        let pred = model.predict_set(data);
+        let figures = Figures::of(&pred, &data.c12_pf);
+        let names = &model.info.inputs;
+        let rel = |i: usize| (pred[i] - data.c12_pf[i]) / data.c12_pf[i];
+        let mut order: Vec<usize> = (0..data.len()).collect();
+        order.sort_by(|&a, &b| rel(b).abs().total_cmp(&rel(a).abs()));
+        let worst = order
+            .iter()
+            .take(worst)
+            .map(|&i| Worst {
+                index: data.index[i],
+                inputs: names
+                    .iter()
+                    .cloned()
+                    .zip(data.physical_row(i).iter().copied())
+                    .collect(),
+                c12_solver_pf: data.c12_pf[i],
+                c12_surrogate_pf: pred[i],
+                rel: rel(i),
+            })
+            .collect();
+        Evaluation {
+            figures,
+            excluded: data.excluded,
+            data_hash: data.hash.clone(),
+            recipe: model.info.recipe_name.clone(),
+            sigma_p: model.sigma_p(),
+            worst,
+            predictions: pred,
+        }
+    }
+
+    /// The `--json` record, naming the model and data files as given.
+    pub fn json(&self, model_file: &Path, data_file: &Path) -> EvaluationJson<'_> {
+        let f = &self.figures;
+        EvaluationJson {
+            n: f.n,
+            rel_sigma: f.rel_sigma,
+            rel_mean: f.rel_mean,
+            abs_rel_q50: f.abs_rel_q50,
+            abs_rel_q90: f.abs_rel_q90,
+            abs_rel_q99: f.abs_rel_q99,
+            abs_rel_max: f.abs_rel_max,
+            abs_rel_q999: f.abs_rel_q999,
+            rel_rms: f.rel_rms,
+            abs_rms_pf: f.abs_rms_pf,
+            excluded: self.excluded,
+            model: model_file.display().to_string(),
+            data: data_file.display().to_string(),
+            data_hash: &self.data_hash,
+            recipe: &self.recipe,
+            sigma_p: self.sigma_p,
+            worst: &self.worst,
+            program_version: env!("CARGO_PKG_VERSION"),
+        }
+    }
+}

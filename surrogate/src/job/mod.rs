@@ -1,0 +1,17 @@
+//! The surrogate's application layer, as the `train`, `evaluate` and `predict` commands use it
+//! (and tests and other programs can, without the command line): a training run with its
+//! resumable checkpoints and learning curves ([`TrainJob`]), a model's accuracy on a data set
+//! ([`Evaluation`]) and parameter lists as a user writes them ([`parse_params`]).
+
+mod checkpoint;
+mod evaluate;
+mod params;
+mod train;
+
+#[cfg(test)]
+mod tests;
+
+pub use checkpoint::{curves_path, partial_dir, resume_members, save_member, write_curves};
+pub use evaluate::{Evaluation, EvaluationJson, Worst, read_for_model};
+pub use params::parse_params;
+pub use train::{POLYNOMIAL_RECIPE, TrainEvent, TrainJob, TrainOutcome, detector_info};

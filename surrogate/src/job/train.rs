@@ -1,0 +1,284 @@
+//! A training run as `hpge-cv train` does it: read and check the data sets, assemble the model
+//! file's metadata, train (ensembles member by member, resuming the members an interrupted run
+//! left in `NAME.partial/`), and write the model file and its learning curves. Progress is
+//! reported through a callback ([`TrainEvent`]); drawing it is the caller's business.
+
+use std::path::{Path, PathBuf};
+
+use hpge_solver::FieldSettings;
+
+use super::checkpoint::{curves_path, partial_dir, resume_members, save_member, write_curves};
+use crate::generate::ExactSolver;
+use crate::model::{
+    DataInfo, DataSet, DetectorInfo, EpochRecord, FORMAT, FORMAT_VERSION, Figures, Member,
+    ModelInfo, OutputTransform, Polynomial, Predictor, Recipe, Surrogate, Trained, network_order,
+    output_transform, train_resuming, unit_to_z,
+};
+use crate::space::ParameterSpace;
+use crate::{Error, Result};
+
+/// Name of the polynomial baseline among the recipes (degree-3 polynomial in z, fitted by least
+/// squares; no network).
+pub const POLYNOMIAL_RECIPE: &str = "poly3";
+
+/// The input normalisation recorded in every model file, in words.
+const INPUT_MAP: &str = "u = (x - lo)/(hi - lo) per the space's distribution, clamped to \
+                         [1e-6, 1 - 1e-6]; z = Phi^-1(u) (standard-normal coordinates)";
+
+/// One training run: its inputs and the model file it writes.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TrainJob {
+    /// Training rows (a `generate` rows file or a subset).
+    pub data: PathBuf,
+    /// Test rows (learning curves, the model's test figures and sigma_p).
+    pub test: PathBuf,
+    /// The parameter space file both data sets were generated in.
+    pub space: PathBuf,
+    /// Recipe name: one of [`crate::RECIPES`] or [`POLYNOMIAL_RECIPE`].
+    pub recipe: String,
+    /// Seed of initialisation and batch order (member m uses seed + m).
+    pub seed: u64,
+    /// The detector the rows were simulated for: recorded (file and hash) in the model's
+    /// metadata, checked against the space on the way.
+    pub detector: Option<PathBuf>,
+    /// The model file to write (`NAME.safetensors`; the curves go to `NAME.curves.csv`, the
+    /// checkpoints of finished members to `NAME.partial/`).
+    pub out: PathBuf,
+}
+
+/// What a training run reports while it works, in this order.
+#[derive(Debug, Clone, Copy)]
+pub enum TrainEvent<'a> {
+    /// Both data sets are read and checked against the space.
+    DataRead {
+        /// The training set.
+        train: &'a DataSet,
+        /// The test set.
+        test: &'a DataSet,
+    },
+    /// Network training starts (not sent for the polynomial): epochs of all members together,
+    /// and the members taken from the checkpoint folder of an interrupted run.
+    NetworksStart {
+        /// Epochs of the whole run (epochs per member times members).
+        total_epochs: u64,
+        /// Epochs of the members taken from the checkpoints.
+        resumed_epochs: u64,
+        /// Members taken from the checkpoints (0 for a fresh run).
+        resumed: usize,
+        /// Members of the recipe.
+        members: usize,
+        /// The checkpoint folder.
+        partial: &'a Path,
+    },
+    /// An epoch of a network finished.
+    Epoch(&'a EpochRecord),
+    /// Network training ended (the model file is written next; not sent for the polynomial).
+    NetworksDone,
+}
+
+/// The result of [`TrainJob::run`].
+#[derive(Debug, Clone)]
+pub struct TrainOutcome {
+    /// The model as written (its metadata carries the test figures and sigma_p).
+    pub model: Surrogate,
+    /// Learning curves of all members (empty for the polynomial).
+    pub curves: Vec<EpochRecord>,
+    /// The learning-curve file, when written (networks only).
+    pub curves_file: Option<PathBuf>,
+    /// Training wall time (s).
+    pub seconds: f64,
+    /// The model's c12 (pF) of each test sample.
+    pub test_predictions: Vec<f64>,
+    /// The solver's c12 (pF) of each test sample.
+    pub test_c12_pf: Vec<f64>,
+}
+
+/// The detector record of a model: the file and the hash a generation run's fingerprint gives
+/// it (the detector is checked against the space on the way).
+pub fn detector_info(space: &ParameterSpace, detector: &Path) -> Result<DetectorInfo> {
+    let exact = ExactSolver::new(space.clone(), detector, FieldSettings::default())?;
+    Ok(DetectorInfo {
+        file: detector.display().to_string(),
+        hash: exact.detector_hash(),
+    })
+}
+
+/// An error as error-chain printers show it: its text, then each source after a colon.
+fn with_sources(e: &dyn std::error::Error) -> String {
+    let mut text = e.to_string();
+    let mut cause = e.source();
+    while let Some(c) = cause {
+        text += &format!(": {c}");
+        cause = c.source();
+    }
+    text
+}
+
+impl TrainJob {
+    /// Checks the output path: it must end in `.safetensors` and its folder must exist
+    /// ([`Error::ModelPath`]). [`Self::run`] checks it first.
+    pub fn check_out(&self) -> Result<()> {
+        let bad = |message: String| Error::ModelPath {
+            file: self.out.clone(),
+            message,
+        };
+        if self.out.extension().and_then(|e| e.to_str()) != Some("safetensors") {
+            return Err(bad("the model file must end in .safetensors".into()));
+        }
+        if let Some(dir) = self.out.parent().filter(|d| !d.as_os_str().is_empty())
+            && !dir.is_dir()
+        {
+            return Err(bad(format!("the folder {} does not exist", dir.display())));
+        }
+        Ok(())
+    }
+
+    /// Trains, evaluates on the test set and writes the model file and (networks) its learning
+    /// curves; removes the checkpoint folder once the model is written.
+    pub fn run(&self, progress: &mut dyn FnMut(TrainEvent<'_>)) -> Result<TrainOutcome> {
+        self.check_out()?;
+        let space = ParameterSpace::from_file(&self.space)?;
+        let recipe = if self.recipe == POLYNOMIAL_RECIPE {
+            None
+        } else {
+            Some(Recipe::named(&self.recipe)?)
+        };
+        let train = DataSet::read(&self.data, &space)?;
+        let test = DataSet::read(&self.test, &space)?;
+        progress(TrainEvent::DataRead {
+            train: &train,
+            test: &test,
+        });
+        let start = std::time::Instant::now();
+        let mut info = self.model_info(&space, recipe.as_ref(), &train, &test)?;
+        let (predictor, curves, seconds) = match &recipe {
+            Some(recipe) => {
+                let Trained {
+                    members,
+                    curves,
+                    seconds,
+                    ..
+                } = self.train_networks(recipe, &info, &train, &test, progress)?;
+                progress(TrainEvent::NetworksDone);
+                (Predictor::Networks(members), curves, seconds)
+            }
+            None => {
+                let z: Vec<f64> = train.unit.iter().map(|&u| unit_to_z(u)).collect();
+                let OutputTransform::LogStandardised { mean, sd } = info.output else {
+                    return Err(Error::Training {
+                        message: "the polynomial learns ln c12".into(),
+                    });
+                };
+                let t: Vec<f64> = train.c12_pf.iter().map(|c| (c.ln() - mean) / sd).collect();
+                let p = Polynomial::fit(train.dim, 3, &z, &t)?;
+                (
+                    Predictor::Polynomial(p),
+                    Vec::new(),
+                    start.elapsed().as_secs_f64(),
+                )
+            }
+        };
+        info.train_seconds = seconds;
+        let mut model = Surrogate::new(info.clone(), predictor)?;
+        let pred = model.predict_set(&test);
+        info.test_figures = Figures::of(&pred, &test.c12_pf);
+        info.sigma_p = info.test_figures.rel_sigma;
+        model.info = info;
+        model.save(&self.out)?;
+        let partial = partial_dir(&self.out);
+        if partial.is_dir() {
+            std::fs::remove_dir_all(&partial).map_err(|source| Error::RunFile {
+                action: "cannot remove the checkpoints",
+                file: partial.clone(),
+                source,
+            })?;
+        }
+        let curves_file = if curves.is_empty() {
+            None
+        } else {
+            let file = curves_path(&self.out);
+            write_curves(&file, &curves, &self.out)?;
+            Some(file)
+        };
+        Ok(TrainOutcome {
+            model,
+            curves,
+            curves_file,
+            seconds,
+            test_predictions: pred,
+            test_c12_pf: test.c12_pf,
+        })
+    }
+
+    /// The model file's metadata before training (no test figures yet, sigma_p NaN).
+    fn model_info(
+        &self,
+        space: &ParameterSpace,
+        recipe: Option<&Recipe>,
+        train: &DataSet,
+        test: &DataSet,
+    ) -> Result<ModelInfo> {
+        let inputs: Vec<String> = network_order(space)?
+            .iter()
+            .map(|&j| space.dimensions[j].name.clone())
+            .collect();
+        let log_output = recipe.is_none_or(|r| r.log_output);
+        Ok(ModelInfo {
+            format: FORMAT.into(),
+            format_version: FORMAT_VERSION,
+            program_version: env!("CARGO_PKG_VERSION").into(),
+            space: space.clone(),
+            inputs,
+            input_map: INPUT_MAP.into(),
+            output: output_transform(log_output, train),
+            recipe_name: self.recipe.clone(),
+            recipe: recipe.cloned(),
+            seed: self.seed,
+            training: DataInfo::of(train),
+            test: DataInfo::of(test),
+            train_seconds: 0.0,
+            threads: std::thread::available_parallelism().map_or(1, |n| n.get()),
+            test_figures: Figures::of(&[], &[]),
+            detector: match &self.detector {
+                Some(d) => Some(detector_info(space, d)?),
+                None => None,
+            },
+            sigma_p: f64::NAN,
+        })
+    }
+
+    /// Trains the ensemble member by member, taking finished members from the checkpoint folder
+    /// and checkpointing each new one.
+    fn train_networks(
+        &self,
+        recipe: &Recipe,
+        info: &ModelInfo,
+        train: &DataSet,
+        test: &DataSet,
+        progress: &mut dyn FnMut(TrainEvent<'_>),
+    ) -> Result<Trained> {
+        let partial = partial_dir(&self.out);
+        let finished = resume_members(&partial, info)?;
+        progress(TrainEvent::NetworksStart {
+            total_epochs: (recipe.total_epochs() * recipe.members) as u64,
+            resumed_epochs: (finished.len() * recipe.total_epochs()) as u64,
+            resumed: finished.len(),
+            members: recipe.members,
+            partial: &partial,
+        });
+        let mut checkpoint = |m: usize, member: &Member| -> Result<()> {
+            save_member(&partial, info, m, member).map_err(|e| Error::Training {
+                message: with_sources(&e),
+            })
+        };
+        train_resuming(
+            recipe,
+            train,
+            test,
+            self.seed,
+            finished,
+            &mut |r| progress(TrainEvent::Epoch(r)),
+            &mut checkpoint,
+        )
+    }
+}
