@@ -7,11 +7,11 @@ use std::path::Path;
 
 use anyhow::{Context, Result};
 use hpge_inference::{Fit, Prior};
+use hpge_reports::plot::{ZetaAtMode, ZetaProfile};
 use hpge_surrogate::ExactSolver;
 use serde::Serialize;
 
 use super::fit::{FitOptions, Setup};
-use crate::plot::{ZetaAtMode, ZetaProfile};
 
 /// Truth values by parameter name (a TOML table NAME = VALUE).
 pub fn read_truth(path: &Path, prior: &Prior) -> Result<Vec<Option<f64>>> {
@@ -181,7 +181,7 @@ pub fn write_outputs(
         let truth_vals: Option<Vec<f64>> =
             truth.map(|t| t.iter().map(|v| v.unwrap_or(f64::NAN)).collect());
         let title = format!("{} fit", s.prior.name);
-        figures = crate::plot::fit_figures(
+        figures = hpge_reports::plot::fit_figures(
             &o.out.join("figures"),
             fit,
             &zeta,

@@ -318,9 +318,9 @@ pub fn train(o: &TrainOptions) -> Result<()> {
     }
     if let Some(dir) = o.plot {
         if !curves.is_empty() {
-            crate::plot::learning_curves(&curves, &model.info, dir)?;
+            hpge_reports::plot::learning_curves(&curves, &model.info, dir)?;
         }
-        crate::plot::surrogate_errors(&pred, &test.c12_pf, &model.info, "test", dir)?;
+        hpge_reports::plot::surrogate_errors(&pred, &test.c12_pf, &model.info, "test", dir)?;
     }
     let f = &model.info.test_figures;
     if !o.quiet {
@@ -421,7 +421,7 @@ pub fn evaluate(o: &EvaluateOptions) -> Result<()> {
         })
         .collect();
     if let Some(dir) = o.plot {
-        crate::plot::surrogate_errors(&pred, &data.c12_pf, &model.info, "evaluated", dir)?;
+        hpge_reports::plot::surrogate_errors(&pred, &data.c12_pf, &model.info, "evaluated", dir)?;
     }
     if o.json {
         let j = EvaluateJson {

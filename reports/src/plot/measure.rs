@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use anyhow::Result;
+use crate::Result;
 use hpge_inference::{Measurement, PulseSet, VoltagePoint, negative_slopes};
 use plotters::coord::Shift;
 use plotters::prelude::*;

@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use anyhow::Result;
+use crate::Result;
 use hpge_surrogate::{EpochRecord, Figures, ModelInfo};
 use plotters::coord::Shift;
 use plotters::prelude::*;

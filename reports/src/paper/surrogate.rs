@@ -7,17 +7,20 @@
 
 use std::path::Path;
 
-use anyhow::{Context, Result, bail};
 use hpge_surrogate::{DataSet, EpochRecord, Figures, Surrogate};
 use serde_json::json;
 
-use super::{Ctx, verdict};
+use super::ctx::{Ctx, verdict};
 use crate::plot;
+use crate::{Error, Result};
 
 /// The learning curves `train` wrote beside a model (`<stem>.curves.csv`).
 fn read_curves(path: &Path) -> Result<Vec<EpochRecord>> {
-    let text = std::fs::read_to_string(path)
-        .with_context(|| format!("{}: cannot read the learning curves", path.display()))?;
+    let text = std::fs::read_to_string(path).map_err(|source| Error::Read {
+        file: path.to_path_buf(),
+        what: "the learning curves",
+        source,
+    })?;
     let mut out = Vec::new();
     for line in text
         .lines()
@@ -25,7 +28,10 @@ fn read_curves(path: &Path) -> Result<Vec<EpochRecord>> {
     {
         let v: Vec<f64> = line.split(',').filter_map(|x| x.parse().ok()).collect();
         if v.len() != 8 {
-            bail!("{}: malformed line `{line}`", path.display());
+            return Err(Error::Content {
+                file: path.to_path_buf(),
+                message: format!("malformed line `{line}`"),
+            });
         }
         out.push(EpochRecord {
             member: v[0] as usize,
@@ -39,7 +45,10 @@ fn read_curves(path: &Path) -> Result<Vec<EpochRecord>> {
         });
     }
     if out.is_empty() {
-        bail!("{}: no learning-curve rows", path.display());
+        return Err(Error::Content {
+            file: path.to_path_buf(),
+            message: "no learning-curve rows".into(),
+        });
     }
     Ok(out)
 }
@@ -52,15 +61,15 @@ fn heldout(model: &Surrogate, data: &Path) -> Result<(Vec<f64>, Vec<f64>, Figure
     Ok((pred, set.c12_pf.clone(), f, set.excluded))
 }
 
+/// Draws the learning curves and the held-out errors and adds their README rows.
 pub fn run(ctx: &mut Ctx) -> Result<()> {
     let tmp = ctx.out.join("surrogate");
-    std::fs::create_dir_all(&tmp)
-        .with_context(|| format!("cannot create the folder {}", tmp.display()))?;
+    std::fs::create_dir_all(&tmp).map_err(Error::io(&tmp, "cannot create the folder"))?;
     let model = Surrogate::load(&ctx.inputs.paper_model)?;
     let curves = read_curves(&ctx.inputs.paper_model.with_extension("curves.csv"))?;
     plot::learning_curves(&curves, &model.info, &tmp)?;
     ctx.copy_both(&tmp, "learning-curves", "surrogate-learning-curves")?;
-    let last = curves.last().context("no epochs")?;
+    let last = curves.last().ok_or_else(|| Error::invalid("no epochs"))?;
     let first = &curves[0];
     let cycles = curves.iter().map(|r| r.cycle).max().unwrap_or(0);
     ctx.row(

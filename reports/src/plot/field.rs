@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use anyhow::Result;
+use crate::Result;
 use hpge_solver::{Detector, PotentialPoint};
 use plotters::coord::Shift;
 use plotters::prelude::*;

@@ -5,7 +5,7 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context as _, Result, bail};
+use crate::{Error, Result};
 use hpge_inference::Discovery;
 use hpge_solver::{BoundingBox, Detector};
 use plotters::coord::Shift;
@@ -66,20 +66,19 @@ fn window_color(i: usize) -> RGBColor {
 pub fn discovery_figures(d: &Discovery, det: &Detector, out: &Path) -> Result<Vec<PathBuf>> {
     let n = d.voltage_v.len();
     if n == 0 {
-        bail!("the discovery has no voltages to plot");
+        invalid!("the discovery has no voltages to plot");
     }
     let fits = std::iter::once(&d.before).chain(&d.after);
     for f in fits {
         if f.check.residuals.len() != n {
-            bail!(
+            invalid!(
                 "{}: {} residuals for {n} voltages",
                 f.model,
                 f.check.residuals.len()
             );
         }
     }
-    std::fs::create_dir_all(out)
-        .with_context(|| format!("cannot create the folder {}", out.display()))?;
+    std::fs::create_dir_all(out).map_err(Error::io(out, "cannot create the folder"))?;
     let mut paths = Vec::new();
     for ext in ["svg", "png"] {
         let p = out.join(format!("residuals.{ext}"));

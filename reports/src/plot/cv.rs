@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use anyhow::Result;
+use crate::Result;
 use hpge_solver::{CvCurve, Detector};
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -36,8 +36,8 @@ fn draw<DB: DrawingBackend>(
         "{}: simulated C-V curve ({}; {} {})",
         det.name,
         det.semiconductor.impurity_file().display(),
-        env!("CARGO_PKG_NAME"),
-        env!("CARGO_PKG_VERSION")
+        crate::PROGRAM,
+        crate::VERSION
     );
     let mut chart = ChartBuilder::on(root)
         .caption(title, ("sans-serif", 20))

@@ -4,11 +4,11 @@
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
-use anyhow::{Context, Result};
 use hpge_surrogate::fnv1a;
 use serde_json::json;
 
-use super::Ctx;
+use super::ctx::Ctx;
+use crate::{Error, Result};
 
 /// The paper's figures this report does not make, and why.
 const NOT_MADE: &str = "Figs. 1-4 and 6 (schemes and photographs), 5 and 7 (pulser pulses and \
@@ -31,7 +31,7 @@ pub fn write(ctx: &Ctx, total_s: f64) -> Result<PathBuf> {
     writeln!(
         t,
         "# The paper's figures, remade by hpge-cv {}\n",
-        env!("CARGO_PKG_VERSION")
+        crate::VERSION
     )?;
     writeln!(
         t,
@@ -127,10 +127,10 @@ pub fn write(ctx: &Ctx, total_s: f64) -> Result<PathBuf> {
     }
     writeln!(t, "| **total** | **{total_s:.1}** |")?;
     let readme = ctx.out.join("README.md");
-    std::fs::write(&readme, t).with_context(|| format!("cannot write {}", readme.display()))?;
+    std::fs::write(&readme, t).map_err(Error::io(&readme, "cannot write"))?;
     let j = json!({
-        "program": env!("CARGO_PKG_NAME"),
-        "version": env!("CARGO_PKG_VERSION"),
+        "program": crate::PROGRAM,
+        "version": crate::VERSION,
         "quick": ctx.quick,
         "exact_check": ctx.exact_check,
         "inputs": ctx.inputs.all().iter().map(|p| json!({"file": p.display().to_string(), "hash": hash(p)})).collect::<Vec<_>>(),
@@ -142,6 +142,6 @@ pub fn write(ctx: &Ctx, total_s: f64) -> Result<PathBuf> {
     });
     let path = ctx.out.join("report.json");
     std::fs::write(&path, serde_json::to_string_pretty(&j)? + "\n")
-        .with_context(|| format!("cannot write {}", path.display()))?;
+        .map_err(Error::io(&path, "cannot write"))?;
     Ok(readme)
 }

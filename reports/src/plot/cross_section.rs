@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use anyhow::Result;
+use crate::Result;
 use hpge_solver::{BoundaryKind, Detector, PassiveKind, Region, WorldSide};
 use plotters::coord::Shift;
 use plotters::coord::types::RangedCoordf64;
@@ -277,8 +277,8 @@ fn draw_title<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, det: &Detector)
     let line1 = format!(
         "{}: r-z cross-section (axisymmetric)   [{} {}]",
         det.name,
-        env!("CARGO_PKG_NAME"),
-        env!("CARGO_PKG_VERSION")
+        crate::PROGRAM,
+        crate::VERSION
     );
     let line2 = format!(
         "impurity model \"{}\" ({}){}",

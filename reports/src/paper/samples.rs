@@ -1,13 +1,13 @@
 //! The paper's Fig. 16 (section 7): the distributions of zeta_1^bot and zeta_4^bot over the
 //! generated training and test samples (the points of `data/training/train.csv` and `test.csv`).
 
-use anyhow::{Context, Result, bail};
 use hpge_solver::LogTransform;
 use hpge_surrogate::{ParameterSpace, Sequence, SequenceKind};
 use serde_json::json;
 
-use super::{Ctx, verdict};
+use super::ctx::{Ctx, verdict};
 use crate::plot::{self, Corner, Curve, LineFigure};
+use crate::{Error, Result};
 
 /// (column, y range, histogram range in signed log10 zeta, bins, stem, title).
 struct Param {
@@ -44,7 +44,10 @@ const PARAMS: [Param; 2] = [
 /// but the points they were solved at follow from the sequence alone.
 fn column(space: &ParameterSpace, name: &str, range: std::ops::Range<u64>) -> Result<Vec<f64>> {
     let Some(k) = space.dimensions.iter().position(|d| d.name == name) else {
-        bail!("the space {} has no dimension `{name}`", space.name);
+        return Err(Error::invalid(format!(
+            "the space {} has no dimension `{name}`",
+            space.name
+        )));
     };
     let seq = Sequence::new(SequenceKind::Golden, space.dim(), 0);
     Ok(range.map(|n| space.from_unit(&seq.point(n))[k]).collect())
@@ -83,6 +86,7 @@ fn histogram(label: String, slog: &[f64], p: &Param) -> Curve {
     Curve { label, points }
 }
 
+/// Draws both histograms and adds their README rows.
 pub fn run(ctx: &mut Ctx) -> Result<()> {
     let t = LogTransform::default();
     let slog = |y: f64| {
@@ -93,8 +97,10 @@ pub fn run(ctx: &mut Ctx) -> Result<()> {
             z.signum() * z.abs().log10().max(0.0)
         }
     };
-    let space = ParameterSpace::from_file(&ctx.inputs.space)
-        .with_context(|| format!("the space {}", ctx.inputs.space.display()))?;
+    let space = ParameterSpace::from_file(&ctx.inputs.space).map_err(|source| Error::Space {
+        file: ctx.inputs.space.clone(),
+        source,
+    })?;
     let sets = [("training", 0..48_000u64), ("test", 48_000..60_000u64)];
     let mut numbers = serde_json::Map::new();
     for p in &PARAMS {
@@ -127,7 +133,7 @@ pub fn run(ctx: &mut Ctx) -> Result<()> {
             legend: Corner::MiddleMiddle,
             footnotes: vec![format!(
                 "hpge-cv {} report paper: {}, golden sequence seed 0, indices 0..47999 (training), 48000..59999 (test); {}",
-                env!("CARGO_PKG_VERSION"),
+                crate::VERSION,
                 ctx.inputs.space.display(),
                 notes.join("; ")
             )],

@@ -5,7 +5,7 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context as _, Result, bail};
+use crate::{Error, Result};
 use hpge_validation::{CoverageReport, ParameterCoverage, binomial_interval};
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -41,14 +41,14 @@ const FAIL: RGBColor = RGBColor(214, 39, 40);
 pub fn coverage_figures(dir: &Path, report: &CoverageReport, title: &str) -> Result<Vec<PathBuf>> {
     let params = &report.parameters;
     if params.is_empty() {
-        bail!("the coverage report has no parameters to plot");
+        invalid!("the coverage report has no parameters to plot");
     }
     for p in params {
         if let Some(r) = p.ranks.iter().find(|&&r| r > report.ranks) {
-            bail!("{}: rank {r} exceeds L = {} draws", p.name, report.ranks);
+            invalid!("{}: rank {r} exceeds L = {} draws", p.name, report.ranks);
         }
         if p.coverage_curve.len() != report.levels.len() {
-            bail!(
+            invalid!(
                 "{}: {} coverage values for {} levels",
                 p.name,
                 p.coverage_curve.len(),
@@ -56,8 +56,7 @@ pub fn coverage_figures(dir: &Path, report: &CoverageReport, title: &str) -> Res
             );
         }
     }
-    std::fs::create_dir_all(dir)
-        .with_context(|| format!("cannot create the folder {}", dir.display()))?;
+    std::fs::create_dir_all(dir).map_err(Error::io(dir, "cannot create the folder"))?;
     let mut out = Vec::new();
     let cols = COLUMNS.min(params.len());
     let rows = params.len().div_ceil(cols);

@@ -6,7 +6,7 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context as _, Result, bail};
+use crate::{Error, Result};
 use hpge_inference::{Fit, ParameterSummary};
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -67,28 +67,27 @@ pub fn fit_figures(
     let params = &fit.summary.parameters;
     let d = params.len();
     if d == 0 {
-        bail!("the fit has no parameters to plot");
+        invalid!("the fit has no parameters to plot");
     }
     let draws: usize = fit.samples.chains.iter().map(|c| c.theta.len()).sum();
     if draws == 0 {
-        bail!("the fit has no draws to plot");
+        invalid!("the fit has no draws to plot");
     }
     let all_d = fit.samples.chains.iter().flat_map(|c| &c.theta);
     if let Some(t) = all_d.clone().find(|t| t.len() != d) {
-        bail!("a draw has {} values, the summary {d} parameters", t.len());
+        invalid!("a draw has {} values, the summary {d} parameters", t.len());
     }
     if let Some(t) = truth
         && t.len() != d
     {
-        bail!("the truth has {} values, the fit {d} parameters", t.len());
+        invalid!("the truth has {} values, the fit {d} parameters", t.len());
     }
     for &(a, b) in pairs {
         if a >= d || b >= d || a == b {
-            bail!("the pair ({a}, {b}) needs two different parameter indices below {d}");
+            invalid!("the pair ({a}, {b}) needs two different parameter indices below {d}");
         }
     }
-    std::fs::create_dir_all(dir)
-        .with_context(|| format!("cannot create the folder {}", dir.display()))?;
+    std::fs::create_dir_all(dir).map_err(Error::io(dir, "cannot create the folder"))?;
     let mut out = Vec::new();
     let (rows, cols) = grid(d, 3);
     let size = (1500, 100 + 380 * rows as u32);

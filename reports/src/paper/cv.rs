@@ -4,15 +4,15 @@
 
 use std::path::Path;
 
-use anyhow::{Result, bail};
 use hpge_inference::{Data, load_data};
 use hpge_solver::{CvCurve, Detector, FieldSettings, Parameters, cv_curve};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use serde_json::json;
 
-use super::{Ctx, verdict};
+use super::ctx::{Ctx, verdict};
 use crate::plot::{Format, err};
+use crate::{Error, Result};
 
 /// The figure's stem.
 pub const STEM: &str = "cv-data-vs-manufacturer";
@@ -23,10 +23,16 @@ const D_LI_MM: f64 = 1.0;
 /// The slope (pF/V) that defines the full-depletion voltage of the data (section 4).
 const FD_SLOPE: f64 = 1e-3;
 
+/// Draws the figure and adds its README row.
 pub fn run(ctx: &mut Ctx) -> Result<()> {
     let data = match load_data(&ctx.inputs.data)? {
         Data::Curve(c) => c,
-        Data::Raw(_) => bail!("{}: expected a C-V curve", ctx.inputs.data.display()),
+        Data::Raw(_) => {
+            return Err(Error::Content {
+                file: ctx.inputs.data.clone(),
+                message: "expected a C-V curve".into(),
+            });
+        }
     };
     let mut p = Parameters::new();
     p.set("d_li_mm".to_string(), D_LI_MM);
@@ -46,7 +52,7 @@ pub fn run(ctx: &mut Ctx) -> Result<()> {
         .map(|(u, _)| u[1]);
     let (first, last) = match (curve.points.first(), curve.points.last()) {
         (Some(a), Some(b)) => (a, b),
-        _ => bail!("the simulated curve is empty"),
+        _ => return Err(Error::invalid("the simulated curve is empty")),
     };
     let c_m = |u: f64| {
         data.voltage_v
@@ -61,7 +67,7 @@ pub fn run(ctx: &mut Ctx) -> Result<()> {
     let foot = [
         format!(
             "hpge-cv {} report paper: data {} ({} points, a stand-in: see its README);",
-            env!("CARGO_PKG_VERSION"),
+            crate::VERSION,
             ctx.inputs.data.display(),
             data.voltage_v.len(),
         ),
@@ -131,7 +137,10 @@ fn figure(path: &Path, data: &[(f64, f64, f64)], sim: &CvCurve, foot: &[String])
             draw(&root, data, sim, foot)?;
             root.present().map_err(err)
         }
-        None => bail!("{}: use .svg or .png", path.display()),
+        None => Err(Error::UnknownFormat {
+            file: path.to_path_buf(),
+            message: "use .svg or .png",
+        }),
     }
 }
 

@@ -198,7 +198,7 @@ fn synthetic(extended: bool) -> Discovery {
 }
 
 fn detector() -> Detector {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("detectors/super-siegfried-k1.toml");
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../detectors/super-siegfried-k1.toml");
     Detector::from_file(&path, &Default::default()).unwrap()
 }
 

@@ -4,11 +4,12 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result, anyhow};
 use hpge_inference::{CvModel, ExactModel, Prior, PriorSpec};
 use hpge_solver::{Detector, FieldSettings, Parameters};
 use hpge_surrogate::{ExactSolver, Surrogate};
 use serde_json::Value;
+
+use crate::{Error, Result};
 
 /// One impurity model of the comparison and where it came from.
 #[derive(Debug, Clone)]
@@ -96,13 +97,20 @@ impl ModeDetectors {
 
 /// The `global_mode` of each parameter in `names` from a fit summary.
 pub fn global_mode(summary: &Path, names: &[String]) -> Result<Vec<f64>> {
-    let text = std::fs::read_to_string(summary)
-        .with_context(|| format!("{}: cannot read the fit summary", summary.display()))?;
-    let v: Value = serde_json::from_str(&text)
-        .with_context(|| format!("{}: not a JSON fit summary", summary.display()))?;
-    let params = v["parameters"]
-        .as_array()
-        .ok_or_else(|| anyhow!("{}: no `parameters` list", summary.display()))?;
+    let text = std::fs::read_to_string(summary).map_err(|source| Error::Read {
+        file: summary.to_path_buf(),
+        what: "the fit summary",
+        source,
+    })?;
+    let v: Value = serde_json::from_str(&text).map_err(|source| Error::Json {
+        file: summary.to_path_buf(),
+        what: "not a JSON fit summary",
+        source,
+    })?;
+    let params = v["parameters"].as_array().ok_or_else(|| Error::Content {
+        file: summary.to_path_buf(),
+        message: "no `parameters` list".into(),
+    })?;
     names
         .iter()
         .map(|n| {
@@ -110,11 +118,9 @@ pub fn global_mode(summary: &Path, names: &[String]) -> Result<Vec<f64>> {
                 .iter()
                 .find(|p| p["name"].as_str() == Some(n))
                 .and_then(|p| p["global_mode"].as_f64())
-                .ok_or_else(|| {
-                    anyhow!(
-                        "{}: no `global_mode` for the parameter `{n}`",
-                        summary.display()
-                    )
+                .ok_or_else(|| Error::Content {
+                    file: summary.to_path_buf(),
+                    message: format!("no `global_mode` for the parameter `{n}`"),
                 })
         })
         .collect()

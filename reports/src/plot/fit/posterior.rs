@@ -1,6 +1,6 @@
 //! Figures of the draws: marginals, 2D marginals of pairs, traces.
 
-use anyhow::Result;
+use crate::Result;
 use hpge_inference::{Fit, LEVELS, ParameterSummary};
 use plotters::coord::Shift;
 use plotters::prelude::*;

@@ -2,16 +2,17 @@
 //! p_zeta,E along z and r) and the detector's cross-section (Fig. 9): with the manufacturer's model
 //! and with the example density (d_Li = 3 mm, as `reports/make-figures.sh` draws it).
 
-use anyhow::Result;
 use hpge_solver::{Detector, LogTransform, Parameters};
 use serde_json::json;
 
-use super::{Ctx, verdict};
+use super::ctx::{Ctx, verdict};
+use crate::Result;
 use crate::plot::{self, Corner, Curve, LineFigure};
 
 /// y = 0.018566145 is zeta_l = 1e8 cm^-3 (the paper's prior bound).
 const Y_L: f64 = 0.018566145;
 
+/// Draws the transform, the example density and both cross-sections, with their README rows.
 pub fn run(ctx: &mut Ctx) -> Result<()> {
     transform(ctx)?;
     example(ctx)?;
@@ -63,7 +64,7 @@ fn transform(ctx: &mut Ctx) -> Result<()> {
         legend: Corner::UpperLeft,
         footnotes: vec![format!(
             "hpge-cv {} report paper: LogTransform defaults v = {}, g = {}; paper Eqs. (18)-(20)",
-            env!("CARGO_PKG_VERSION"),
+            crate::VERSION,
             t.v,
             t.g
         )],
@@ -107,7 +108,7 @@ fn example(ctx: &mut Ctx) -> Result<()> {
     let lin = |a: f64, c: f64| (0..n).map(move |i| a + (c - a) * i as f64 / (n - 1) as f64);
     let foot = format!(
         "hpge-cv {} report paper: {} with {} (p_zeta,E), d_Li = 3 mm; gaps: outside the semiconductor",
-        env!("CARGO_PKG_VERSION"),
+        crate::VERSION,
         ctx.inputs.detector.display(),
         ctx.inputs.example_impurity.display()
     );

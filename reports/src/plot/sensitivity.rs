@@ -2,15 +2,30 @@
 
 use std::path::Path;
 
-use anyhow::Result;
+use crate::Result;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::{err, log_key_points};
-use crate::cli::ScanPoint;
+
+/// One point of a sensitivity scan: c12 at the bias for one constant impurity density.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SensitivityPoint {
+    /// Constant net impurity density, cm^-3 (positive: n-type).
+    pub zeta_cm3: f64,
+    /// c12 at the bias, pF.
+    pub c12_pf: f64,
+    /// No undepleted semiconductor at the bias (drawn as a filled marker).
+    pub fully_depleted: bool,
+}
 
 /// Draws c12 against zeta (both log scale); filled markers: fully depleted at the bias.
-pub fn sensitivity(points: &[ScanPoint], voltage_v: f64, name: &str, path: &Path) -> Result<()> {
+pub fn sensitivity(
+    points: &[SensitivityPoint],
+    voltage_v: f64,
+    name: &str,
+    path: &Path,
+) -> Result<()> {
     render!(path, (1000, 700), |root, _svg| draw(
         &root, points, voltage_v, name
     ))
@@ -18,7 +33,7 @@ pub fn sensitivity(points: &[ScanPoint], voltage_v: f64, name: &str, path: &Path
 
 fn draw<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
-    points: &[ScanPoint],
+    points: &[SensitivityPoint],
     voltage_v: f64,
     name: &str,
 ) -> Result<()> {
@@ -40,8 +55,8 @@ fn draw<DB: DrawingBackend>(
         .max(cmin * 1.01);
     let title = format!(
         "{name}: c12 at {voltage_v} V for constant impurity densities ({} {})",
-        env!("CARGO_PKG_NAME"),
-        env!("CARGO_PKG_VERSION")
+        crate::PROGRAM,
+        crate::VERSION
     );
     let mut chart = ChartBuilder::on(root)
         .caption(title, ("sans-serif", 20))

@@ -1,34 +1,36 @@
 //! Figures: SVG and PNG through plotters.
 
 /// Draws `$body` (which sees the drawing area as `$root` and whether the target is SVG as
-/// `$svg`) on a PNG or SVG backend chosen by the extension of `$path`, then writes the file; every
-/// failure names the file.
+/// `$svg`, and returns this crate's `Result<()>`) on a PNG or SVG backend chosen by the extension
+/// of `$path`, then writes the file; every failure is an `Error::Draw` or `Error::UnknownFormat`
+/// naming the file. Returns from the enclosing function on failure, else evaluates to `Ok(())`.
 macro_rules! render {
     ($path:expr, $size:expr, |$root:ident, $svg:ident| $body:expr) => {{
-        use anyhow::Context as _;
         let path: &std::path::Path = $path;
-        let ctx = || format!("cannot write the plot {}", path.display());
+        let draw = |message: String| $crate::Error::Draw {
+            file: path.to_path_buf(),
+            message,
+        };
         match $crate::plot::Format::from_path(path) {
             Some(format) => {
                 let $svg = format == $crate::plot::Format::Svg;
                 if $svg {
                     let $root = plotters::prelude::SVGBackend::new(path, $size).into_drawing_area();
-                    $body.with_context(ctx)?;
-                    $root
-                        .present()
-                        .map_err(|e| anyhow::anyhow!("{e}"))
-                        .with_context(ctx)?;
+                    $body.map_err(|e: $crate::Error| draw(e.chain_text()))?;
+                    $root.present().map_err(|e| draw(e.to_string()))?;
                 } else {
                     let $root =
                         plotters::prelude::BitMapBackend::new(path, $size).into_drawing_area();
-                    $body.with_context(ctx)?;
-                    $root
-                        .present()
-                        .map_err(|e| anyhow::anyhow!("{e}"))
-                        .with_context(ctx)?;
+                    $body.map_err(|e: $crate::Error| draw(e.chain_text()))?;
+                    $root.present().map_err(|e| draw(e.to_string()))?;
                 }
             }
-            None => anyhow::bail!("{}: unknown file type; use .svg or .png", path.display()),
+            None => {
+                return Err($crate::Error::UnknownFormat {
+                    file: path.to_path_buf(),
+                    message: "unknown file type; use .svg or .png",
+                });
+            }
         }
         Ok(())
     }};
@@ -49,6 +51,8 @@ mod surrogate;
 
 use std::path::Path;
 
+use crate::{Error, Result};
+
 pub use convergence::convergence;
 pub use coverage::coverage_figures;
 pub use cross_section::cross_section;
@@ -58,7 +62,7 @@ pub use field::field_map;
 pub use fit::{ZetaAtMode, ZetaProfile, fit_figures};
 pub use lines::{Corner, Curve, LineFigure, line_figure};
 pub use measure::measurement;
-pub use sensitivity::sensitivity;
+pub use sensitivity::{SensitivityPoint, sensitivity};
 pub use surrogate::{learning_curves, surrogate_errors};
 
 /// Output format, chosen by the file extension.
@@ -83,21 +87,24 @@ impl Format {
 
 /// Checks an output path before any work: a known extension and an existing folder. `flag` names
 /// the option in the message.
-pub fn check_output(path: &Path, flag: &str) -> anyhow::Result<()> {
+pub fn check_output(path: &Path, flag: &str) -> Result<()> {
+    let output = |message: String| Error::Output {
+        flag: flag.to_string(),
+        file: path.to_path_buf(),
+        message,
+    };
     if Format::from_path(path).is_none() {
-        anyhow::bail!(
-            "{flag} {}: unknown file type; use a name ending in .svg or .png",
-            path.display()
-        );
+        return Err(output(
+            "unknown file type; use a name ending in .svg or .png".into(),
+        ));
     }
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty())
         && !dir.is_dir()
     {
-        anyhow::bail!(
-            "{flag} {}: the folder {} does not exist",
-            path.display(),
+        return Err(output(format!(
+            "the folder {} does not exist",
             dir.display()
-        );
+        )));
     }
     Ok(())
 }
@@ -110,7 +117,7 @@ pub(crate) fn legend<
 >(
     chart: &mut plotters::prelude::ChartContext<'a, DB, CT>,
     position: plotters::prelude::SeriesLabelPosition,
-) -> anyhow::Result<()> {
+) -> Result<()> {
     use plotters::prelude::{BLACK, Color, WHITE};
     chart
         .configure_series_labels()
@@ -121,9 +128,9 @@ pub(crate) fn legend<
         .map_err(err)
 }
 
-/// A plotters drawing error as an anyhow error.
-pub(crate) fn err<E: std::fmt::Debug>(e: E) -> anyhow::Error {
-    anyhow::anyhow!("drawing failed: {e:?}")
+/// A plotters drawing error as this crate's error (`Error::Drawing`).
+pub(crate) fn err<E: std::fmt::Debug>(e: E) -> Error {
+    Error::drawing(e)
 }
 
 /// 1, 2 and 5 times the powers of ten within [lo, hi] (log-axis labels at every scale).

@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use anyhow::Result;
+use crate::Result;
 use hpge_solver::ConvergenceRow;
 use plotters::coord::Shift;
 use plotters::prelude::*;
