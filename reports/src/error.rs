@@ -3,6 +3,13 @@
 //! Each variant names the file (and what was attempted) where there is one. The texts are those
 //! the command line prints: `hpge-cv` shows an error with its sources joined by ": ".
 
+/// Returns `Err(Error::Invalid)` with a formatted message from the enclosing function.
+macro_rules! invalid {
+    ($($arg:tt)*) => {
+        return Err($crate::error::Error::invalid(format!($($arg)*)))
+    };
+}
+
 use std::path::PathBuf;
 
 /// Errors of the reports crate.

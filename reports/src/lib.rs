@@ -40,23 +40,12 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
-/// Returns `Err(Error::Invalid)` with a formatted message from the enclosing function.
-macro_rules! invalid {
-    ($($arg:tt)*) => {
-        return Err($crate::Error::invalid(format!($($arg)*)))
-    };
-}
-
+#[macro_use]
 mod error;
 pub mod paper;
 pub mod plot;
+mod provenance;
 
 pub use error::{Error, Result};
 pub use plot::{Corner, Curve, Format, LineFigure, check_output, line_figure};
-
-/// The program whose name the figures and reports carry.
-pub const PROGRAM: &str = "hpge-cv";
-
-/// The version the figures and reports carry (the workspace's version, which the command line
-/// shares).
-pub const VERSION: &str = env!("CARGO_PKG_VERSION");
+pub use provenance::{PROGRAM, VERSION};

@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::{Error, Result};
+use crate::error::{Error, Result};
 
 /// The shipped inputs the report reads (paths relative to the repository root).
 #[derive(Debug, Clone)]

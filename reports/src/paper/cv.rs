@@ -11,8 +11,9 @@ use plotters::prelude::*;
 use serde_json::json;
 
 use super::ctx::{Ctx, verdict};
-use crate::plot::{Format, err};
-use crate::{Error, Result};
+use crate::error::{Error, Result};
+use crate::plot::Format;
+use crate::plot::style::err;
 
 /// The figure's stem.
 pub const STEM: &str = "cv-data-vs-manufacturer";
@@ -67,7 +68,7 @@ pub fn run(ctx: &mut Ctx) -> Result<()> {
     let foot = [
         format!(
             "hpge-cv {} report paper: data {} ({} points, a stand-in: see its README);",
-            crate::VERSION,
+            crate::provenance::VERSION,
             ctx.inputs.data.display(),
             data.voltage_v.len(),
         ),

@@ -6,7 +6,7 @@ use hpge_solver::{Detector, LogTransform, Parameters};
 use serde_json::json;
 
 use super::ctx::{Ctx, verdict};
-use crate::Result;
+use crate::error::Result;
 use crate::plot::{self, Corner, Curve, LineFigure};
 
 /// y = 0.018566145 is zeta_l = 1e8 cm^-3 (the paper's prior bound).
@@ -64,7 +64,7 @@ fn transform(ctx: &mut Ctx) -> Result<()> {
         legend: Corner::UpperLeft,
         footnotes: vec![format!(
             "hpge-cv {} report paper: LogTransform defaults v = {}, g = {}; paper Eqs. (18)-(20)",
-            crate::VERSION,
+            crate::provenance::VERSION,
             t.v,
             t.g
         )],
@@ -108,7 +108,7 @@ fn example(ctx: &mut Ctx) -> Result<()> {
     let lin = |a: f64, c: f64| (0..n).map(move |i| a + (c - a) * i as f64 / (n - 1) as f64);
     let foot = format!(
         "hpge-cv {} report paper: {} with {} (p_zeta,E), d_Li = 3 mm; gaps: outside the semiconductor",
-        crate::VERSION,
+        crate::provenance::VERSION,
         ctx.inputs.detector.display(),
         ctx.inputs.example_impurity.display()
     );

@@ -9,7 +9,7 @@ use hpge_solver::{Detector, FieldSettings, Parameters};
 use hpge_surrogate::{ExactSolver, Surrogate};
 use serde_json::Value;
 
-use crate::{Error, Result};
+use crate::error::{Error, Result};
 
 /// One impurity model of the comparison and where it came from.
 #[derive(Debug, Clone)]

@@ -8,7 +8,7 @@ use hpge_surrogate::fnv1a;
 use serde_json::json;
 
 use super::ctx::Ctx;
-use crate::{Error, Result};
+use crate::error::{Error, Result};
 
 /// The paper's figures this report does not make, and why.
 const NOT_MADE: &str = "Figs. 1-4 and 6 (schemes and photographs), 5 and 7 (pulser pulses and \
@@ -31,7 +31,7 @@ pub fn write(ctx: &Ctx, total_s: f64) -> Result<PathBuf> {
     writeln!(
         t,
         "# The paper's figures, remade by hpge-cv {}\n",
-        crate::VERSION
+        crate::provenance::VERSION
     )?;
     writeln!(
         t,
@@ -129,8 +129,8 @@ pub fn write(ctx: &Ctx, total_s: f64) -> Result<PathBuf> {
     let readme = ctx.out.join("README.md");
     std::fs::write(&readme, t).map_err(Error::io(&readme, "cannot write"))?;
     let j = json!({
-        "program": crate::PROGRAM,
-        "version": crate::VERSION,
+        "program": crate::provenance::PROGRAM,
+        "version": crate::provenance::VERSION,
         "quick": ctx.quick,
         "exact_check": ctx.exact_check,
         "inputs": ctx.inputs.all().iter().map(|p| json!({"file": p.display().to_string(), "hash": hash(p)})).collect::<Vec<_>>(),

@@ -6,8 +6,8 @@ use hpge_surrogate::{ParameterSpace, Sequence, SequenceKind};
 use serde_json::json;
 
 use super::ctx::{Ctx, verdict};
+use crate::error::{Error, Result};
 use crate::plot::{self, Corner, Curve, LineFigure};
-use crate::{Error, Result};
 
 /// (column, y range, histogram range in signed log10 zeta, bins, stem, title).
 struct Param {
@@ -133,7 +133,7 @@ pub fn run(ctx: &mut Ctx) -> Result<()> {
             legend: Corner::MiddleMiddle,
             footnotes: vec![format!(
                 "hpge-cv {} report paper: {}, golden sequence seed 0, indices 0..47999 (training), 48000..59999 (test); {}",
-                crate::VERSION,
+                crate::provenance::VERSION,
                 ctx.inputs.space.display(),
                 notes.join("; ")
             )],

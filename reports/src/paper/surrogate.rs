@@ -11,8 +11,8 @@ use hpge_surrogate::{DataSet, EpochRecord, Figures, Surrogate};
 use serde_json::json;
 
 use super::ctx::{Ctx, verdict};
+use crate::error::{Error, Result};
 use crate::plot;
-use crate::{Error, Result};
 
 /// The learning curves `train` wrote beside a model (`<stem>.curves.csv`).
 fn read_curves(path: &Path) -> Result<Vec<EpochRecord>> {

@@ -3,13 +3,12 @@
 
 use std::path::Path;
 
-use crate::Result;
 use hpge_solver::ConvergenceRow;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::err;
-use super::fit::PALETTE;
+use super::style::{PALETTE, err};
+use crate::error::Result;
 
 /// Draws the rows of a convergence study (`hpge_solver::convergence_study`).
 pub fn convergence(rows: &[ConvergenceRow], title: &str, path: &Path) -> Result<()> {

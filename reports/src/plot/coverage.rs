@@ -5,13 +5,13 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::{Error, Result};
 use hpge_validation::{CoverageReport, ParameterCoverage, binomial_interval};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
-use super::err;
+use super::style::{PALETTE, err};
+use crate::error::{Error, Result};
 
 /// Bins of a rank histogram (fewer when L + 1 is smaller).
 const RANK_BINS: usize = 20;
@@ -365,7 +365,7 @@ fn coverage<DB: DrawingBackend>(
                 + PathElement::new(vec![(12, 0), (20, 0)], BLACK.stroke_width(2))
         });
     for (k, p) in report.parameters.iter().enumerate() {
-        let c = super::fit::PALETTE[k % super::fit::PALETTE.len()];
+        let c = PALETTE[k % PALETTE.len()];
         let pts: Vec<(f64, f64)> = report
             .levels
             .iter()

@@ -3,14 +3,14 @@
 
 use std::path::Path;
 
-use crate::Result;
 use hpge_solver::{BoundaryKind, Detector, PassiveKind, Region, WorldSide};
 use plotters::coord::Shift;
 use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 
 use super::colormap::{density_color, t_color};
-use super::err;
+use super::style::err;
+use crate::error::Result;
 
 /// Largest plot width and height in pixels (the scale is chosen so that both fit).
 const MAX_PLOT_W: f64 = 700.0;
@@ -277,8 +277,8 @@ fn draw_title<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, det: &Detector)
     let line1 = format!(
         "{}: r-z cross-section (axisymmetric)   [{} {}]",
         det.name,
-        crate::PROGRAM,
-        crate::VERSION
+        crate::provenance::PROGRAM,
+        crate::provenance::VERSION
     );
     let line2 = format!(
         "impurity model \"{}\" ({}){}",

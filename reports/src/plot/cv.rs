@@ -2,12 +2,12 @@
 
 use std::path::Path;
 
-use crate::Result;
 use hpge_solver::{CvCurve, Detector};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::{err, log_key_points};
+use super::style::{err, log_key_points};
+use crate::error::Result;
 
 /// Draws c12 (log scale) against U_B, marking the full-depletion voltage.
 pub fn cv_curve(curve: &CvCurve, det: &Detector, path: &Path) -> Result<()> {
@@ -36,8 +36,8 @@ fn draw<DB: DrawingBackend>(
         "{}: simulated C-V curve ({}; {} {})",
         det.name,
         det.semiconductor.impurity_file().display(),
-        crate::PROGRAM,
-        crate::VERSION
+        crate::provenance::PROGRAM,
+        crate::provenance::VERSION
     );
     let mut chart = ChartBuilder::on(root)
         .caption(title, ("sans-serif", 20))

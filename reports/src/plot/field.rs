@@ -2,12 +2,12 @@
 
 use std::path::Path;
 
-use crate::Result;
 use hpge_solver::{Detector, PotentialPoint};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::err;
+use super::style::err;
+use crate::error::Result;
 
 /// A perceptually ordered map (viridis anchors) for t in [0, 1].
 fn viridis(t: f64) -> RGBColor {

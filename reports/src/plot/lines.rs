@@ -3,12 +3,11 @@
 
 use std::path::Path;
 
-use crate::Result;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::err;
-use super::fit::PALETTE;
+use super::style::{PALETTE, err};
+use crate::error::Result;
 
 /// One curve: points (x, y); `None` leaves a gap (e.g. undepleted volume).
 #[derive(Debug, Clone, PartialEq)]

@@ -4,12 +4,12 @@
 
 use std::path::Path;
 
-use crate::Result;
 use hpge_inference::{Measurement, PulseSet, VoltagePoint, negative_slopes};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::{err, legend, log_key_points};
+use super::style::{err, legend, log_key_points};
+use crate::error::Result;
 
 /// Writes `pulses`, `spectra`, `peak-fits`, `cv` and `slope` (.svg and .png) into `dir`.
 pub fn measurement(m: &Measurement, sets: &[PulseSet], dir: &Path) -> Result<()> {

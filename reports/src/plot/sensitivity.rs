@@ -2,11 +2,11 @@
 
 use std::path::Path;
 
-use crate::Result;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::{err, log_key_points};
+use super::style::{err, log_key_points};
+use crate::error::Result;
 
 /// One point of a sensitivity scan: c12 at the bias for one constant impurity density.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -55,8 +55,8 @@ fn draw<DB: DrawingBackend>(
         .max(cmin * 1.01);
     let title = format!(
         "{name}: c12 at {voltage_v} V for constant impurity densities ({} {})",
-        crate::PROGRAM,
-        crate::VERSION
+        crate::provenance::PROGRAM,
+        crate::provenance::VERSION
     );
     let mut chart = ChartBuilder::on(root)
         .caption(title, ("sans-serif", 20))

@@ -4,12 +4,12 @@
 
 use std::path::Path;
 
-use crate::Result;
 use hpge_surrogate::{EpochRecord, Figures, ModelInfo};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::{err, legend};
+use super::style::{err, legend};
+use crate::error::Result;
 
 /// `learning-curves.svg/png` in `dir`.
 pub fn learning_curves(curves: &[EpochRecord], info: &ModelInfo, dir: &Path) -> Result<()> {

@@ -1,6 +1,14 @@
 //! The key beside the panels.
 
-use super::*;
+use hpge_inference::Discovery;
+use hpge_solver::{BoundingBox, Detector};
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use super::layout::*;
+use crate::error::Result;
+use crate::plot::cross_section::{contact_color, passive_color};
+use crate::plot::style::err;
 
 /// The key beside the cross-section: materials and contacts, then the windows.
 pub(super) fn draw_key<DB: DrawingBackend>(

@@ -1,6 +1,15 @@
 //! The right panel: the detector's r-z cross-section with each window's probed region.
 
-use super::*;
+use hpge_inference::Discovery;
+use hpge_solver::{BoundingBox, Detector};
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use super::key::draw_key;
+use super::layout::*;
+use crate::error::Result;
+use crate::plot::cross_section::draw_regions;
+use crate::plot::style::err;
 
 /// The r-z box shown: the semiconductor and the contacts, padded by 6% of the larger side, r
 /// from 0, within the world.

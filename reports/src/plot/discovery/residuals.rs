@@ -1,6 +1,12 @@
 //! The left panel: standardised residuals against the bias, windows shaded.
 
-use super::*;
+use hpge_inference::Discovery;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use super::layout::*;
+use crate::error::Result;
+use crate::plot::style::err;
 
 /// The residuals against U_B.
 pub(super) fn residual_panel<DB: DrawingBackend>(

@@ -7,6 +7,7 @@ use hpge_inference::{
     Window,
 };
 
+use super::layout::*;
 use super::*;
 
 #[test]

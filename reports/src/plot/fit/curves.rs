@@ -1,13 +1,15 @@
 //! Figures against a coordinate: the posterior predictive against the bias and zeta at the
 //! global mode along z and r.
 
-use crate::Result;
 use hpge_inference::{LEVELS, Predictive};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::{Key, LEVEL_COLORS, PALETTE, ZetaProfile, key_strip, padded, ticks};
-use crate::plot::err;
+use super::layout::{Key, LEVEL_COLORS, key_strip, padded, ticks};
+use super::profile::ZetaProfile;
+use crate::error::Result;
+use crate::plot::style::PALETTE;
+use crate::plot::style::err;
 
 /// sigma_c (dashed) and the zero line.
 const SIGMA: RGBColor = RGBColor(90, 90, 90);

@@ -1,16 +1,17 @@
 //! Figures of the draws: marginals, 2D marginals of pairs, traces.
 
-use crate::Result;
 use hpge_inference::{Fit, LEVELS, ParameterSummary};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::{
-    Key, LEVEL_COLORS, OUTSIDE, PALETTE, PRIOR, TRUTH, axis_label, grid, key_strip, padded, ticks,
+use super::layout::{
+    Key, LEVEL_COLORS, OUTSIDE, PRIOR, TRUTH, axis_label, grid, key_strip, padded, ticks,
     view_range,
 };
+use crate::error::Result;
 use crate::plot::colormap::t_color;
-use crate::plot::err;
+use crate::plot::style::PALETTE;
+use crate::plot::style::err;
 
 /// Bins of a 1D marginal.
 const BINS_1D: usize = 60;

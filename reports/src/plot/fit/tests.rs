@@ -3,8 +3,8 @@
 use std::collections::BTreeMap;
 
 use hpge_inference::{
-    ChainDraws, Diagnostics, FitSummary, LEVELS, NoiseSettings, Predictive, PriorDistribution,
-    SampleSettings, Samples, StopReason, marginal_mode, smallest_intervals,
+    ChainDraws, Diagnostics, FitSummary, LEVELS, NoiseSettings, ParameterSummary, Predictive,
+    PriorDistribution, SampleSettings, Samples, StopReason, marginal_mode, smallest_intervals,
 };
 
 use super::*;
