@@ -6,7 +6,6 @@
 
 mod cli;
 mod paper;
-mod plot;
 mod report;
 
 use std::process::ExitCode;

@@ -3,12 +3,12 @@
 use std::path::PathBuf;
 
 use anyhow::{Result, bail};
+use hpge_reports::plot;
 use hpge_solver::convergence_study;
 use serde_json::json;
 
 use super::args::load_detector;
 use super::{DetectorInput, SolverArgs, WeightingArg};
-use crate::plot;
 
 /// Arguments of `convergence`.
 #[derive(Debug, clap::Args)]

@@ -3,12 +3,12 @@
 use std::path::PathBuf;
 
 use anyhow::Result;
+use hpge_reports::plot;
 use hpge_solver::{Detector, WorldSide};
 use serde_json::json;
 
 use super::DetectorInput;
 use super::args::load_detector;
-use crate::plot;
 
 /// Loads and checks the detector, prints a summary (text or JSON) and writes the plots.
 pub fn run(input: &DetectorInput, plots: &[PathBuf], as_json: bool) -> Result<()> {

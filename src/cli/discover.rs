@@ -252,7 +252,7 @@ pub fn write_outputs(
         Vec::new()
     } else {
         let det = exact.detector(&d.start_inputs)?;
-        crate::plot::discovery_figures(d, &det, out)?
+        hpge_reports::plot::discovery_figures(d, &det, out)?
     };
     super::discover_report::write_report(&out.join("report.md"), d, &figures)?;
     Ok(())

@@ -5,6 +5,7 @@ use std::io::Write as _;
 use std::path::PathBuf;
 
 use anyhow::{Context, Result, bail};
+use hpge_reports::plot;
 use hpge_solver::{Detector, ElectricField};
 use serde_json::json;
 
@@ -12,7 +13,6 @@ use super::args::{RadiusRange, load_detector, parse_r_range};
 use super::drift_common::{PointStatus, point_status};
 use super::simulate::backend_json;
 use super::{DetectorInput, SolverArgs, WeightingArg};
-use crate::plot;
 
 /// V/m per V/cm.
 const V_PER_M_PER_V_PER_CM: f64 = 100.0;

@@ -28,7 +28,7 @@ pub fn write_outputs(
         let truth_vals: Option<Vec<f64>> =
             truth.map(|t| t.iter().map(|v| v.unwrap_or(f64::NAN)).collect());
         let title = format!("{} fit", s.prior.name);
-        figures = crate::plot::fit_figures(
+        figures = hpge_reports::plot::fit_figures(
             &out.join("figures"),
             fit,
             &zeta,

@@ -9,10 +9,9 @@ use hpge_measurement::{
     MeasureSettings, Measurement, PulseSet, RawProblem, SynthSettings, depletion_voltage, measure,
     read_raw_dir, synthesize_voltage, write_curve_with_comments, write_pulses,
 };
+use hpge_reports::plot;
 use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::json;
-
-use crate::plot;
 
 /// Options of `measure`.
 pub struct MeasureOptions<'a> {

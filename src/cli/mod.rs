@@ -27,7 +27,6 @@ use clap::{Parser, Subcommand};
 
 pub use args::{parse_param, parse_point, parse_voltages};
 pub use fit::Unconverged;
-pub use sensitivity::ScanPoint;
 
 /// Impurity densities of HPGe detectors from capacitance-voltage curves: field solver, neural
 /// surrogate and Bayesian inference (Abt et al., EPJ C 2023).

@@ -6,6 +6,7 @@ use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
+use hpge_reports::plot;
 use hpge_solver::{AdlModel, AdlParameters, Detector, DriftSettings, ElectricField, Pulse};
 use serde_json::json;
 
@@ -16,7 +17,6 @@ use super::drift_common::{
 };
 use super::simulate::backend_json;
 use super::{DetectorInput, SolverArgs, WeightingArg};
-use crate::plot;
 
 #[derive(Debug, clap::Args)]
 pub struct PulseArgs {

@@ -5,13 +5,13 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
+use hpge_reports::plot;
 use hpge_solver::{FieldSettings, ImpuritySpec, solve_point};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::json;
 
 use super::DetectorInput;
 use super::args::load_detector;
-use crate::plot;
 
 /// One point of the scan.
 pub struct ScanPoint {
@@ -110,7 +110,15 @@ pub fn run(o: &SensitivityOptions<'_>) -> Result<()> {
         }
     }
     if let Some(path) = o.plot {
-        plot::sensitivity(&points, o.voltage_v, &det.name, path)?;
+        let drawn: Vec<plot::SensitivityPoint> = points
+            .iter()
+            .map(|p| plot::SensitivityPoint {
+                zeta_cm3: p.zeta_cm3,
+                c12_pf: p.c12_pf,
+                fully_depleted: p.fully_depleted,
+            })
+            .collect();
+        plot::sensitivity(&drawn, o.voltage_v, &det.name, path)?;
     }
     if o.json {
         let v = json!({

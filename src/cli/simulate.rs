@@ -4,6 +4,7 @@ use std::io::Write;
 use std::path::PathBuf;
 
 use anyhow::{Context, Result, bail};
+use hpge_reports::plot;
 use hpge_solver::{
     Backend, CvCurve, Error, FieldSettings, Precision, curve_pinch_off_voltage, cv_curve,
     gpu_adapter, normalise_voltages, solve_point, solve_potential,
@@ -13,7 +14,6 @@ use serde_json::json;
 
 use super::DetectorInput;
 use super::args::{GridArgs, load_detector};
-use crate::plot;
 
 /// Options of `simulate`.
 pub struct SimulateOptions<'a> {

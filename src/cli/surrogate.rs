@@ -134,9 +134,9 @@ pub fn train(o: &TrainOptions) -> Result<()> {
     let model = &outcome.model;
     if let Some(dir) = o.plot {
         if !outcome.curves.is_empty() {
-            crate::plot::learning_curves(&outcome.curves, &model.info, dir)?;
+            hpge_reports::plot::learning_curves(&outcome.curves, &model.info, dir)?;
         }
-        crate::plot::surrogate_errors(
+        hpge_reports::plot::surrogate_errors(
             &outcome.test_predictions,
             &outcome.test_c12_pf,
             &model.info,
@@ -184,7 +184,7 @@ pub fn evaluate(o: &EvaluateOptions) -> Result<()> {
     let data = read_for_model(&model, o.model, o.data)?;
     let ev = Evaluation::new(&model, &data, o.worst);
     if let Some(dir) = o.plot {
-        crate::plot::surrogate_errors(
+        hpge_reports::plot::surrogate_errors(
             &ev.predictions,
             &data.c12_pf,
             &model.info,

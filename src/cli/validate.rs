@@ -147,7 +147,7 @@ pub fn coverage(o: &CoverageOptions) -> Result<()> {
         writeln!(w, "{i},{}", r.join(","))?;
     }
     w.flush()?;
-    crate::plot::coverage_figures(
+    hpge_reports::plot::coverage_figures(
         &o.out.join("figures"),
         &report,
         &format!("{} coverage", o.prior.display()),

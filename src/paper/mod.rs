@@ -1,7 +1,6 @@
 //! The paper's results that need more than one command: computed by library functions here, which
 //! the report commands call.
 
-mod models;
 mod section9;
 
 pub use section9::{Section9Inputs, section9};

@@ -8,14 +8,14 @@ use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
+use hpge_reports::paper::models::{ModeDetectors, NamedModel, manufacturer};
+use hpge_reports::plot::{self, Corner, Curve, LineFigure};
 use hpge_solver::{AdlModel, DriftSettings, ElectricField, FieldSettings, solve_point};
 use serde_json::{Value, json};
 
-use super::models::{ModeDetectors, NamedModel, manufacturer};
 use crate::cli::drift_common::{
     PointStatus, drift_json, normalise, point_status, reference_contact, rise_time_10_90_ns,
 };
-use crate::plot::{self, Corner, Curve, LineFigure};
 
 /// V/m per V/cm.
 const V_PER_M_PER_V_PER_CM: f64 = 100.0;

@@ -4,10 +4,10 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
+use hpge_reports::paper::{Ctx, verdict};
 use hpge_solver::LogTransform;
 use serde_json::{Value, json};
 
-use super::{Ctx, verdict};
 use crate::cli::fit::{FitOptions, run as fit};
 
 /// The figures each fit contributes: (fit's figure stem, report stem suffix, paper figure).

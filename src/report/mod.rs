@@ -1,24 +1,22 @@
 //! `hpge-cv report paper`: every figure of the paper this project can produce, made in one run
 //! with this project's numbers, and a README that sets each beside the paper's statement about it.
 //!
-//! Each figure group is one file: the C-V curve against the data (`cv`), the sensitivity scan
-//! (`sensitivity`), the transform, the example density and the cross-sections (`density`), the
-//! training samples (`samples`), the surrogate (`surrogate`), the fits and section 9 (`fits`);
-//! `readme` writes `README.md` and `report.json`.
+//! Each figure group is one step: the C-V curve against the data (`hpge_reports::paper::cv`), the
+//! sensitivity scan (`sensitivity`), the transform, the example density and the cross-sections
+//! (`hpge_reports::paper::density`), the training samples (`hpge_reports::paper::samples`), the
+//! surrogate (`hpge_reports::paper::surrogate`), the fits (`fits`) and section 9 (`section9`);
+//! `hpge_reports::paper::readme` writes `README.md` and `report.json`. The steps that run the
+//! command line's fits stay here.
 
-mod cv;
-mod density;
 mod fits;
-mod readme;
-mod samples;
 mod section9;
 mod sensitivity;
-mod surrogate;
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
+use hpge_reports::paper::{Ctx, Inputs, cv, density, readme, samples, surrogate};
 
 /// `report`: reports made of several commands' results.
 #[derive(Debug, clap::Args)]
@@ -48,135 +46,6 @@ pub struct PaperArgs {
     pub exact_check: bool,
 }
 
-/// The shipped inputs the report reads (paths relative to the repository root).
-pub(crate) struct Inputs {
-    pub detector: PathBuf,
-    pub example_impurity: PathBuf,
-    pub data: PathBuf,
-    /// The surrogate's parameter space (the training points follow from it).
-    pub space: PathBuf,
-    pub heldout: PathBuf,
-    /// The paper's recipe (figures of the surrogate).
-    pub paper_model: PathBuf,
-    /// The model the fits use.
-    pub fit_model: PathBuf,
-    pub prior_bz: PathBuf,
-    pub prior_brz: PathBuf,
-}
-
-impl Default for Inputs {
-    fn default() -> Self {
-        Inputs {
-            detector: "detectors/super-siegfried-k1.toml".into(),
-            example_impurity: "detectors/impurities/paper-example-rz.toml".into(),
-            data: "data/super-siegfried-k1/cv.csv".into(),
-            space: "spaces/super-siegfried-rz.toml".into(),
-            heldout: "data/training/heldout.csv".into(),
-            paper_model: "models/super-siegfried-rz-paper.safetensors".into(),
-            fit_model: "models/super-siegfried-rz-split.safetensors".into(),
-            prior_bz: "priors/b-z.toml".into(),
-            prior_brz: "priors/b-rz.toml".into(),
-        }
-    }
-}
-
-impl Inputs {
-    fn all(&self) -> Vec<&Path> {
-        vec![
-            &self.detector,
-            &self.example_impurity,
-            &self.data,
-            &self.space,
-            &self.heldout,
-            &self.paper_model,
-            &self.fit_model,
-            &self.prior_bz,
-            &self.prior_brz,
-        ]
-    }
-}
-
-/// One row of the README: a figure beside the paper's statement about it.
-pub(crate) struct Row {
-    /// The figure's stem in figures/ (SVG and PNG).
-    pub stem: String,
-    /// The paper's figure and section, e.g. "Fig. 12 (sec. 5)".
-    pub paper: String,
-    /// What the paper says about it (in our words).
-    pub statement: String,
-    /// This run's numbers.
-    pub ours: String,
-    /// "agrees", "differs (why)" or "not run (why)".
-    pub verdict: String,
-}
-
-/// What a run collects: its rows, figure files, step times and numbers for report.json.
-pub(crate) struct Ctx {
-    pub out: PathBuf,
-    pub figures: PathBuf,
-    pub quick: bool,
-    pub exact_check: bool,
-    pub inputs: Inputs,
-    pub rows: Vec<Row>,
-    pub files: Vec<PathBuf>,
-    pub steps: Vec<(String, f64)>,
-    pub numbers: serde_json::Map<String, serde_json::Value>,
-}
-
-impl Ctx {
-    /// `figures/<stem>.<ext>`.
-    pub fn fig(&self, stem: &str, ext: &str) -> PathBuf {
-        self.figures.join(format!("{stem}.{ext}"))
-    }
-
-    /// Draws `figures/<stem>.svg` and `.png` with `draw`.
-    pub fn both(&mut self, stem: &str, draw: impl Fn(&Path) -> Result<()>) -> Result<()> {
-        for ext in ["svg", "png"] {
-            let p = self.fig(stem, ext);
-            draw(&p)?;
-            self.files.push(p);
-        }
-        Ok(())
-    }
-
-    /// Copies `<dir>/<src>.svg/.png` to `figures/<stem>.svg/.png`.
-    pub fn copy_both(&mut self, dir: &Path, src: &str, stem: &str) -> Result<()> {
-        for ext in ["svg", "png"] {
-            let from = dir.join(format!("{src}.{ext}"));
-            let to = self.fig(stem, ext);
-            std::fs::copy(&from, &to)
-                .with_context(|| format!("cannot copy {} to {}", from.display(), to.display()))?;
-            self.files.push(to);
-        }
-        Ok(())
-    }
-
-    /// Adds a README row.
-    pub fn row(&mut self, stem: &str, paper: &str, statement: &str, ours: String, verdict: String) {
-        self.rows.push(Row {
-            stem: stem.into(),
-            paper: paper.into(),
-            statement: statement.into(),
-            ours,
-            verdict,
-        });
-    }
-
-    /// Records a number for report.json.
-    pub fn number(&mut self, key: &str, v: serde_json::Value) {
-        self.numbers.insert(key.into(), v);
-    }
-}
-
-/// "agrees" when `ok`, else "differs (`why`)".
-pub(crate) fn verdict(ok: bool, why: &str) -> String {
-    if ok {
-        "agrees".into()
-    } else {
-        format!("differs ({why})")
-    }
-}
-
 /// Runs `report`.
 pub fn run(a: &ReportArgs) -> Result<()> {
     match &a.what {
@@ -197,30 +66,20 @@ pub fn paper(a: &PaperArgs) -> Result<()> {
             );
         }
     }
-    let figures = a.out.join("figures");
-    std::fs::create_dir_all(&figures)
+    let mut ctx = Ctx::new(a.out.clone(), a.quick, a.exact_check, inputs);
+    std::fs::create_dir_all(&ctx.figures)
         .with_context(|| format!("--out {}: cannot create the folder", a.out.display()))?;
-    let mut ctx = Ctx {
-        out: a.out.clone(),
-        figures,
-        quick: a.quick,
-        exact_check: a.exact_check,
-        inputs,
-        rows: Vec::new(),
-        files: Vec::new(),
-        steps: Vec::new(),
-        numbers: serde_json::Map::new(),
-    };
     type StepFn = fn(&mut Ctx) -> Result<()>;
     let steps: [(&str, StepFn); 8] = [
-        ("C-V curve: manufacturer model vs data", cv::run),
+        ("C-V curve: manufacturer model vs data", |c| Ok(cv::run(c)?)),
         ("sensitivity scan at 25 V", sensitivity::run),
-        ("transform, example density, cross-sections", density::run),
-        ("training-sample histograms", samples::run),
-        (
-            "surrogate: learning curves, held-out accuracy",
-            surrogate::run,
-        ),
+        ("transform, example density, cross-sections", |c| {
+            Ok(density::run(c)?)
+        }),
+        ("training-sample histograms", |c| Ok(samples::run(c)?)),
+        ("surrogate: learning curves, held-out accuracy", |c| {
+            Ok(surrogate::run(c)?)
+        }),
         ("fit B_Z", fits::run_bz),
         ("fit B_RZ", fits::run_brz),
         ("section 9: field and pulses", section9::run),

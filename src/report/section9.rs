@@ -3,10 +3,10 @@
 //! fits of this run.
 
 use anyhow::{Context, Result};
+use hpge_reports::paper::{Ctx, verdict};
 use serde_json::Value;
 
 use super::fits::fit_dir;
-use super::{Ctx, verdict};
 
 pub fn run(ctx: &mut Ctx) -> Result<()> {
     let stems = [

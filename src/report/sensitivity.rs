@@ -5,12 +5,10 @@ use std::path::Path;
 
 use anyhow::{Context, Result, bail};
 use hpge_measurement::{Data, load_data};
+use hpge_reports::paper::{Ctx, verdict};
+use hpge_reports::plot;
 use hpge_solver::{Detector, FieldSettings, ImpuritySpec, Parameters, solve_point};
 use serde_json::json;
-
-use super::{Ctx, verdict};
-use crate::cli::ScanPoint;
-use crate::plot;
 
 pub const STEM: &str = "sensitivity-25V";
 const VOLTAGE_V: f64 = 25.0;
@@ -39,7 +37,7 @@ pub fn run(ctx: &mut Ctx) -> Result<()> {
         det.set_impurity(&spec, name)?;
         let r = solve_point(&det, VOLTAGE_V, &settings, None)
             .with_context(|| format!("constant density {zeta:e} cm^-3 at {VOLTAGE_V} V"))?;
-        points.push(ScanPoint {
+        points.push(plot::SensitivityPoint {
             zeta_cm3: zeta,
             c12_pf: r.c12_pf,
             fully_depleted: r.fully_depleted(),
