@@ -102,7 +102,10 @@ fn bad_names_and_files_are_named() {
         .err()
         .map(|e| e.to_string())
         .unwrap_or_default();
-    assert!(e.contains("2 voltages") && e.contains("3 parameters"), "{e}");
+    assert!(
+        e.contains("2 voltages") && e.contains("3 parameters"),
+        "{e}"
+    );
 }
 
 #[test]

@@ -3,12 +3,11 @@
 
 use std::path::Path;
 
-use anyhow::{Context, Result};
-use hpge_inference::fit::{FitFiles, FitJob, outputs, read_truth, truth_records};
-use hpge_inference::{CvModel, Fit, SamplerKind, Status};
+use anyhow::Result;
+use hpge_inference::fit::{FitFiles, FitJob};
+use hpge_inference::{CvModel, FitSettings, SamplerKind, Status};
+use hpge_reports::fit::{FitObserver, run_fit, summary_text};
 use indicatif::{ProgressBar, ProgressStyle};
-
-use super::fit_outputs::write_outputs;
 
 /// A fit that did not reach its convergence targets (exit code 3).
 #[derive(Debug, thiserror::Error)]
@@ -89,62 +88,88 @@ pub fn noise_settings(likelihood: &str) -> Result<hpge_inference::NoiseSettings>
     Ok(hpge_inference::fit::noise_settings(likelihood)?)
 }
 
-/// Runs `fit`: `json` prints the summary as one JSON object; `allow_unconverged` exits with 0
-/// when the convergence targets were not reached.
-pub fn run(o: &FitOptions, print_json: bool, allow_unconverged: bool) -> Result<()> {
-    let kind = o.sampler_kind()?;
-    let noise = o.noise()?;
-    let s = setup(&o.data, &o.model, &o.prior, &o.detector, noise, &o.grid)?;
-    let truth = match &o.truth {
-        Some(p) => Some(read_truth(p, &s.prior)?),
-        None => None,
-    };
-    let settings = o.settings()?;
-    let sample = settings.sample;
-    let out = o.out_dir();
-    std::fs::create_dir_all(&out)
-        .with_context(|| format!("--out {}: cannot create the folder", out.display()))?;
-    eprintln!(
-        "fitting {} ({} voltages) with {} and the prior {} ({} parameters), {} sampler, {} chains, seed {}",
-        o.data.display(),
-        s.data.voltage_v.len(),
-        s.surrogate.describe(),
-        o.prior.display(),
-        s.prior.dim(),
-        kind.as_str(),
-        sample.chains,
-        o.seed
-    );
-    let (bar, progress) = progress_printer(false);
-    let mut result = s.run(&settings, &progress)?;
-    bar.finish_and_clear();
-    if !o.no_exact_check {
-        let pb = ProgressBar::new(o.exact_draws as u64 + 1);
+/// The fit's progress on stderr: the job's warnings and a one-line description, the sampling
+/// spinner (one line per update when stderr is not a terminal), the exact check's bar.
+struct Display {
+    sampling: std::sync::Mutex<Option<(ProgressBar, Box<dyn Fn(&Status) + Sync + Send>)>>,
+    exact: std::sync::Mutex<Option<ProgressBar>>,
+}
+
+impl FitObserver for Display {
+    fn setup_done(&self, job: &FitJob, o: &FitOptions, settings: &FitSettings) {
+        for w in &job.warnings {
+            eprintln!("warning: {w}");
+        }
+        eprintln!(
+            "fitting {} ({} voltages) with {} and the prior {} ({} parameters), {} sampler, {} chains, seed {}",
+            o.data.display(),
+            job.data.voltage_v.len(),
+            job.surrogate.describe(),
+            o.prior.display(),
+            job.prior.dim(),
+            settings.sample.sampler.as_str(),
+            settings.sample.chains,
+            o.seed
+        );
+        let (bar, f) = progress_printer(false);
+        if let Ok(mut g) = self.sampling.lock() {
+            *g = Some((bar, Box::new(f)));
+        }
+    }
+    fn sampling(&self, status: &Status) {
+        if let Ok(g) = self.sampling.lock()
+            && let Some((_, f)) = g.as_ref()
+        {
+            f(status);
+        }
+    }
+    fn sampling_done(&self) {
+        if let Ok(mut g) = self.sampling.lock()
+            && let Some((bar, _)) = g.take()
+        {
+            bar.finish_and_clear();
+        }
+    }
+    fn exact_start(&self, draws: usize) {
+        let pb = ProgressBar::new(draws as u64 + 1);
         pb.set_style(
             ProgressStyle::with_template("exact check {bar:30} {pos}/{len} curves, {elapsed}")
                 .unwrap_or_else(|_| ProgressStyle::default_bar()),
         );
-        s.check_exact(&mut result, o.exact_draws, &|done, _| {
-            pb.set_position(done as u64)
-        })?;
-        pb.finish_and_clear();
+        if let Ok(mut g) = self.exact.lock() {
+            *g = Some(pb);
+        }
     }
-    let truth_records = truth.as_ref().map(|t| truth_records(&result.summary, t));
-    write_outputs(
-        o,
-        &out,
-        &s,
-        &result,
-        truth.as_deref(),
-        truth_records.as_deref(),
-    )?;
-    let sm = &result.summary;
-    let json = outputs::summary_json(&result, truth_records.as_deref())?;
-    outputs::write_summary(&out.join("summary.json"), &json)?;
+    fn exact_progress(&self, done: usize, _total: usize) {
+        if let Ok(g) = self.exact.lock()
+            && let Some(pb) = g.as_ref()
+        {
+            pb.set_position(done as u64);
+        }
+    }
+    fn exact_done(&self) {
+        if let Ok(mut g) = self.exact.lock()
+            && let Some(pb) = g.take()
+        {
+            pb.finish_and_clear();
+        }
+    }
+}
+
+/// Runs `fit` ([`hpge_reports::fit::run_fit`]) with progress on stderr: `print_json` prints
+/// the summary as one JSON object; `allow_unconverged` exits with 0 when the convergence
+/// targets were not reached.
+pub fn run(o: &FitOptions, print_json: bool, allow_unconverged: bool) -> Result<()> {
+    let display = Display {
+        sampling: std::sync::Mutex::new(None),
+        exact: std::sync::Mutex::new(None),
+    };
+    let run = run_fit(o, &display)?;
+    let sm = &run.fit.summary;
     if print_json {
-        println!("{}", serde_json::to_string(&json)?);
+        println!("{}", serde_json::to_string(&run.summary_json)?);
     } else {
-        print_summary(&result, &out);
+        print!("{}", summary_text(&run.fit, &run.out));
     }
     if !sm.converged {
         let worst = sm
@@ -171,69 +196,4 @@ pub fn run(o: &FitOptions, print_json: bool, allow_unconverged: bool) -> Result<
         }
     }
     Ok(())
-}
-
-fn print_summary(fit: &Fit, out: &Path) {
-    let s = &fit.summary;
-    println!(
-        "{} in {:.1} s: chi2/ndf at the global mode {:.1}/{} , {} draws per chain, max |pull| {:.2}",
-        if s.converged {
-            "converged"
-        } else {
-            "NOT converged"
-        },
-        s.seconds,
-        s.chi2,
-        s.ndf,
-        s.draws_per_chain,
-        s.max_abs_pull
-    );
-    println!(
-        "{:<10} {:>10} {:>9} {:>10} {:>10}  {:<28} {:>7} {:>7} {:>7}",
-        "parameter",
-        "mean",
-        "std",
-        "glob.mode",
-        "marg.mode",
-        "68.3% smallest interval(s)",
-        "R-hat",
-        "ESS_b",
-        "ESS_t"
-    );
-    for p in &s.parameters {
-        let si: Vec<String> = p.smallest_intervals["0.683"]
-            .iter()
-            .map(|[a, b]| format!("[{a:.4}, {b:.4}]"))
-            .collect();
-        println!(
-            "{:<10} {:>10.4} {:>9.4} {:>10.4} {:>10.4}  {:<28} {:>7.4} {:>7.0} {:>7.0}",
-            p.name,
-            p.mean,
-            p.std,
-            p.global_mode,
-            p.marginal_mode,
-            si.join(" "),
-            p.rhat,
-            p.ess_bulk,
-            p.ess_tail
-        );
-    }
-    if s.modes.len() > 1 {
-        for (i, m) in s.modes.iter().enumerate() {
-            let loc: Vec<String> = m.location.iter().map(|v| format!("{v:.4}")).collect();
-            println!("mode {i}: weight {:.3} at ({})", m.weight, loc.join(", "));
-        }
-    }
-    if let Some(c) = &s.exact_check {
-        println!(
-            "exact check ({} draws, {:.1} s): Pareto k {:.2}, largest mean shift {:.2} sd, |c_exact - c_surrogate|/c at the mode <= {:.2}%: {}",
-            c.draws,
-            c.seconds,
-            c.pareto_k,
-            c.max_abs_shift_sd,
-            100.0 * c.max_rel_diff_at_mode,
-            if c.pass { "pass" } else { "FAIL" }
-        );
-    }
-    println!("outputs in {}", out.display());
 }

@@ -8,8 +8,6 @@ mod discover_report;
 pub(crate) mod drift_common;
 pub(crate) mod field;
 pub(crate) mod fit;
-mod fit_outputs;
-mod fit_report;
 mod generate;
 mod impurity;
 mod measure;

@@ -11,12 +11,12 @@ use hpge_surrogate::{ExactSolver, Surrogate, fnv1a};
 use super::exact_check::exact_check;
 use super::run::{Fit, FitSettings, fit};
 use super::zeta::{ZetaAtMode, zeta_at_mode};
-use hpge_measurement::{CvData, Data, load_data};
 use crate::model::{CvModel, ExactModel, SurrogateModel};
 use crate::posterior::{Likelihood, NoiseSettings, Posterior};
 use crate::prior::{Prior, PriorSpec};
 use crate::sampler::Status;
 use crate::{Error, Result};
+use hpge_measurement::{CvData, Data, load_data};
 
 /// The four input files of a fit.
 #[derive(Debug, Clone, PartialEq, Eq)]

@@ -6,7 +6,7 @@ mod overrides;
 mod settings;
 mod tensor;
 
-pub use overrides::{GridOverrides, parse_grid_setting};
 pub(crate) use axis::{AxisRule, build_axis};
+pub use overrides::{GridOverrides, parse_grid_setting};
 pub use settings::{GridSettings, MIN_TOLERANCE};
 pub use tensor::Grid;

@@ -6,10 +6,10 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::layout::{Key, LEVEL_COLORS, key_strip, padded, ticks};
-use hpge_inference::fit::ZetaProfile;
 use crate::error::Result;
 use crate::plot::style::PALETTE;
 use crate::plot::style::err;
+use hpge_inference::fit::ZetaProfile;
 
 /// sigma_c (dashed) and the zero line.
 const SIGMA: RGBColor = RGBColor(90, 90, 90);

@@ -15,8 +15,8 @@ mod curves;
 mod layout;
 mod posterior;
 
-use layout::grid;
 pub use hpge_inference::fit::{ZetaAtMode, ZetaProfile};
+use layout::grid;
 
 /// Writes `$stem.svg` and `$stem.png` into `$dir` by `$body` (which sees the drawing area as
 /// `$root`) and pushes both paths onto `$out`.

@@ -3,10 +3,10 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result};
+use hpge_inference::fit::{FitJob, FitOptions};
 use hpge_inference::{CvModel, Fit};
 
-use super::fit::{FitOptions, Setup};
+use crate::{Error, Result};
 
 /// The largest |median of c_p - c_m| / sigma over the voltages below and from `split_v`.
 fn misfit(fit: &Fit, split_v: f64) -> (f64, f64) {
@@ -31,12 +31,13 @@ fn intervals(v: &[[f64; 2]]) -> String {
         .join(" ")
 }
 
-/// Writes the report.
+/// Writes the report: the run, convergence, every parameter's summary, the modes, the
+/// posterior predictive's misfit, the exact-solver check and the figures.
 pub fn write_report(
     path: &Path,
     o: &FitOptions,
     out: &Path,
-    s: &Setup,
+    s: &FitJob,
     fit: &Fit,
     figures: &[PathBuf],
     truth: Option<Vec<(String, f64, bool, bool)>>,
@@ -247,5 +248,5 @@ pub fn write_report(
         r,
         "Files: `samples.csv` (chain, draw, parameters, ln posterior), `summary.json`, `predictive.csv` (c_p - c_m bands per voltage), `zeta-mode.csv` (zeta at the global mode), `figures/`."
     );
-    std::fs::write(path, r).with_context(|| format!("cannot write {}", path.display()))
+    std::fs::write(path, r).map_err(Error::io(path, "cannot write"))
 }

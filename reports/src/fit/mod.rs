@@ -1,0 +1,237 @@
+//! A whole fit as the command line runs it: the job set up from its files, sampled, checked
+//! against the exact solver, and written out (the tables, the figures, `report.md` and
+//! `summary.json`), with hooks for progress display.
+
+mod report;
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use hpge_inference::fit::{FitJob, FitOptions, TruthRecord, outputs, read_truth, truth_records};
+use hpge_inference::{Fit, FitSettings, Status};
+
+pub use report::write_report;
+
+use crate::{Error, Result, plot};
+
+/// What a display of a running fit sees (every method has an empty default).
+pub trait FitObserver: Sync {
+    /// The job is set up (its warnings are in `job.warnings`) and sampling starts.
+    fn setup_done(&self, _job: &FitJob, _options: &FitOptions, _settings: &FitSettings) {}
+    /// A sampling status update.
+    fn sampling(&self, _status: &Status) {}
+    /// Sampling ended.
+    fn sampling_done(&self) {}
+    /// The exact-solver check of `draws` draws starts.
+    fn exact_start(&self, _draws: usize) {}
+    /// Curves done of the exact-solver check.
+    fn exact_progress(&self, _done: usize, _total: usize) {}
+    /// The exact-solver check ended.
+    fn exact_done(&self) {}
+}
+
+/// An observer that shows nothing.
+pub struct Quiet;
+impl FitObserver for Quiet {}
+
+/// A finished fit with everything it wrote.
+pub struct FitRun {
+    /// The job it ran.
+    pub job: FitJob,
+    /// The samples and the summary.
+    pub fit: Fit,
+    /// The output folder.
+    pub out: PathBuf,
+    /// `summary.json` as written (with `truth` where a truth file was given).
+    pub summary_json: serde_json::Value,
+}
+
+/// Runs a fit as `hpge-cv fit` does: set up from the files in `o`, sample, the exact-solver
+/// check unless `o.no_exact_check`, then writes every output into `o.out_dir()`.
+///
+/// # Errors
+/// Every input the job refuses (see [`FitJob::from_files`]), an output folder that cannot be
+/// made, and writing failures, each naming its file.
+pub fn run_fit(o: &FitOptions, observer: &dyn FitObserver) -> Result<FitRun> {
+    o.sampler_kind()?;
+    let noise = o.noise()?;
+    let job = FitJob::from_files(&o.files(), noise, &o.grid)?;
+    let truth = match &o.truth {
+        Some(p) => Some(read_truth(p, &job.prior)?),
+        None => None,
+    };
+    let settings = o.settings()?;
+    let out = o.out_dir();
+    std::fs::create_dir_all(&out).map_err(|e| Error::Output {
+        flag: "--out".into(),
+        file: out.clone(),
+        message: format!("cannot create the folder: {e}"),
+    })?;
+    observer.setup_done(&job, o, &settings);
+    let mut fit = job.run(&settings, &|s| observer.sampling(s))?;
+    observer.sampling_done();
+    if !o.no_exact_check {
+        observer.exact_start(o.exact_draws);
+        job.check_exact(&mut fit, o.exact_draws, &|done, total| {
+            observer.exact_progress(done, total)
+        })?;
+        observer.exact_done();
+    }
+    let records = truth.as_ref().map(|t| truth_records(&fit.summary, t));
+    write_outputs(o, &out, &job, &fit, truth.as_deref(), records.as_deref())?;
+    let summary_json = outputs::summary_json(&fit, records.as_deref())?;
+    outputs::write_summary(&out.join("summary.json"), &summary_json)?;
+    Ok(FitRun {
+        job,
+        fit,
+        out,
+        summary_json,
+    })
+}
+
+/// Writes the fit's tables (samples, posterior predictive, zeta at the mode), its figures
+/// (unless `o.no_plots`) and `report.md` into `out`.
+///
+/// # Errors
+/// A file that cannot be written, a figure that cannot be drawn.
+pub fn write_outputs(
+    o: &FitOptions,
+    out: &Path,
+    s: &FitJob,
+    fit: &Fit,
+    truth: Option<&[Option<f64>]>,
+    truth_records: Option<&[TruthRecord]>,
+) -> Result<()> {
+    let header = outputs::output_header(&s.files, &o.sampler, o.seed, &o.likelihood);
+    outputs::write_samples(&out.join("samples.csv"), &header, fit)?;
+    outputs::write_predictive(&out.join("predictive.csv"), &header, fit)?;
+    let zeta = s.zeta_at_mode(fit)?;
+    outputs::write_zeta(&out.join("zeta-mode.csv"), &header, &zeta)?;
+    let mut figures = Vec::new();
+    if !o.no_plots {
+        let names = s.prior.names();
+        let pairs = default_pairs(&names);
+        let truth_vals: Option<Vec<f64>> =
+            truth.map(|t| t.iter().map(|v| v.unwrap_or(f64::NAN)).collect());
+        let title = format!("{} fit", s.prior.name);
+        figures = plot::fit_figures(
+            &out.join("figures"),
+            fit,
+            &zeta,
+            &pairs,
+            truth_vals.as_deref(),
+            &title,
+        )?;
+    }
+    write_report(
+        &out.join("report.md"),
+        o,
+        out,
+        s,
+        fit,
+        &figures,
+        truth_records.map(|t| {
+            t.iter()
+                .map(|r| (r.name.clone(), r.value, r.inside_683, r.inside_955))
+                .collect::<Vec<_>>()
+        }),
+    )
+}
+
+/// The 2D marginals to draw: the paper's (bottom vs top level) where the names show it.
+fn default_pairs(names: &[String]) -> Vec<(usize, usize)> {
+    let find = |n: &str| names.iter().position(|x| x == n);
+    let mut pairs = Vec::new();
+    for (a, b) in [
+        ("y_bot", "y_top"),
+        ("y1_bot", "y1_top"),
+        ("y4_bot", "y4_top"),
+        ("d_li_mm", "y1_bot"),
+    ] {
+        if let (Some(i), Some(j)) = (find(a), find(b)) {
+            pairs.push((i, j));
+        }
+    }
+    if pairs.is_empty() && names.len() >= 2 {
+        pairs.push((0, 1));
+    }
+    pairs
+}
+
+/// The short summary `hpge-cv fit` prints: convergence, chi^2 at the mode, one line per
+/// parameter (mean, sd, modes, 68.3% smallest intervals, R-hat, ESS), the modes, the exact check.
+pub fn summary_text(fit: &Fit, out: &Path) -> String {
+    let mut t = String::new();
+    let s = &fit.summary;
+    let _ = writeln!(
+        t,
+        "{} in {:.1} s: chi2/ndf at the global mode {:.1}/{} , {} draws per chain, max |pull| {:.2}",
+        if s.converged {
+            "converged"
+        } else {
+            "NOT converged"
+        },
+        s.seconds,
+        s.chi2,
+        s.ndf,
+        s.draws_per_chain,
+        s.max_abs_pull
+    );
+    let _ = writeln!(
+        t,
+        "{:<10} {:>10} {:>9} {:>10} {:>10}  {:<28} {:>7} {:>7} {:>7}",
+        "parameter",
+        "mean",
+        "std",
+        "glob.mode",
+        "marg.mode",
+        "68.3% smallest interval(s)",
+        "R-hat",
+        "ESS_b",
+        "ESS_t"
+    );
+    for p in &s.parameters {
+        let si: Vec<String> = p.smallest_intervals["0.683"]
+            .iter()
+            .map(|[a, b]| format!("[{a:.4}, {b:.4}]"))
+            .collect();
+        let _ = writeln!(
+            t,
+            "{:<10} {:>10.4} {:>9.4} {:>10.4} {:>10.4}  {:<28} {:>7.4} {:>7.0} {:>7.0}",
+            p.name,
+            p.mean,
+            p.std,
+            p.global_mode,
+            p.marginal_mode,
+            si.join(" "),
+            p.rhat,
+            p.ess_bulk,
+            p.ess_tail
+        );
+    }
+    if s.modes.len() > 1 {
+        for (i, m) in s.modes.iter().enumerate() {
+            let loc: Vec<String> = m.location.iter().map(|v| format!("{v:.4}")).collect();
+            let _ = writeln!(
+                t,
+                "mode {i}: weight {:.3} at ({})",
+                m.weight,
+                loc.join(", ")
+            );
+        }
+    }
+    if let Some(c) = &s.exact_check {
+        let _ = writeln!(
+            t,
+            "exact check ({} draws, {:.1} s): Pareto k {:.2}, largest mean shift {:.2} sd, |c_exact - c_surrogate|/c at the mode <= {:.2}%: {}",
+            c.draws,
+            c.seconds,
+            c.pareto_k,
+            c.max_abs_shift_sd,
+            100.0 * c.max_rel_diff_at_mode,
+            if c.pass { "pass" } else { "FAIL" }
+        );
+    }
+    let _ = writeln!(t, "outputs in {}", out.display());
+    t
+}
