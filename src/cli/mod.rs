@@ -5,7 +5,6 @@ mod convergence;
 mod detector;
 mod discover;
 mod discover_report;
-pub(crate) mod drift_common;
 pub(crate) mod field;
 pub(crate) mod fit;
 mod fit_outputs;
@@ -27,7 +26,6 @@ use clap::{Parser, Subcommand};
 
 pub use args::{GridArgs, parse_param, parse_point, parse_voltages};
 pub use fit::Unconverged;
-pub use sensitivity::ScanPoint;
 
 /// Impurity densities of HPGe detectors from capacitance-voltage curves: field solver, neural
 /// surrogate and Bayesian inference (Abt et al., EPJ C 2023).

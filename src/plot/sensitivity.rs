@@ -3,11 +3,11 @@
 use std::path::Path;
 
 use anyhow::Result;
+use hpge_solver::scan::ScanPoint;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::{err, log_key_points};
-use crate::cli::ScanPoint;
 
 /// Draws c12 against zeta (both log scale); filled markers: fully depleted at the bias.
 pub fn sensitivity(points: &[ScanPoint], voltage_v: f64, name: &str, path: &Path) -> Result<()> {
