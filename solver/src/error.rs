@@ -128,6 +128,72 @@ pub enum Error {
         /// What was expected, quoting the text.
         message: String,
     },
+    /// A solve of the sensitivity scan failed (`scan::sensitivity_scan`); the solver's error is
+    /// the source.
+    #[error("constant density {zeta_cm3:e} cm^-3 at {voltage_v} V")]
+    ScanPointFailed {
+        /// The constant net impurity density, cm^-3.
+        zeta_cm3: f64,
+        /// The bias, V.
+        voltage_v: f64,
+        /// Why the solve failed.
+        #[source]
+        source: Box<Error>,
+    },
+    /// An interaction point (the start of a drift) lies inside a contact.
+    #[error(
+        "(r, z) = ({r_mm}, {z_mm}) mm is inside the contact `{contact}`; an interaction must be in the depleted crystal"
+    )]
+    InteractionInContact {
+        /// Radius of the point, mm.
+        r_mm: f64,
+        /// Height of the point, mm.
+        z_mm: f64,
+        /// Name of the contact.
+        contact: String,
+    },
+    /// An interaction point lies in undepleted semiconductor at the bias (no field there).
+    #[error(
+        "(r, z) = ({r_mm}, {z_mm}) mm is in undepleted volume at U_B = {bias_v} V (no field there); raise --voltage or choose a point in the depleted crystal"
+    )]
+    InteractionUndepleted {
+        /// Radius of the point, mm.
+        r_mm: f64,
+        /// Height of the point, mm.
+        z_mm: f64,
+        /// The bias, V.
+        bias_v: f64,
+    },
+    /// An interaction point lies outside the crystal (world medium, a passive, a borehole).
+    #[error(
+        "(r, z) = ({r_mm}, {z_mm}) mm is outside the crystal `{crystal}` (r in [{r_min_mm}, {r_max_mm}] mm, z in [{z_min_mm}, {z_max_mm}] mm, less any borehole)"
+    )]
+    InteractionOutside {
+        /// Radius of the point, mm.
+        r_mm: f64,
+        /// Height of the point, mm.
+        z_mm: f64,
+        /// Name of the semiconductor.
+        crystal: String,
+        /// The crystal's bounding box: smallest radius, mm.
+        r_min_mm: f64,
+        /// Largest radius, mm.
+        r_max_mm: f64,
+        /// Lowest height, mm.
+        z_min_mm: f64,
+        /// Highest height, mm.
+        z_max_mm: f64,
+    },
+    /// A signal to normalise by ends at (nearly) zero: no net charge reached its contact.
+    #[error(
+        "the signal of `{contact}` ends at {end_charge:.3e} (no net charge reached it), so it cannot be scaled to end at 1"
+    )]
+    NoNetCharge {
+        /// Name of the contact.
+        contact: String,
+        /// The signal's end value, units of the pair charge.
+        end_charge: f64,
+    },
 }
 
 /// Result alias of the solver crate.

@@ -22,6 +22,7 @@ mod material;
 mod relaxation;
 
 pub mod constants;
+pub mod scan;
 
 pub use detector::{
     BoundaryKind, Contact, ContactPotential, Detector, Passive, PassiveKind, Region, Semiconductor,
@@ -30,6 +31,10 @@ pub use detector::{
 pub use drift::{
     AdlModel, AdlParameters, AxisParameters, Carrier, ContactSignal, Drift, DriftModel,
     DriftSample, DriftSettings, ElectricField, Pulse, StopReason, drift_carrier, pulse,
+};
+pub use drift::{
+    DriftOutcome, FieldLine, PointStatus, check_interaction_point, crossing_time_ns, field_line,
+    normalise_signals, point_status, reference_contact, rise_time_10_90_ns,
 };
 pub use error::{Error, Result};
 pub use expr::Parameters;

@@ -6,11 +6,10 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result, bail};
 use hpge_reports::plot;
-use hpge_solver::{Detector, ElectricField};
+use hpge_solver::{ElectricField, field_line};
 use serde_json::json;
 
 use super::args::{RadiusRange, load_detector, parse_r_range};
-use super::drift_common::{PointStatus, point_status};
 use super::simulate::backend_json;
 use super::{DetectorInput, SolverArgs, WeightingArg};
 
@@ -45,34 +44,6 @@ pub struct FieldArgs {
     /// Write r_mm, |E| (V/cm, empty where there is no field) and the status as CSV.
     #[arg(long, value_name = "FILE")]
     out: Option<PathBuf>,
-}
-
-/// |E| along r with the status of every radius.
-pub struct FieldLine {
-    /// Radii, mm.
-    pub r_mm: Vec<f64>,
-    /// |E| in V/m; `None` where there is no field.
-    pub e_v_per_m: Vec<Option<f64>>,
-    /// Where each radius lies.
-    pub status: Vec<PointStatus>,
-}
-
-/// |E| at `r_mm` for (phi, z) in the field of one bias point.
-pub fn field_line(
-    det: &Detector,
-    field: &ElectricField,
-    phi_rad: f64,
-    z_mm: f64,
-    r_mm: &[f64],
-) -> FieldLine {
-    FieldLine {
-        r_mm: r_mm.to_vec(),
-        e_v_per_m: field.magnitude_along_r(phi_rad, z_mm, r_mm),
-        status: r_mm
-            .iter()
-            .map(|&r| point_status(det, field, r, z_mm))
-            .collect(),
-    }
 }
 
 /// Runs `field`.

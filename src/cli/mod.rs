@@ -5,7 +5,6 @@ mod convergence;
 mod detector;
 mod discover;
 mod discover_report;
-pub(crate) mod drift_common;
 pub(crate) mod field;
 pub(crate) mod fit;
 mod generate;

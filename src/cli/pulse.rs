@@ -7,14 +7,13 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 use hpge_reports::plot;
-use hpge_solver::{AdlModel, AdlParameters, Detector, DriftSettings, ElectricField, Pulse};
+use hpge_solver::{
+    AdlModel, AdlParameters, Detector, DriftSettings, ElectricField, Pulse,
+    check_interaction_point, normalise_signals, reference_contact, rise_time_10_90_ns,
+};
 use serde_json::json;
 
 use super::args::{load_detector, parse_cylindrical};
-use super::drift_common::{
-    check_interaction_point, drift_json, normalise, read_adl_parameters, reference_contact,
-    rise_time_10_90_ns, stop_text,
-};
 use super::simulate::backend_json;
 use super::{DetectorInput, SolverArgs, WeightingArg};
 
@@ -90,10 +89,12 @@ pub fn run(a: &PulseArgs) -> Result<()> {
     let flag = format!("--at {r_mm},{phi_deg},{z_mm}");
     // Cheap geometric checks before the field solve.
     if let hpge_solver::Region::Contact(i) = det.classify(r_mm, z_mm) {
-        bail!(
-            "{flag}: (r, z) = ({r_mm}, {z_mm}) mm is inside the contact `{}`; an interaction must be in the depleted crystal",
-            det.contacts[i].name
-        );
+        let e = hpge_solver::Error::InteractionInContact {
+            r_mm,
+            z_mm,
+            contact: det.contacts[i].name.clone(),
+        };
+        return Err(anyhow::Error::new(e).context(flag));
     }
     let settings = a
         .solver
@@ -102,7 +103,7 @@ pub fn run(a: &PulseArgs) -> Result<()> {
     backend_json(&settings)?;
     let point = hpge_solver::solve_point(&det, a.voltage, &settings, None)?;
     let field = ElectricField::new(&det, &point);
-    check_interaction_point(&det, &point, &field, (r_mm, z_mm), &flag)?;
+    check_interaction_point(&det, &point, &field, (r_mm, z_mm)).context(flag)?;
     let drift = DriftSettings::default();
     let mut p = hpge_solver::pulse(
         &det,
@@ -113,7 +114,7 @@ pub fn run(a: &PulseArgs) -> Result<()> {
     )?;
     let k_ref = reference_contact(&det);
     let divisor = if a.normalise {
-        Some(normalise(&mut p, k_ref)?)
+        Some(normalise_signals(&mut p, k_ref).context("--normalise")?)
     } else {
         None
     };
@@ -136,8 +137,8 @@ pub fn run(a: &PulseArgs) -> Result<()> {
             "t_ns": p.t_ns,
             "contacts": p.signals.iter().map(|s| json!({"name": s.name, "signal": s.charge})).collect::<Vec<_>>(),
             "collection_time_ns": p.collection_time_ns,
-            "electron": drift_json(&det, &p.electron),
-            "hole": drift_json(&det, &p.hole),
+            "electron": p.electron.outcome(&det),
+            "hole": p.hole.outcome(&det),
             "normalised": a.normalise,
             "normalised_by": divisor,
             "reference_contact": det.contacts[k_ref].name,
@@ -157,6 +158,17 @@ pub fn run(a: &PulseArgs) -> Result<()> {
         print_summary(&det, &p, &provenance, rise, divisor);
     }
     Ok(())
+}
+
+/// ADL parameters from a TOML file (missing keys keep the published defaults), checked.
+fn read_adl_parameters(path: &Path, flag: &str) -> Result<AdlParameters> {
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("{flag} {}: cannot read the file", path.display()))?;
+    let p: AdlParameters = toml::from_str(&text)
+        .with_context(|| format!("{flag} {}: not a valid ADL parameter file", path.display()))?;
+    p.validate()
+        .map_err(|m| anyhow::anyhow!("{flag} {}: {m}", path.display()))?;
+    Ok(p)
 }
 
 /// The inputs every output records.
@@ -210,7 +222,7 @@ fn print_summary(
         println!(
             "  {:8} {} after {:.1} ns, at r = {:.2} mm, z = {:.2} mm",
             d.carrier.as_str(),
-            stop_text(det, d.stop),
+            d.stop.describe(det),
             d.end_time_ns(),
             end[0].hypot(end[1]),
             end[2]

@@ -1,27 +1,19 @@
 //! `hpge-cv sensitivity`: c12 at one bias for constant impurity densities (the paper's
-//! "impurity level sensitivity" scan, section 5).
+//! "impurity level sensitivity" scan, section 5; the scan itself is
+//! `hpge_solver::scan::sensitivity_scan`).
 
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use anyhow::{Context, Result, bail};
 use hpge_reports::plot;
-use hpge_solver::{FieldSettings, ImpuritySpec, solve_point};
+use hpge_solver::FieldSettings;
+use hpge_solver::scan::{log_spaced, sensitivity_scan};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::json;
 
 use super::DetectorInput;
 use super::args::load_detector;
-
-/// One point of the scan.
-pub struct ScanPoint {
-    /// Constant net impurity density, cm^-3 (positive: n-type).
-    pub zeta_cm3: f64,
-    /// c12 at the bias, pF.
-    pub c12_pf: f64,
-    /// No undepleted semiconductor at the bias.
-    pub fully_depleted: bool,
-}
 
 /// Parses `MIN:MAX:N`: N densities (cm^-3) spaced evenly in log between MIN and MAX (> 0).
 pub fn parse_range(s: &str) -> Result<Vec<f64>, String> {
@@ -40,10 +32,7 @@ pub fn parse_range(s: &str) -> Result<Vec<f64>, String> {
     if !(2..=1000).contains(&n) {
         return Err(format!("`{s}`: the count N must lie in 2..=1000, got {n}"));
     }
-    let (la, lb) = (lo.ln(), hi.ln());
-    Ok((0..n)
-        .map(|k| (la + (lb - la) * k as f64 / (n - 1) as f64).exp())
-        .collect())
+    log_spaced(lo, hi, n).map_err(|e| format!("`{s}`: {e}"))
 }
 
 /// Options of `sensitivity`.
@@ -71,7 +60,7 @@ pub fn run(o: &SensitivityOptions<'_>) -> Result<()> {
     if let Some(p) = o.plot {
         plot::check_output(p, "--plot")?;
     }
-    let mut det = load_detector(o.input)?;
+    let det = load_detector(o.input)?;
     let settings = o.grid.apply(&o.settings, &det)?;
     let device = super::simulate::backend_json(&settings)?;
     let bar = ProgressBar::new(o.zetas_cm3.len() as u64);
@@ -82,23 +71,9 @@ pub fn run(o: &SensitivityOptions<'_>) -> Result<()> {
         .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     let start = std::time::Instant::now();
-    let mut points = Vec::with_capacity(o.zetas_cm3.len());
-    for &zeta in o.zetas_cm3 {
-        let name = Path::new("(sensitivity scan: constant model)");
-        let spec = ImpuritySpec::from_toml_str(
-            &format!("model = \"constant\"\nzeta_cm3 = {zeta:e}\n"),
-            name,
-        )?;
-        det.set_impurity(&spec, name)?;
-        let p = solve_point(&det, o.voltage_v, &settings, None)
-            .with_context(|| format!("constant density {zeta:e} cm^-3 at {} V", o.voltage_v))?;
-        points.push(ScanPoint {
-            zeta_cm3: zeta,
-            c12_pf: p.c12_pf,
-            fully_depleted: p.fully_depleted(),
-        });
-        bar.inc(1);
-    }
+    let points = sensitivity_scan(&det, o.voltage_v, o.zetas_cm3, &settings, &|k| {
+        bar.set_position(k as u64)
+    })?;
     bar.finish_and_clear();
     let seconds = start.elapsed().as_secs_f64();
     if let Some(path) = o.out {
@@ -110,15 +85,7 @@ pub fn run(o: &SensitivityOptions<'_>) -> Result<()> {
         }
     }
     if let Some(path) = o.plot {
-        let drawn: Vec<plot::SensitivityPoint> = points
-            .iter()
-            .map(|p| plot::SensitivityPoint {
-                zeta_cm3: p.zeta_cm3,
-                c12_pf: p.c12_pf,
-                fully_depleted: p.fully_depleted,
-            })
-            .collect();
-        plot::sensitivity(&drawn, o.voltage_v, &det.name, path)?;
+        plot::sensitivity(&points, o.voltage_v, &det.name, path)?;
     }
     if o.json {
         let v = json!({

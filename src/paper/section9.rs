@@ -10,12 +10,11 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use hpge_reports::paper::models::{ModeDetectors, NamedModel, manufacturer};
 use hpge_reports::plot::{self, Corner, Curve, LineFigure};
-use hpge_solver::{AdlModel, DriftSettings, ElectricField, FieldSettings, solve_point};
-use serde_json::{Value, json};
-
-use crate::cli::drift_common::{
-    PointStatus, drift_json, normalise, point_status, reference_contact, rise_time_10_90_ns,
+use hpge_solver::{
+    AdlModel, DriftSettings, ElectricField, FieldSettings, PointStatus, field_line,
+    normalise_signals, point_status, reference_contact, rise_time_10_90_ns, solve_point,
 };
+use serde_json::{Value, json};
 
 /// V/m per V/cm.
 const V_PER_M_PER_V_PER_CM: f64 = 100.0;
@@ -113,15 +112,13 @@ fn one_model(model: NamedModel, inputs: &Section9Inputs, r_mm: &[f64]) -> Result
         .with_context(|| format!("field solve for {}", model.key))?;
     let field = ElectricField::new(det, &point);
     let phi = inputs.phi_deg.to_radians();
-    let e_v_per_cm: Vec<Option<f64>> = field
-        .magnitude_along_r(phi, inputs.z_mm, r_mm)
-        .into_iter()
+    let line = field_line(det, &field, phi, inputs.z_mm, r_mm);
+    let e_v_per_cm: Vec<Option<f64>> = line
+        .e_v_per_m
+        .iter()
         .map(|e| e.map(|e| e / V_PER_M_PER_V_PER_CM))
         .collect();
-    let status: Vec<PointStatus> = r_mm
-        .iter()
-        .map(|&r| point_status(det, &field, r, inputs.z_mm))
-        .collect();
+    let status = line.status;
     // The undepleted stretch of the field line, if any.
     let undepleted: Vec<f64> = r_mm
         .iter()
@@ -151,7 +148,7 @@ fn one_model(model: NamedModel, inputs: &Section9Inputs, r_mm: &[f64]) -> Result
     .with_context(|| format!("pulse for {}", model.key))?;
     let k = reference_contact(det);
     let end_raw = pulse.signals[k].charge.last().copied().unwrap_or(f64::NAN);
-    normalise(&mut pulse, k)?;
+    normalise_signals(&mut pulse, k).context("--normalise")?;
     let nplus = pulse.signals[k].charge.clone();
     let rise = rise_time_10_90_ns(&pulse.t_ns, &nplus);
     let d_li = det.parameters.get("d_li_mm");
@@ -171,8 +168,8 @@ fn one_model(model: NamedModel, inputs: &Section9Inputs, r_mm: &[f64]) -> Result
         "e_max_V_per_cm": e_v_per_cm.iter().flatten().fold(f64::NAN, |a: f64, &b| a.max(b)),
         "e_min_V_per_cm": e_v_per_cm.iter().flatten().fold(f64::NAN, |a: f64, &b| a.min(b)),
         "collection_time_ns": pulse.collection_time_ns,
-        "electron": drift_json(det, &pulse.electron),
-        "hole": drift_json(det, &pulse.hole),
+        "electron": pulse.electron.outcome(det),
+        "hole": pulse.hole.outcome(det),
         "nplus_contact": det.contacts[k].name,
         "nplus_end_charge_before_normalisation": end_raw,
         "nplus_rise_time_10_90_ns": rise,

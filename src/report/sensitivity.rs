@@ -1,14 +1,14 @@
 //! The paper's Fig. 13 (section 6): c12 at 25 V with d_Li = 1 mm for constant impurity
 //! densities, which sets the sensitive range zeta_l = 1e8 .. zeta_u = 1e11 cm^-3.
 
-use std::path::Path;
-
 use anyhow::{Context, Result, bail};
 use hpge_measurement::{Data, load_data};
+use hpge_solver::scan::sensitivity_scan;
+use hpge_solver::{Detector, FieldSettings, Parameters};
+use serde_json::json;
+
 use hpge_reports::paper::{Ctx, verdict};
 use hpge_reports::plot;
-use hpge_solver::{Detector, FieldSettings, ImpuritySpec, Parameters, solve_point};
-use serde_json::json;
 
 pub const STEM: &str = "sensitivity-25V";
 const VOLTAGE_V: f64 = 25.0;
@@ -25,24 +25,8 @@ pub fn run(ctx: &mut Ctx) -> Result<()> {
     };
     let mut p = Parameters::new();
     p.set("d_li_mm".to_string(), 1.0);
-    let mut det = Detector::from_file(&ctx.inputs.detector, &p)?;
-    let settings = FieldSettings::default();
-    let mut points = Vec::new();
-    for &zeta in &zetas {
-        let name = Path::new("(report paper: constant model)");
-        let spec = ImpuritySpec::from_toml_str(
-            &format!("model = \"constant\"\nzeta_cm3 = {zeta:e}\n"),
-            name,
-        )?;
-        det.set_impurity(&spec, name)?;
-        let r = solve_point(&det, VOLTAGE_V, &settings, None)
-            .with_context(|| format!("constant density {zeta:e} cm^-3 at {VOLTAGE_V} V"))?;
-        points.push(plot::SensitivityPoint {
-            zeta_cm3: zeta,
-            c12_pf: r.c12_pf,
-            fully_depleted: r.fully_depleted(),
-        });
-    }
+    let det = Detector::from_file(&ctx.inputs.detector, &p)?;
+    let points = sensitivity_scan(&det, VOLTAGE_V, &zetas, &FieldSettings::default(), &|_| {})?;
     ctx.both(STEM, |path| {
         plot::sensitivity(&points, VOLTAGE_V, &det.name, path)
     })?;

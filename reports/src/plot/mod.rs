@@ -33,5 +33,5 @@ pub use fit::{ZetaAtMode, ZetaProfile, fit_figures};
 pub use format::{Format, check_output};
 pub use lines::{Corner, Curve, LineFigure, line_figure};
 pub use measure::measurement;
-pub use sensitivity::{SensitivityPoint, sensitivity};
+pub use sensitivity::sensitivity;
 pub use surrogate::{learning_curves, surrogate_errors};

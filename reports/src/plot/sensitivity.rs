@@ -2,26 +2,16 @@
 
 use std::path::Path;
 
+use hpge_solver::scan::ScanPoint;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::style::{err, log_key_points};
 use crate::error::Result;
 
-/// One point of a sensitivity scan: c12 at the bias for one constant impurity density.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct SensitivityPoint {
-    /// Constant net impurity density, cm^-3 (positive: n-type).
-    pub zeta_cm3: f64,
-    /// c12 at the bias, pF.
-    pub c12_pf: f64,
-    /// No undepleted semiconductor at the bias (drawn as a filled marker).
-    pub fully_depleted: bool,
-}
-
 /// Draws c12 against zeta (both log scale); filled markers: fully depleted at the bias.
 pub fn sensitivity(
-    points: &[SensitivityPoint],
+    points: &[ScanPoint],
     voltage_v: f64,
     name: &str,
     path: &Path,
@@ -33,7 +23,7 @@ pub fn sensitivity(
 
 fn draw<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
-    points: &[SensitivityPoint],
+    points: &[ScanPoint],
     voltage_v: f64,
     name: &str,
 ) -> Result<()> {

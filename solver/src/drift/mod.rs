@@ -12,6 +12,9 @@
 
 mod adl;
 mod field;
+mod interaction;
+mod outcome;
+mod pulse_shape;
 mod settings;
 mod signal;
 mod trajectory;
@@ -23,6 +26,9 @@ mod pulse_tests;
 
 pub use adl::{AdlModel, AdlParameters, AxisParameters};
 pub use field::ElectricField;
+pub use interaction::{FieldLine, PointStatus, check_interaction_point, field_line, point_status};
+pub use outcome::DriftOutcome;
+pub use pulse_shape::{crossing_time_ns, normalise_signals, reference_contact, rise_time_10_90_ns};
 pub use settings::DriftSettings;
 pub use signal::{ContactSignal, Pulse, pulse};
 pub use trajectory::{Drift, DriftSample, StopReason, drift_carrier};
