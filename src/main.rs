@@ -5,7 +5,6 @@
 //! exits with code 3.
 
 mod cli;
-mod paper;
 mod report;
 
 use std::process::ExitCode;

@@ -117,6 +117,17 @@ pub enum Error {
         /// What is wrong.
         message: String,
     },
+    /// An error with what was being done when it happened (e.g. the step of `report paper`).
+    #[error("{context}: {inner}")]
+    Context {
+        /// What was being done.
+        context: String,
+        /// The error itself.
+        inner: Box<Error>,
+    },
+    /// A table of an earlier step could not be read.
+    #[error(transparent)]
+    Csv(#[from] csv::Error),
     /// A solver-side failure (a bad detector, a failed solve).
     #[error(transparent)]
     Solver(#[from] hpge_solver::Error),
@@ -158,6 +169,14 @@ impl Error {
             file,
             action,
             source,
+        }
+    }
+
+    /// This error with what was being done when it happened.
+    pub fn context(self, context: impl Into<String>) -> Self {
+        Error::Context {
+            context: context.into(),
+            inner: Box::new(self),
         }
     }
 

@@ -6,7 +6,7 @@ use std::path::Path;
 use anyhow::Result;
 use hpge_inference::fit::{FitFiles, FitJob};
 use hpge_inference::{CvModel, FitSettings, SamplerKind, Status};
-use hpge_reports::fit::{FitObserver, run_fit, summary_text};
+use hpge_reports::fit::{FitObserver, FitRun, run_fit, summary_text};
 use indicatif::{ProgressBar, ProgressStyle};
 
 /// A fit that did not reach its convergence targets (exit code 3).
@@ -172,23 +172,7 @@ pub fn run(o: &FitOptions, print_json: bool, allow_unconverged: bool) -> Result<
         print!("{}", summary_text(&run.fit, &run.out));
     }
     if !sm.converged {
-        let worst = sm
-            .parameters
-            .iter()
-            .max_by(|a, b| a.rhat.total_cmp(&b.rhat))
-            .map(|p| {
-                format!(
-                    "largest R-hat {:.4} ({}), smallest bulk ESS {:.0}",
-                    p.rhat,
-                    p.name,
-                    sm.parameters
-                        .iter()
-                        .map(|p| p.ess_bulk)
-                        .fold(f64::INFINITY, f64::min)
-                )
-            })
-            .unwrap_or_default();
-        let msg = format!("{worst}; stopped: {:?}", sm.stop);
+        let msg = unconverged_text(sm);
         if allow_unconverged {
             eprintln!("warning: the fit did not converge ({msg})");
         } else {
@@ -196,4 +180,69 @@ pub fn run(o: &FitOptions, print_json: bool, allow_unconverged: bool) -> Result<
         }
     }
     Ok(())
+}
+
+/// Why a fit did not converge: the largest R-hat, the smallest bulk ESS, the stop reason.
+fn unconverged_text(sm: &hpge_inference::FitSummary) -> String {
+    let worst = sm
+        .parameters
+        .iter()
+        .max_by(|a, b| a.rhat.total_cmp(&b.rhat))
+        .map(|p| {
+            format!(
+                "largest R-hat {:.4} ({}), smallest bulk ESS {:.0}",
+                p.rhat,
+                p.name,
+                sm.parameters
+                    .iter()
+                    .map(|p| p.ess_bulk)
+                    .fold(f64::INFINITY, f64::min)
+            )
+        })
+        .unwrap_or_default();
+    format!("{worst}; stopped: {:?}", sm.stop)
+}
+
+/// The display of `report paper`'s fits: the fit's progress, then its summary on stdout and a
+/// warning when it did not converge (as `fit --allow-unconverged` prints them).
+pub struct ReportDisplay(Display);
+
+impl ReportDisplay {
+    /// A display on stderr and stdout.
+    pub fn new() -> Self {
+        ReportDisplay(Display {
+            sampling: std::sync::Mutex::new(None),
+            exact: std::sync::Mutex::new(None),
+        })
+    }
+}
+
+impl FitObserver for ReportDisplay {
+    fn setup_done(&self, job: &FitJob, o: &FitOptions, settings: &FitSettings) {
+        self.0.setup_done(job, o, settings);
+    }
+    fn sampling(&self, status: &Status) {
+        self.0.sampling(status);
+    }
+    fn sampling_done(&self) {
+        self.0.sampling_done();
+    }
+    fn exact_start(&self, draws: usize) {
+        self.0.exact_start(draws);
+    }
+    fn exact_progress(&self, done: usize, total: usize) {
+        self.0.exact_progress(done, total);
+    }
+    fn exact_done(&self) {
+        self.0.exact_done();
+    }
+    fn finished(&self, run: &FitRun) {
+        print!("{}", summary_text(&run.fit, &run.out));
+        if !run.fit.summary.converged {
+            eprintln!(
+                "warning: the fit did not converge ({})",
+                unconverged_text(&run.fit.summary)
+            );
+        }
+    }
 }

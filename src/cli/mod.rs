@@ -632,7 +632,10 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Convergence(a) => convergence::run(&a),
         Command::Field(a) => field::run(&a),
         Command::PaperSection9 { out } => {
-            for f in crate::paper::section9(&out, &crate::paper::Section9Inputs::default())? {
+            for f in hpge_reports::paper::section9_compute::section9(
+                &out,
+                &hpge_reports::paper::section9_compute::Section9Inputs::default(),
+            )? {
                 eprintln!("wrote {}", f.display());
             }
             Ok(())

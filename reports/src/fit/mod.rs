@@ -28,6 +28,8 @@ pub trait FitObserver: Sync {
     fn exact_progress(&self, _done: usize, _total: usize) {}
     /// The exact-solver check ended.
     fn exact_done(&self) {}
+    /// The fit is written (called by `report paper`'s fit steps, which show the result).
+    fn finished(&self, _run: &FitRun) {}
 }
 
 /// An observer that shows nothing.

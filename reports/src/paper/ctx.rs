@@ -77,7 +77,7 @@ pub struct Row {
 }
 
 /// What a run collects: its rows, figure files, step times and numbers for report.json.
-#[derive(Debug)]
+
 pub struct Ctx {
     /// The output folder.
     pub out: PathBuf,
@@ -97,6 +97,8 @@ pub struct Ctx {
     pub steps: Vec<(String, f64)>,
     /// Numbers for report.json, by key.
     pub numbers: serde_json::Map<String, serde_json::Value>,
+    /// What shows the progress and results of the fit steps (default: nothing).
+    pub fit_observer: Box<dyn crate::fit::FitObserver>,
 }
 
 impl Ctx {
@@ -112,6 +114,7 @@ impl Ctx {
             files: Vec::new(),
             steps: Vec::new(),
             numbers: serde_json::Map::new(),
+            fit_observer: Box::new(crate::fit::Quiet),
         }
     }
 

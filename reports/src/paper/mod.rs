@@ -1,4 +1,4 @@
-//! The steps of `hpge-cv report paper` that need no command-line code: each draws one group of
+//! The steps of `hpge-cv report paper`: each draws one group of
 //! the paper's figures with this project's numbers and adds the README rows that set them beside
 //! the paper's statements.
 //!
@@ -11,16 +11,26 @@
 //! - [`models`]: the impurity models of section 9 as detectors (the manufacturer's model and the
 //!   global modes of fits).
 //!
-//! [`Ctx`] carries a run's state between the steps; the command line owns the order of the steps
-//! (and the ones that run fits).
+//! - [`sensitivity`]: Fig. 13, the sensitivity scan at 25 V.
+//! - [`fits`]: Figs. 20-28, the B_Z and B_RZ fits of the shipped data.
+//! - [`section9`]: Fig. 29, the field along r and the n+ pulses at the fits' modes (computed by
+//!   [`section9_compute`]).
+//!
+//! [`run_paper`] runs the steps in order; [`Ctx`] carries a run's state between them.
 
 pub mod ctx;
 pub mod cv;
 pub mod density;
+pub mod fits;
 pub mod models;
 pub mod readme;
+mod run;
 pub mod samples;
+pub mod section9;
+pub mod section9_compute;
+pub mod sensitivity;
 pub mod surrogate;
 
 pub use ctx::{Ctx, Inputs, Row, verdict};
 pub use models::{ModeDetectors, NamedModel};
+pub use run::{PaperRun, run_paper};

@@ -10,12 +10,7 @@ use super::style::{err, log_key_points};
 use crate::error::Result;
 
 /// Draws c12 against zeta (both log scale); filled markers: fully depleted at the bias.
-pub fn sensitivity(
-    points: &[ScanPoint],
-    voltage_v: f64,
-    name: &str,
-    path: &Path,
-) -> Result<()> {
+pub fn sensitivity(points: &[ScanPoint], voltage_v: f64, name: &str, path: &Path) -> Result<()> {
     render!(path, (1000, 700), |root, _svg| draw(
         &root, points, voltage_v, name
     ))

@@ -3,12 +3,13 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result};
-use hpge_reports::paper::{Ctx, verdict};
+use hpge_inference::fit::FitOptions;
 use hpge_solver::LogTransform;
 use serde_json::{Value, json};
 
-use crate::cli::fit::{FitOptions, run as fit};
+use super::{Ctx, verdict};
+use crate::fit::run_fit as fit;
+use crate::{Error, Result};
 
 /// The figures each fit contributes: (fit's figure stem, report stem suffix, paper figure).
 const BZ_FIGS: [(&str, &str, &str); 5] = [
@@ -44,24 +45,21 @@ pub(super) fn fit_dir(ctx: &Ctx, key: &str) -> PathBuf {
 /// Runs `fit` with the shipped defaults into fits/<key>; returns summary.json.
 fn run_fit(ctx: &Ctx, key: &str, prior: &Path, truth: Option<&Path>) -> Result<Value> {
     let out = fit_dir(ctx, key);
-    fit(
+    let run = fit(
         &FitOptions {
             data: ctx.inputs.data.clone(),
             model: ctx.inputs.fit_model.clone(),
             prior: prior.to_path_buf(),
             detector: ctx.inputs.detector.clone(),
-            out: Some(out.clone()),
+            out: Some(out),
             no_exact_check: !ctx.exact_check,
             truth: truth.map(Path::to_path_buf),
             ..FitOptions::default()
         },
-        false,
-        true,
+        ctx.fit_observer.as_ref(),
     )?;
-    let path = out.join("summary.json");
-    let text = std::fs::read_to_string(&path)
-        .with_context(|| format!("cannot read {}", path.display()))?;
-    Ok(serde_json::from_str(&text)?)
+    ctx.fit_observer.finished(&run);
+    Ok(run.summary_json)
 }
 
 /// The global mode of parameter `name` and its 68.3% smallest intervals, as text.
@@ -91,19 +89,25 @@ fn pulls(dir: &Path) -> Result<(f64, f64)> {
     let mut r = csv::ReaderBuilder::new()
         .comment(Some(b'#'))
         .from_path(&path)
-        .with_context(|| format!("cannot read {}", path.display()))?;
+        .map_err(|e| Error::from(e).context(format!("cannot read {}", path.display())))?;
     let h = r.headers()?.clone();
     let col = |n: &str| {
         h.iter()
             .position(|x| x == n)
-            .context("predictive.csv: no column")
+            .ok_or_else(|| Error::invalid("predictive.csv: no column"))
     };
     let (u, p) = (col("voltage_V")?, col("pull_at_mode")?);
     let (mut lo, mut hi) = (0.0_f64, 0.0_f64);
     for rec in r.records() {
         let rec = rec?;
-        let v: f64 = rec.get(u).unwrap_or("").parse()?;
-        let pull: f64 = rec.get(p).unwrap_or("").parse()?;
+        let num = |i: usize| -> Result<f64> {
+            let t = rec.get(i).unwrap_or("");
+            t.parse().map_err(|e| Error::Content {
+                file: path.clone(),
+                message: format!("`{t}`: {e}"),
+            })
+        };
+        let (v, pull) = (num(u)?, num(p)?);
         if v < 1000.0 {
             lo = lo.max(pull.abs());
         } else {

@@ -7,9 +7,9 @@
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result};
-use hpge_reports::paper::models::{ModeDetectors, NamedModel, manufacturer};
-use hpge_reports::plot::{self, Corner, Curve, LineFigure};
+use super::models::{ModeDetectors, NamedModel, manufacturer};
+use crate::plot::{self, Corner, Curve, LineFigure};
+use crate::{Error, Result};
 use hpge_solver::{
     AdlModel, DriftSettings, ElectricField, FieldSettings, PointStatus, field_line,
     normalise_signals, point_status, reference_contact, rise_time_10_90_ns, solve_point,
@@ -84,8 +84,7 @@ struct ModelResult {
 /// Computes section 9 into `out` (created if missing): `field-r.svg/png`, `pulses-nplus.svg/png`,
 /// `field-r.csv`, `pulses-nplus.csv`, `section9.csv` and `section9.json`; returns the paths.
 pub fn section9(out: &Path, inputs: &Section9Inputs) -> Result<Vec<PathBuf>> {
-    std::fs::create_dir_all(out)
-        .with_context(|| format!("{}: cannot create the folder", out.display()))?;
+    std::fs::create_dir_all(out).map_err(Error::io(out, "cannot create the folder"))?;
     let mut models = vec![manufacturer(&inputs.detector, inputs.d_li_manufacturer_mm)?];
     let modes = ModeDetectors::new(&inputs.surrogate, &inputs.detector)?;
     for (key, label, prior, summary) in &inputs.fits {
@@ -109,7 +108,7 @@ pub fn section9(out: &Path, inputs: &Section9Inputs) -> Result<Vec<PathBuf>> {
 fn one_model(model: NamedModel, inputs: &Section9Inputs, r_mm: &[f64]) -> Result<ModelResult> {
     let det = &model.detector;
     let point = solve_point(det, inputs.voltage_v, &FieldSettings::default(), None)
-        .with_context(|| format!("field solve for {}", model.key))?;
+        .map_err(|e| Error::from(e).context(format!("field solve for {}", model.key)))?;
     let field = ElectricField::new(det, &point);
     let phi = inputs.phi_deg.to_radians();
     let line = field_line(det, &field, phi, inputs.z_mm, r_mm);
@@ -145,10 +144,10 @@ fn one_model(model: NamedModel, inputs: &Section9Inputs, r_mm: &[f64]) -> Result
         (inputs.event_r_mm, phi, inputs.z_mm),
         &DriftSettings::default(),
     )
-    .with_context(|| format!("pulse for {}", model.key))?;
+    .map_err(|e| Error::from(e).context(format!("pulse for {}", model.key)))?;
     let k = reference_contact(det);
     let end_raw = pulse.signals[k].charge.last().copied().unwrap_or(f64::NAN);
-    normalise_signals(&mut pulse, k).context("--normalise")?;
+    normalise_signals(&mut pulse, k).map_err(|e| Error::from(e).context("--normalise"))?;
     let nplus = pulse.signals[k].charge.clone();
     let rise = rise_time_10_90_ns(&pulse.t_ns, &nplus);
     let d_li = det.parameters.get("d_li_mm");
@@ -304,10 +303,9 @@ fn figures(out: &Path, inputs: &Section9Inputs, res: &[ModelResult]) -> Result<V
 }
 
 fn write_text(path: &Path, text: &str) -> Result<PathBuf> {
-    let mut f = std::fs::File::create(path)
-        .with_context(|| format!("{}: cannot create the file", path.display()))?;
+    let mut f = std::fs::File::create(path).map_err(Error::io(path, "cannot create the file"))?;
     f.write_all(text.as_bytes())
-        .with_context(|| format!("{}: cannot write the file", path.display()))?;
+        .map_err(Error::io(path, "cannot write the file"))?;
     Ok(path.to_path_buf())
 }
 

@@ -1,14 +1,13 @@
 //! The paper's Fig. 13 (section 6): c12 at 25 V with d_Li = 1 mm for constant impurity
 //! densities, which sets the sensitive range zeta_l = 1e8 .. zeta_u = 1e11 cm^-3.
 
-use anyhow::{Context, Result, bail};
 use hpge_measurement::{Data, load_data};
 use hpge_solver::scan::sensitivity_scan;
 use hpge_solver::{Detector, FieldSettings, Parameters};
 use serde_json::json;
 
-use hpge_reports::paper::{Ctx, verdict};
-use hpge_reports::plot;
+use super::{Ctx, verdict};
+use crate::{Error, Result, plot};
 
 pub const STEM: &str = "sensitivity-25V";
 const VOLTAGE_V: f64 = 25.0;
@@ -34,12 +33,17 @@ pub fn run(ctx: &mut Ctx) -> Result<()> {
         points
             .iter()
             .find(|p| (p.zeta_cm3 / z - 1.0).abs() < 1e-9)
-            .context("a density of the scan is missing")
+            .ok_or_else(|| Error::invalid("a density of the scan is missing"))
     };
     let (p7, p8, p11) = (at(1e7)?, at(1e8)?, at(1e11)?);
     let data = match load_data(&ctx.inputs.data)? {
         Data::Curve(c) => c,
-        Data::Raw(_) => bail!("{}: expected a C-V curve", ctx.inputs.data.display()),
+        Data::Raw(_) => {
+            return Err(Error::Content {
+                file: ctx.inputs.data.clone(),
+                message: "expected a C-V curve".into(),
+            });
+        }
     };
     let c_m = data
         .voltage_v

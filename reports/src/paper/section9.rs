@@ -2,12 +2,14 @@
 //! manufacturer's model and the global modes of both fits) from `paper::section9`, fed with the
 //! fits of this run.
 
-use anyhow::{Context, Result};
-use hpge_reports::paper::{Ctx, verdict};
 use serde_json::Value;
 
 use super::fits::fit_dir;
+use super::section9_compute::{Section9Inputs, section9};
+use super::{Ctx, verdict};
+use crate::{Error, Result};
 
+/// The section-9 step of `report paper` (left out of a `--quick` run).
 pub fn run(ctx: &mut Ctx) -> Result<()> {
     let stems = [
         ("section9-field-r", "Fig. 29a (sec. 9)"),
@@ -25,7 +27,7 @@ pub fn run(ctx: &mut Ctx) -> Result<()> {
         }
         return Ok(());
     }
-    let mut inputs = crate::paper::Section9Inputs {
+    let mut inputs = Section9Inputs {
         detector: ctx.inputs.detector.clone(),
         surrogate: ctx.inputs.fit_model.clone(),
         ..Default::default()
@@ -34,14 +36,18 @@ pub fn run(ctx: &mut Ctx) -> Result<()> {
         f.3 = fit_dir(ctx, &f.0).join("summary.json");
     }
     let dir = ctx.out.join("section9");
-    crate::paper::section9(&dir, &inputs)?;
+    section9(&dir, &inputs)?;
     ctx.copy_both(&dir, "field-r", "section9-field-r")?;
     ctx.copy_both(&dir, "pulses-nplus", "section9-pulses-nplus")?;
     let path = dir.join("section9.json");
-    let v: Value = serde_json::from_str(
-        &std::fs::read_to_string(&path)
-            .with_context(|| format!("cannot read {}", path.display()))?,
-    )?;
+    let v: Value =
+        serde_json::from_str(
+            &std::fs::read_to_string(&path).map_err(|source| Error::Read {
+                file: path.clone(),
+                what: "section 9's numbers",
+                source,
+            })?,
+        )?;
     let models = v["models"].as_array().cloned().unwrap_or_default();
     let get = |key: &str| {
         models

@@ -1,0 +1,95 @@
+//! `report paper` as one library call: every step in order, each timed, then `README.md` and
+//! `report.json`.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use super::{Ctx, Inputs, cv, density, fits, readme, samples, section9, sensitivity, surrogate};
+use crate::fit::FitObserver;
+use crate::{Error, Result};
+
+/// A finished `report paper` run.
+pub struct PaperRun {
+    /// The README written.
+    pub readme: PathBuf,
+    /// Figures with a result (rows not marked "not run").
+    pub figures: usize,
+    /// Figure files written.
+    pub files: usize,
+    /// The figures folder.
+    pub figures_dir: PathBuf,
+    /// Seconds in all.
+    pub seconds: f64,
+}
+
+type StepFn = fn(&mut Ctx) -> Result<()>;
+
+/// The steps in order, with their names.
+const STEPS: [(&str, StepFn); 8] = [
+    ("C-V curve: manufacturer model vs data", cv::run),
+    ("sensitivity scan at 25 V", sensitivity::run),
+    ("transform, example density, cross-sections", density::run),
+    ("training-sample histograms", samples::run),
+    (
+        "surrogate: learning curves, held-out accuracy",
+        surrogate::run,
+    ),
+    ("fit B_Z", fits::run_bz),
+    ("fit B_RZ", fits::run_brz),
+    ("section 9: field and pulses", section9::run),
+];
+
+/// Runs every step of `report paper` into `out` (`quick`: the reduced run without fits and
+/// section 9; `exact_check`: the fits' exact-solver check); `step` sees (step name, number from
+/// 1, steps in all, seconds so far) before each step; the fits' progress goes to `observer`.
+///
+/// # Errors
+/// A missing shipped input, an output folder that cannot be made, and the first step that fails
+/// (named in the error).
+pub fn run_paper(
+    out: PathBuf,
+    quick: bool,
+    exact_check: bool,
+    observer: Box<dyn FitObserver>,
+    step: &dyn Fn(&str, usize, usize, f64),
+) -> Result<PaperRun> {
+    let start = Instant::now();
+    let inputs = Inputs::default();
+    for p in inputs.all() {
+        if !p.is_file() {
+            return Err(Error::invalid(format!(
+                "{}: a shipped input of `report paper` is missing; run it from the repository root \
+                 of a complete checkout",
+                p.display()
+            )));
+        }
+    }
+    let mut ctx = Ctx::new(out.clone(), quick, exact_check, inputs);
+    ctx.fit_observer = observer;
+    std::fs::create_dir_all(&ctx.figures).map_err(|e| Error::Output {
+        flag: "--out".into(),
+        file: out.clone(),
+        message: format!("cannot create the folder: {e}"),
+    })?;
+    let n = STEPS.len();
+    for (k, (name, run)) in STEPS.iter().enumerate() {
+        step(name, k + 1, n, start.elapsed().as_secs_f64());
+        let t = Instant::now();
+        run(&mut ctx).map_err(|e| e.context(format!("report paper, step `{name}`")))?;
+        ctx.steps
+            .push((name.to_string(), t.elapsed().as_secs_f64()));
+    }
+    let total = start.elapsed().as_secs_f64();
+    let written = readme::write(&ctx, total)?;
+    Ok(PaperRun {
+        readme: written,
+        figures: ctx
+            .rows
+            .iter()
+            .filter(|r| !r.verdict.starts_with("not run"))
+            .count(),
+        files: ctx.files.len(),
+        figures_dir: ctx.figures.clone(),
+        seconds: total,
+    })
+}
