@@ -42,6 +42,7 @@
 
 #[macro_use]
 mod error;
+pub mod discover;
 pub mod fit;
 pub mod paper;
 pub mod plot;

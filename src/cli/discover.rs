@@ -2,7 +2,6 @@
 //! start model, locate where it disagrees with the data and what region of the detector that
 //! probes, score the catalogue of extensions, fit the best, and show the gap shrink.
 
-use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -195,66 +194,12 @@ pub fn run(a: &DiscoverArgs) -> Result<()> {
         &printer,
     )?;
     bar.finish_and_clear();
-    write_outputs(&out, &d, &s.exact, a.no_plots)?;
+    hpge_reports::discover::write_outputs(&out, &d, &s.exact, a.no_plots)?;
     if a.json {
         println!("{}", serde_json::to_string_pretty(&d.summary)?);
     } else {
         print_summary(&d, &out);
     }
-    Ok(())
-}
-
-/// The per-voltage table: data, both models at their modes, sigma, standardised residuals.
-fn write_residuals(path: &Path, d: &Discovery) -> Result<()> {
-    let mut f = std::fs::File::create(path)
-        .with_context(|| format!("{}: cannot create the file", path.display()))?;
-    writeln!(
-        f,
-        "# hpge-cv {} discover: start model {}, chosen {}",
-        env!("CARGO_PKG_VERSION"),
-        d.summary.start_model,
-        d.summary.chosen.as_deref().unwrap_or("none")
-    )?;
-    writeln!(
-        f,
-        "voltage_V,c_m_pF,before_c_pF,before_sigma_pF,before_residual,after_c_pF,after_sigma_pF,after_residual"
-    )?;
-    let after = d.after.as_ref().unwrap_or(&d.before);
-    for k in 0..d.voltage_v.len() {
-        writeln!(
-            f,
-            "{},{},{},{},{},{},{},{}",
-            d.voltage_v[k],
-            d.c_m_pf[k],
-            d.before.c_mode[k],
-            d.before.sigma_mode[k],
-            d.before.check.residuals[k],
-            after.c_mode[k],
-            after.sigma_mode[k],
-            after.check.residuals[k]
-        )?;
-    }
-    Ok(())
-}
-
-/// discovery.json, residuals.csv, report.md and the figures.
-pub fn write_outputs(
-    out: &Path,
-    d: &Discovery,
-    exact: &hpge_surrogate::ExactSolver,
-    no_plots: bool,
-) -> Result<()> {
-    let json = out.join("discovery.json");
-    std::fs::write(&json, serde_json::to_string_pretty(&d.summary)? + "\n")
-        .with_context(|| format!("{}: cannot write", json.display()))?;
-    write_residuals(&out.join("residuals.csv"), d)?;
-    let figures = if no_plots {
-        Vec::new()
-    } else {
-        let det = exact.detector(&d.start_inputs)?;
-        hpge_reports::plot::discovery_figures(d, &det, out)?
-    };
-    super::discover_report::write_report(&out.join("report.md"), d, &figures)?;
     Ok(())
 }
 

@@ -4,7 +4,6 @@ mod args;
 mod convergence;
 mod detector;
 mod discover;
-mod discover_report;
 pub(crate) mod field;
 pub(crate) mod fit;
 mod generate;

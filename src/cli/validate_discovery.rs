@@ -15,8 +15,9 @@ use hpge_measurement::write_curve_with_comments;
 use hpge_validation::{HiddenOutcome, hidden_effects, run_hidden, simulate_hidden};
 use serde::Serialize;
 
-use super::discover::{Printer, write_outputs};
+use super::discover::Printer;
 use super::fit::{noise_settings, progress_printer, setup};
+use hpge_reports::discover::write_outputs;
 
 /// `hpge-cv validate discovery` arguments.
 #[derive(Debug, clap::Args)]

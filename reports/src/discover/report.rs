@@ -3,8 +3,9 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result};
 use hpge_inference::Discovery;
+
+use crate::{Error, Result};
 
 /// Writes `report.md`.
 pub fn write_report(path: &Path, d: &Discovery, figures: &[PathBuf]) -> Result<()> {
@@ -173,6 +174,6 @@ pub fn write_report(path: &Path, d: &Discovery, figures: &[PathBuf]) -> Result<(
         "\nFiles: `discovery.json` (everything above), `residuals.csv` (per voltage: data, both \
          models at their modes, sigma, residuals)."
     );
-    std::fs::write(path, m).with_context(|| format!("{}: cannot write", path.display()))?;
+    std::fs::write(path, m).map_err(Error::io(path, "cannot write"))?;
     Ok(())
 }
