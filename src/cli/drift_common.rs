@@ -5,9 +5,9 @@
 use std::path::Path;
 
 use anyhow::{Context, Result, bail};
-use hpge_solver::{
-    AdlParameters, Detector, Drift, ElectricField, PointResult, Pulse, Region, StopReason,
-};
+use hpge_solver::detector::Region;
+use hpge_solver::drift::{AdlParameters, Drift, ElectricField, StopReason};
+use hpge_solver::{Detector, PointResult, Pulse};
 use serde_json::{Value, json};
 
 /// Where a point (r, z) lies at a solved bias: what `ElectricField::at` needs to give a field.

@@ -5,7 +5,8 @@ use std::io::Write as _;
 use std::path::PathBuf;
 
 use anyhow::{Context, Result, bail};
-use hpge_solver::{Detector, ElectricField};
+use hpge_solver::Detector;
+use hpge_solver::drift::ElectricField;
 use serde_json::json;
 
 use super::args::{RadiusRange, load_detector, parse_r_range};

@@ -10,7 +10,8 @@ use hpge_inference::{
     PriorSpec, SampleSettings, SamplerKind, Status, SurrogateModel, exact_check, fit,
     interval_contains, load_data,
 };
-use hpge_surrogate::{ExactSolver, Surrogate, fnv1a};
+use hpge_surrogate::hash::fnv1a;
+use hpge_surrogate::{ExactSolver, Surrogate};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use super::fit_outputs::{TruthRecord, read_truth, write_outputs};

@@ -6,7 +6,8 @@ use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
-use hpge_solver::{AdlModel, AdlParameters, Detector, DriftSettings, ElectricField, Pulse};
+use hpge_solver::drift::{AdlModel, AdlParameters, DriftSettings, ElectricField};
+use hpge_solver::{Detector, Pulse};
 use serde_json::json;
 
 use super::args::{load_detector, parse_cylindrical};
@@ -89,7 +90,7 @@ pub fn run(a: &PulseArgs) -> Result<()> {
     let (r_mm, phi_deg, z_mm) = a.at;
     let flag = format!("--at {r_mm},{phi_deg},{z_mm}");
     // Cheap geometric checks before the field solve.
-    if let hpge_solver::Region::Contact(i) = det.classify(r_mm, z_mm) {
+    if let hpge_solver::detector::Region::Contact(i) = det.classify(r_mm, z_mm) {
         bail!(
             "{flag}: (r, z) = ({r_mm}, {z_mm}) mm is inside the contact `{}`; an interaction must be in the depleted crystal",
             det.contacts[i].name

@@ -4,10 +4,11 @@ use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
-use hpge_surrogate::{
-    DataInfo, DataSet, EpochRecord, FORMAT, FORMAT_VERSION, Figures, Member, ModelInfo,
-    OutputTransform, ParameterSpace, Polynomial, Predictor, Recipe, Surrogate, Trained, unit_to_z,
+use hpge_surrogate::model::{
+    DataInfo, EpochRecord, FORMAT, FORMAT_VERSION, Member, OutputTransform, Polynomial, Trained,
+    unit_to_z,
 };
+use hpge_surrogate::{DataSet, Figures, ModelInfo, ParameterSpace, Predictor, Recipe, Surrogate};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 
@@ -29,13 +30,13 @@ pub struct TrainOptions<'a> {
 pub fn detector_info(
     space: &hpge_surrogate::ParameterSpace,
     detector: &Path,
-) -> Result<hpge_surrogate::DetectorInfo> {
+) -> Result<hpge_surrogate::model::DetectorInfo> {
     let exact = hpge_surrogate::ExactSolver::new(
         space.clone(),
         detector,
         hpge_solver::FieldSettings::default(),
     )?;
-    Ok(hpge_surrogate::DetectorInfo {
+    Ok(hpge_surrogate::model::DetectorInfo {
         file: detector.display().to_string(),
         hash: exact.detector_hash(),
     })
@@ -198,7 +199,7 @@ pub fn train(o: &TrainOptions) -> Result<()> {
         input_map: "u = (x - lo)/(hi - lo) per the space's distribution, clamped to \
                     [1e-6, 1 - 1e-6]; z = Phi^-1(u) (standard-normal coordinates)"
             .into(),
-        output: hpge_surrogate::output_transform(log_output, &train),
+        output: hpge_surrogate::model::output_transform(log_output, &train),
         recipe_name: o.recipe.into(),
         recipe: recipe.clone(),
         seed: o.seed,
@@ -274,7 +275,7 @@ pub fn train(o: &TrainOptions) -> Result<()> {
                 curves,
                 seconds,
                 ..
-            } = hpge_surrogate::train_resuming(
+            } = hpge_surrogate::model::train_resuming(
                 recipe,
                 &train,
                 &test,

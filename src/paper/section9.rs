@@ -8,7 +8,8 @@ use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
-use hpge_solver::{AdlModel, DriftSettings, ElectricField, FieldSettings, solve_point};
+use hpge_solver::drift::{AdlModel, DriftSettings, ElectricField};
+use hpge_solver::{FieldSettings, solve_point};
 use serde_json::{Value, json};
 
 use super::models::{ModeDetectors, NamedModel, manufacturer};

@@ -4,7 +4,8 @@
 use std::path::Path;
 
 use anyhow::Result;
-use hpge_solver::{BoundaryKind, Detector, PassiveKind, Region, WorldSide};
+use hpge_solver::Detector;
+use hpge_solver::detector::{BoundaryKind, PassiveKind, Region, WorldSide};
 use plotters::coord::Shift;
 use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;

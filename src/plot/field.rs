@@ -3,7 +3,8 @@
 use std::path::Path;
 
 use anyhow::Result;
-use hpge_solver::{Detector, PotentialPoint};
+use hpge_solver::Detector;
+use hpge_solver::field::PotentialPoint;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 

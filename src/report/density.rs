@@ -3,7 +3,8 @@
 //! and with the example density (d_Li = 3 mm, as `reports/make-figures.sh` draws it).
 
 use anyhow::Result;
-use hpge_solver::{Detector, LogTransform, Parameters};
+use hpge_solver::impurity::LogTransform;
+use hpge_solver::{Detector, Parameters};
 use serde_json::json;
 
 use super::{Ctx, verdict};

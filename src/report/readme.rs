@@ -5,7 +5,7 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use anyhow::{Context, Result};
-use hpge_surrogate::fnv1a;
+use hpge_surrogate::hash::fnv1a;
 use serde_json::json;
 
 use super::Ctx;

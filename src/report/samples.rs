@@ -2,7 +2,7 @@
 //! generated training and test samples (the points of `data/training/train.csv` and `test.csv`).
 
 use anyhow::{Context, Result, bail};
-use hpge_solver::LogTransform;
+use hpge_solver::impurity::LogTransform;
 use hpge_surrogate::{ParameterSpace, Sequence, SequenceKind};
 use serde_json::json;
 

@@ -7,7 +7,8 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context as _, Result, bail};
 use hpge_inference::Discovery;
-use hpge_solver::{BoundingBox, Detector};
+use hpge_solver::Detector;
+use hpge_solver::geometry::BoundingBox;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
