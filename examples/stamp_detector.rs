@@ -29,7 +29,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         )
         .into());
     }
-    model.info.detector = Some(hpge_surrogate::DetectorInfo {
+    model.info.detector = Some(hpge_surrogate::model::DetectorInfo {
         file: detector.display().to_string(),
         hash,
     });

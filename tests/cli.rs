@@ -320,7 +320,7 @@ fn simulate_bridge_error_draws_the_field() {
 /// GPU issue: `--backend wgpu` gives the CPU's c12 and says in the JSON where it ran.
 #[test]
 fn simulate_on_wgpu_matches_cpu_json() {
-    if !hpge_solver::gpu_test_gate() {
+    if !hpge_solver::gpu::gpu_test_gate() {
         return;
     }
     let run = |backend: &str| {

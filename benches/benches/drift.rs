@@ -7,10 +7,8 @@ use std::hint::black_box;
 use std::time::Duration;
 
 use criterion::Criterion;
-use hpge_solver::{
-    AdlModel, Carrier, Detector, DriftModel, DriftSettings, ElectricField, FieldSettings,
-    Parameters, pulse, solve_point,
-};
+use hpge_solver::drift::{AdlModel, Carrier, DriftModel, DriftSettings, ElectricField};
+use hpge_solver::{Detector, FieldSettings, Parameters, pulse, solve_point};
 use hpge_validation::repo_path;
 
 pub fn bench(c: &mut Criterion) {

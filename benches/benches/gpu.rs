@@ -11,10 +11,12 @@ use std::hint::black_box;
 use std::time::Duration;
 
 use criterion::Criterion;
-use hpge_solver::{
-    Detector, Grid, GridSettings, Mesh, Parameters, Precision, gpu_adapter, solve_fast, solve_sor,
-    solve_sor_wgpu, weighting_potentials, weighting_potentials_wgpu,
+use hpge_solver::field::{
+    Mesh, solve_fast, solve_sor, solve_sor_wgpu, weighting_potentials, weighting_potentials_wgpu,
 };
+use hpge_solver::gpu::gpu_adapter;
+use hpge_solver::grid::Grid;
+use hpge_solver::{Detector, GridSettings, Parameters, Precision};
 use hpge_validation::repo_path;
 
 const BIAS_V: f64 = 1025.0;

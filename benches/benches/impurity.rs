@@ -4,7 +4,8 @@
 use std::hint::black_box;
 
 use criterion::Criterion;
-use hpge_solver::{Detector, LogTransform, Parameters};
+use hpge_solver::impurity::LogTransform;
+use hpge_solver::{Detector, Parameters};
 use hpge_validation::repo_path;
 
 pub fn bench(c: &mut Criterion) {
@@ -36,7 +37,12 @@ pub fn bench(c: &mut Criterion) {
     c.bench_function("detector/classify_10k_points", |b| {
         b.iter(|| {
             pts.iter()
-                .filter(|&&(r, z)| matches!(det.classify(r, z), hpge_solver::Region::Semiconductor))
+                .filter(|&&(r, z)| {
+                    matches!(
+                        det.classify(r, z),
+                        hpge_solver::detector::Region::Semiconductor
+                    )
+                })
                 .count()
         })
     });

@@ -7,10 +7,8 @@
 use std::hint::black_box;
 
 use criterion::Criterion;
-use hpge_surrogate::{
-    DataInfo, FORMAT, FORMAT_VERSION, Figures, ModelInfo, OutputTransform, ParameterSpace,
-    Predictor, Recipe, Surrogate, initial_network,
-};
+use hpge_surrogate::model::{DataInfo, FORMAT, FORMAT_VERSION, OutputTransform, initial_network};
+use hpge_surrogate::{Figures, ModelInfo, ParameterSpace, Predictor, Recipe, Surrogate};
 use hpge_validation::repo_path;
 
 fn model(recipe: &str) -> Surrogate {

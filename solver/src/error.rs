@@ -194,6 +194,25 @@ pub enum Error {
         /// The signal's end value, units of the pair charge.
         end_charge: f64,
     },
+    /// An arithmetic expression (a length in a detector file) or a `NAME=VALUE` assignment does
+    /// not evaluate: syntax, unknown parameter, division by zero, non-finite result.
+    #[error("{reason}")]
+    Expression {
+        /// The expression or the assignment as written.
+        text: String,
+        /// What is wrong (the text the user sees; it quotes the expression where that helps).
+        reason: String,
+    },
+    /// A value built in code or given through the API is invalid (settings, model parameters,
+    /// spline knots, grid ticks) where no file is involved; callers that know the file or the
+    /// command-line flag put it in front of the message.
+    #[error("{message}")]
+    InvalidValue {
+        /// What kind of value, e.g. `grid settings` or `ADL parameters`.
+        what: &'static str,
+        /// What is wrong, naming the field.
+        message: String,
+    },
 }
 
 /// Result alias of the solver crate.
@@ -209,6 +228,14 @@ impl Error {
         Error::Invalid {
             file: file.into(),
             key: key.into(),
+            message: message.into(),
+        }
+    }
+
+    /// Shorthand for [`Error::InvalidValue`].
+    pub fn invalid_value(what: &'static str, message: impl Into<String>) -> Self {
+        Error::InvalidValue {
+            what,
             message: message.into(),
         }
     }

@@ -10,6 +10,8 @@ use std::fmt;
 use serde::de::{self, Visitor};
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
+use crate::error::{Error, Result};
+
 /// Named numeric parameters of a detector (e.g. `d_li_mm = 1.0`), in the units their names say.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Parameters {
@@ -47,24 +49,32 @@ impl Parameters {
         self.values.is_empty()
     }
 
-    /// Parses `NAME=VALUE` (as given to `--param`).
-    pub fn parse_assignment(text: &str) -> Result<(String, f64), String> {
-        let (name, value) = text
-            .split_once('=')
-            .ok_or_else(|| format!("expected NAME=VALUE, got `{text}`"))?;
-        let name = name.trim();
-        if !is_identifier(name) {
-            return Err(format!("`{name}` is not a valid parameter name"));
-        }
-        let value: f64 = value
-            .trim()
-            .parse()
-            .map_err(|_| format!("`{}` is not a number", value.trim()))?;
-        if !value.is_finite() {
-            return Err(format!("the value of `{name}` must be finite"));
-        }
-        Ok((name.to_string(), value))
+    /// Parses `NAME=VALUE` (as given to `--param`); the error is an [`Error::Expression`].
+    pub fn parse_assignment(text: &str) -> Result<(String, f64)> {
+        parse_assignment(text).map_err(|reason| Error::Expression {
+            text: text.to_string(),
+            reason,
+        })
     }
+}
+
+/// [`Parameters::parse_assignment`], the reason of a failure as text.
+fn parse_assignment(text: &str) -> Parsed<(String, f64)> {
+    let (name, value) = text
+        .split_once('=')
+        .ok_or_else(|| format!("expected NAME=VALUE, got `{text}`"))?;
+    let name = name.trim();
+    if !is_identifier(name) {
+        return Err(format!("`{name}` is not a valid parameter name"));
+    }
+    let value: f64 = value
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{}` is not a number", value.trim()))?;
+    if !value.is_finite() {
+        return Err(format!("the value of `{name}` must be finite"));
+    }
+    Ok((name.to_string(), value))
 }
 
 fn is_identifier(s: &str) -> bool {
@@ -83,8 +93,9 @@ pub(crate) enum Quantity {
 }
 
 impl Quantity {
-    /// Evaluates the quantity; the error says what failed (unknown name, syntax, non-finite).
-    pub(crate) fn eval(&self, params: &Parameters) -> Result<f64, String> {
+    /// Evaluates the quantity; the error ([`Error::Expression`]) says what failed (unknown name,
+    /// syntax, non-finite).
+    pub(crate) fn eval(&self, params: &Parameters) -> Result<f64> {
         let value = match self {
             Quantity::Number(v) => *v,
             Quantity::Expr(text) => eval_expr(text, params)?,
@@ -92,7 +103,10 @@ impl Quantity {
         if value.is_finite() {
             Ok(value)
         } else {
-            Err(format!("{self} is not a finite number"))
+            Err(Error::Expression {
+                text: self.to_string(),
+                reason: format!("{self} is not a finite number"),
+            })
         }
     }
 }
@@ -140,8 +154,19 @@ impl<'de> Deserialize<'de> for Quantity {
     }
 }
 
-/// Evaluates an arithmetic expression over `params`.
-pub(crate) fn eval_expr(text: &str, params: &Parameters) -> Result<f64, String> {
+/// Evaluates an arithmetic expression over `params`; the error is an [`Error::Expression`].
+pub(crate) fn eval_expr(text: &str, params: &Parameters) -> Result<f64> {
+    parse_and_eval(text, params).map_err(|reason| Error::Expression {
+        text: text.to_string(),
+        reason,
+    })
+}
+
+/// The parser's own results: the reason of a failure as text, turned into an
+/// [`Error::Expression`] by [`eval_expr`].
+type Parsed<T> = std::result::Result<T, String>;
+
+fn parse_and_eval(text: &str, params: &Parameters) -> Parsed<f64> {
     let tokens = tokenize(text)?;
     let mut p = ExprParser {
         tokens: &tokens,
@@ -172,7 +197,7 @@ impl fmt::Display for Token {
     }
 }
 
-fn tokenize(text: &str) -> Result<Vec<Token>, String> {
+fn tokenize(text: &str) -> Parsed<Vec<Token>> {
     let chars: Vec<char> = text.chars().collect();
     let mut out = Vec::new();
     let mut i = 0;
@@ -235,7 +260,7 @@ impl ExprParser<'_> {
         }
     }
 
-    fn expr(&mut self) -> Result<f64, String> {
+    fn expr(&mut self) -> Parsed<f64> {
         let mut acc = self.term()?;
         while let Some(op @ ('+' | '-')) = self.peek_op() {
             self.pos += 1;
@@ -245,7 +270,7 @@ impl ExprParser<'_> {
         Ok(acc)
     }
 
-    fn term(&mut self) -> Result<f64, String> {
+    fn term(&mut self) -> Parsed<f64> {
         let mut acc = self.factor()?;
         while let Some(op @ ('*' | '/')) = self.peek_op() {
             self.pos += 1;
@@ -258,7 +283,7 @@ impl ExprParser<'_> {
         Ok(acc)
     }
 
-    fn factor(&mut self) -> Result<f64, String> {
+    fn factor(&mut self) -> Parsed<f64> {
         match self.tokens.get(self.pos) {
             Some(Token::Op('-')) => {
                 self.pos += 1;
@@ -329,22 +354,40 @@ mod tests {
         assert!(
             eval_expr("5 + d_li", &p)
                 .unwrap_err()
+                .to_string()
                 .contains("unknown parameter `d_li`")
         );
-        assert!(eval_expr("5 +", &p).unwrap_err().contains("ends too early"));
-        assert!(eval_expr("(5", &p).unwrap_err().contains("missing `)`"));
+        assert!(
+            eval_expr("5 +", &p)
+                .unwrap_err()
+                .to_string()
+                .contains("ends too early")
+        );
+        assert!(
+            eval_expr("(5", &p)
+                .unwrap_err()
+                .to_string()
+                .contains("missing `)`")
+        );
         assert!(
             eval_expr("5 $ 2", &p)
                 .unwrap_err()
+                .to_string()
                 .contains("unexpected character")
         );
         assert!(
             eval_expr("1 / 0", &p)
                 .unwrap_err()
+                .to_string()
                 .contains("division by zero")
         );
-        assert!(eval_expr("", &p).unwrap_err().contains("empty"));
-        assert!(eval_expr("2 3", &p).unwrap_err().contains("unexpected `3`"));
+        assert!(eval_expr("", &p).unwrap_err().to_string().contains("empty"));
+        assert!(
+            eval_expr("2 3", &p)
+                .unwrap_err()
+                .to_string()
+                .contains("unexpected `3`")
+        );
     }
 
     #[test]

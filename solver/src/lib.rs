@@ -7,51 +7,66 @@
 //!
 //! Units at the interfaces: lengths in mm, potentials in V, impurity densities in cm^-3 (signed:
 //! positive is n-type), capacitances in pF. SI inside the numerics.
+//!
+//! # Modules
+//!
+//! - [`detector`]: the detector file format, its evaluation and checks, and the [`Detector`].
+//! - [`impurity`]: impurity-density models zeta(r, z) and the paper's parameter transform.
+//! - [`geometry`]: axisymmetric (r, z) primitives and constructive solid geometry.
+//! - [`grid`]: the non-uniform tensor grid and its settings ([`GridSettings`]).
+//! - [`field`]: field solves: potential with depletion, weighting potentials, capacitances,
+//!   C-V curves, depletion and pinch-off voltages.
+//! - [`drift`]: the electric field of a solved point, charge drift and pulses.
+//! - [`gpu`]: the wgpu backend's adapter and precision.
+//! - [`expr`]: named parameters ([`Parameters`]) and the expressions detector files may use.
+//! - [`material`], [`constants`]: material properties and physical constants.
+//!
+//! The names most users need first are re-exported here; everything else lives at its module
+//! path (e.g. [`field::solve_fast`], [`detector::Region`], [`drift::ElectricField`]).
+//!
+//! # Example
+//!
+//! The capacitance between the two contacts of the planar p-n detector at 100 V on the default
+//! grid (1 mm spacing) without adaptive refinement:
+//!
+//! ```
+//! use std::path::Path;
+//!
+//! use hpge_solver::{Detector, FieldSettings, Parameters, solve_point};
+//!
+//! let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../detectors/planar-pn.toml");
+//! let det = Detector::from_file(&file, &Parameters::new())?;
+//! let mut settings = FieldSettings::default().for_detector(&det);
+//! settings.grid.adaptive = false;
+//! let point = solve_point(&det, 100.0, &settings, None)?;
+//! assert!(point.c12_pf > 0.0);
+//! # Ok::<(), hpge_solver::Error>(())
+//! ```
 
 mod carrier;
-mod detector;
-mod drift;
 mod error;
-mod expr;
-mod field;
-mod geometry;
-mod gpu;
-mod grid;
-mod impurity;
-mod material;
 mod relaxation;
 
 pub mod constants;
+pub mod detector;
+pub mod drift;
+pub mod expr;
+pub mod field;
+pub mod geometry;
+pub mod gpu;
+pub mod grid;
+pub mod impurity;
+pub mod material;
 pub mod scan;
 
-pub use detector::{
-    BoundaryKind, Contact, ContactPotential, Detector, Passive, PassiveKind, Region, Semiconductor,
-    World, WorldSide,
-};
-pub use drift::{
-    AdlModel, AdlParameters, AxisParameters, Carrier, ContactSignal, Drift, DriftModel,
-    DriftSample, DriftSettings, ElectricField, Pulse, StopReason, drift_carrier, pulse,
-};
-pub use drift::{
-    DriftOutcome, FieldLine, PointStatus, check_interaction_point, crossing_time_ns, field_line,
-    normalise_signals, point_status, reference_contact, rise_time_10_90_ns,
-};
+pub use detector::Detector;
+pub use drift::{Pulse, pulse};
 pub use error::{Error, Result};
 pub use expr::Parameters;
 pub use field::{
-    Accuracy, Backend, CapacitanceMatrix, ConvergenceRow, CvCurve, CvPoint, FieldSettings, Mesh,
-    Method, NodeKind, PAPER_EPSILON_FACTOR, Pocket, PointResult, PotentialPoint, PotentialSolution,
-    Seed, SolveReport, Termination, WeightingMode, WeightingPotentials, contact_charge_c,
-    convergence_study, curve_pinch_off_voltage, cv_curve, deepest_depression_v,
-    deepest_empty_depression_v, find_pockets, full_depletion_voltage, normalise_voltages,
-    pinch_off_voltage, quasi_static_c12_pf, solve_fast, solve_point, solve_point_on_grid,
-    solve_potential, solve_sor, solve_sor_wgpu, weighting_potentials, weighting_potentials_wgpu,
+    Backend, CvCurve, CvPoint, FieldSettings, Method, PointResult, WeightingMode, cv_curve,
+    full_depletion_voltage, pinch_off_voltage, solve_point, solve_potential,
 };
-pub use geometry::{BoundingBox, Primitive, Solid};
-pub use gpu::{AdapterReport, Precision, gpu_adapter, gpu_test_gate};
-pub use grid::{Grid, GridOverrides, GridSettings, MIN_TOLERANCE, parse_grid_setting};
-pub use impurity::{
-    ClampedNaturalSpline, ConstantModel, ImpurityContext, ImpurityModel, ImpuritySpec,
-    LinearZModel, LogTransform, ModelKind, PointDensity, RzModel,
-};
-pub use material::Material;
+pub use gpu::Precision;
+pub use grid::{GridOverrides, GridSettings};
+pub use impurity::ImpuritySpec;

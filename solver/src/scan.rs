@@ -10,7 +10,10 @@
 
 use std::path::Path;
 
-use crate::{Detector, Error, FieldSettings, ImpuritySpec, Result, solve_point};
+use crate::detector::Detector;
+use crate::error::{Error, Result};
+use crate::field::{FieldSettings, solve_point};
+use crate::impurity::ImpuritySpec;
 
 /// Name of the constant impurity model in messages.
 const SCAN_MODEL_NAME: &str = "(sensitivity scan: constant model)";

@@ -139,7 +139,7 @@ fn parse_voltage_values(text: &str) -> Result<Vec<f64>, String> {
 
 /// Parses "NAME=VALUE" as given to `--param`.
 pub fn parse_param(text: &str) -> Result<(String, f64), String> {
-    Parameters::parse_assignment(text)
+    Parameters::parse_assignment(text).map_err(|e| e.to_string())
 }
 
 /// Grid and accuracy options: declared once, in the solver library.

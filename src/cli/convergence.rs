@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use anyhow::{Result, bail};
 use hpge_reports::plot;
-use hpge_solver::convergence_study;
+use hpge_solver::field::convergence_study;
 use serde_json::json;
 
 use super::args::load_detector;

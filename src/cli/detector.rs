@@ -4,7 +4,8 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 use hpge_reports::plot;
-use hpge_solver::{Detector, WorldSide};
+use hpge_solver::Detector;
+use hpge_solver::detector::WorldSide;
 use serde_json::json;
 
 use super::DetectorInput;

@@ -6,7 +6,8 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result, bail};
 use hpge_reports::plot;
-use hpge_solver::{ElectricField, field_line};
+use hpge_solver::drift::ElectricField;
+use hpge_solver::drift::field_line;
 use serde_json::json;
 
 use super::args::{RadiusRange, load_detector, parse_r_range};

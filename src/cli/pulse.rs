@@ -7,10 +7,15 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 use hpge_reports::plot;
-use hpge_solver::{
-    AdlModel, AdlParameters, Detector, DriftSettings, ElectricField, Pulse,
-    check_interaction_point, normalise_signals, reference_contact, rise_time_10_90_ns,
-};
+use hpge_solver::drift::AdlModel;
+use hpge_solver::drift::AdlParameters;
+use hpge_solver::drift::DriftSettings;
+use hpge_solver::drift::ElectricField;
+use hpge_solver::drift::check_interaction_point;
+use hpge_solver::drift::normalise_signals;
+use hpge_solver::drift::reference_contact;
+use hpge_solver::drift::rise_time_10_90_ns;
+use hpge_solver::{Detector, Pulse};
 use serde_json::json;
 
 use super::args::{load_detector, parse_cylindrical};
@@ -88,7 +93,7 @@ pub fn run(a: &PulseArgs) -> Result<()> {
     let (r_mm, phi_deg, z_mm) = a.at;
     let flag = format!("--at {r_mm},{phi_deg},{z_mm}");
     // Cheap geometric checks before the field solve.
-    if let hpge_solver::Region::Contact(i) = det.classify(r_mm, z_mm) {
+    if let hpge_solver::detector::Region::Contact(i) = det.classify(r_mm, z_mm) {
         let e = hpge_solver::Error::InteractionInContact {
             r_mm,
             z_mm,

@@ -5,9 +5,10 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result, bail};
 use hpge_reports::plot;
+use hpge_solver::field::{curve_pinch_off_voltage, normalise_voltages};
+use hpge_solver::gpu::gpu_adapter;
 use hpge_solver::{
-    Backend, CvCurve, Error, FieldSettings, Precision, curve_pinch_off_voltage, cv_curve,
-    gpu_adapter, normalise_voltages, solve_point, solve_potential,
+    Backend, CvCurve, Error, FieldSettings, Precision, cv_curve, solve_point, solve_potential,
 };
 use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::json;

@@ -4,8 +4,9 @@
 use std::path::Path;
 
 use anyhow::{Context, Result};
+use hpge_surrogate::Surrogate;
 use hpge_surrogate::job::{Evaluation, TrainEvent, TrainJob, parse_params, read_for_model};
-use hpge_surrogate::{EpochRecord, Surrogate};
+use hpge_surrogate::model::EpochRecord;
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 

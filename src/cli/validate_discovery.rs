@@ -12,7 +12,8 @@ use hpge_inference::{
     CvModel, DiscoverSettings, FitSettings, PriorSpec, SampleSettings, SamplerKind,
 };
 use hpge_measurement::write_curve_with_comments;
-use hpge_validation::{HiddenOutcome, hidden_effects, run_hidden, simulate_hidden};
+use hpge_validation::studies::hidden::simulate_hidden;
+use hpge_validation::{HiddenOutcome, hidden_effects, run_hidden};
 use serde::Serialize;
 
 use super::discover::Printer;

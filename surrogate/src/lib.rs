@@ -8,27 +8,53 @@
 //! physical parameters, plain f64, no allocation per voltage), guarded by the training domain
 //! ([`Error::OutsideDomain`]). This crate depends on `hpge-solver` only (data flows
 //! solver <- surrogate <- inference).
+//!
+//! # Modules
+//!
+//! - [`space`]: parameter spaces (TOML), their maps to the unit hypercube and standard normals.
+//! - [`sequence`]: quasi-random sequences on [0, 1)^d.
+//! - [`generate`]: training-set generation with the exact solver ([`ExactSolver`]), sharded and
+//!   resumable, and merging of shards.
+//! - [`model`]: data sets, training recipes, candle-nn training, the trained [`Surrogate`] and its
+//!   prediction path, model files and accuracy figures.
+//! - [`hash`]: the stable hash that fingerprints inputs.
+//!
+//! The names most users need first are re-exported here; everything else lives at its module
+//! path (e.g. [`model::train_resuming`], [`space::Distribution`]).
+//!
+//! # Example
+//!
+//! The first points of the golden quasi-random sequence in the shipped parameter space, mapped
+//! from the unit hypercube to physical parameters:
+//!
+//! ```
+//! use std::path::Path;
+//!
+//! use hpge_surrogate::{ParameterSpace, Sequence, SequenceKind};
+//!
+//! let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../spaces/super-siegfried-rz.toml");
+//! let space = ParameterSpace::from_file(&file)?;
+//! let sequence = Sequence::new(SequenceKind::Golden, space.dim(), 0);
+//! for n in 0..3 {
+//!     let p = space.from_unit(&sequence.point(n));
+//!     assert_eq!(p.len(), space.dim());
+//! }
+//! # Ok::<(), hpge_surrogate::Error>(())
+//! ```
 
 mod error;
-mod generate;
-mod hash;
+
+pub mod generate;
+pub mod hash;
 pub mod job;
-mod model;
-mod sequence;
-mod space;
+pub mod model;
+pub mod sequence;
+pub mod space;
 
 pub use error::{Error, Result};
-pub use generate::{
-    ExactSolver, Fingerprint, Generator, MergeReport, RunInfo, RunReport, Sample, Shard,
-    format_row, merge, read_rows, run,
-};
-pub use hash::fnv1a;
+pub use generate::{ExactSolver, Generator, Shard, merge, run};
 pub use model::{
-    Architecture, Cycle, DataInfo, DataSet, Dense, DetectorInfo, EpochRecord, FORMAT,
-    FORMAT_VERSION, Figures, Loss, Member, ModelInfo, Network, OutputTransform, Polynomial,
-    Predictor, RECIPES, Recipe, Surrogate, Trained, U_EDGE, Voltages, candle_outputs, gaussian_fit,
-    initial_network, monomials, network_order, output_transform, physical_to_z, quantile, train,
-    train_resuming, unit_to_z,
+    DataSet, Figures, ModelInfo, Predictor, RECIPES, Recipe, Surrogate, network_order, train,
 };
-pub use sequence::{Sequence, SequenceKind, phi_d};
-pub use space::{Dimension, Distribution, ParameterSpace, Target, normal_cdf, normal_quantile};
+pub use sequence::{Sequence, SequenceKind};
+pub use space::{Dimension, ParameterSpace, Target, normal_cdf, normal_quantile};

@@ -7,7 +7,8 @@ use hpge_inference::PriorSpec;
 use hpge_measurement::read_curve;
 use hpge_solver::FieldSettings;
 use hpge_surrogate::{ExactSolver, Surrogate};
-use hpge_validation::{hidden_curve, hidden_effects, repo_path};
+use hpge_validation::studies::hidden::hidden_curve;
+use hpge_validation::{hidden_effects, repo_path};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let surrogate = Surrogate::load(&repo_path("models/super-siegfried-rz-split.safetensors"))?;

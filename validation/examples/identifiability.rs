@@ -15,7 +15,8 @@ use hpge_inference::{
 use hpge_measurement::{CvData, read_curve};
 use hpge_solver::FieldSettings;
 use hpge_surrogate::{ExactSolver, Surrogate};
-use hpge_validation::{BASE_TRUTH, HiddenEffect, hidden_curve, repo_path};
+use hpge_validation::studies::hidden::{BASE_TRUTH, hidden_curve};
+use hpge_validation::{HiddenEffect, repo_path};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();

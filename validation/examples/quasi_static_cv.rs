@@ -2,7 +2,7 @@
 //! - c12 of the weighting potentials, every pocket a floating conductor (the small-signal
 //!   response of a pulser or an AC bridge: trapped carriers cannot follow);
 //! - the quasi-static C = -dQ/dU of the read-out contact's charge in the nonlinear solutions
-//!   (`hpge_solver::contact_charge_c`: a slow ramp, carriers spilling from the pocket counted).
+//!   (`hpge_solver::field::contact_charge_c`: a slow ramp, carriers spilling from the pocket counted).
 //!
 //! Writes `reports/pockets/<name>-quasi-static.{csv,svg,png}` and prints the largest jump of each
 //! curve between neighbouring biases.
@@ -10,10 +10,9 @@
 //! `cargo run --release -p hpge-validation --example quasi_static_cv -- [DETECTOR U0 U1 STEP SPACING_MM]`
 //! (defaults: detectors/icpc-example.toml 1200 1700 10 0.5).
 
-use hpge_solver::{
-    Detector, FieldSettings, Grid, Mesh, Parameters, contact_charge_c, solve_fast,
-    solve_point_on_grid,
-};
+use hpge_solver::field::{Mesh, contact_charge_c, solve_fast, solve_point_on_grid};
+use hpge_solver::grid::Grid;
+use hpge_solver::{Detector, FieldSettings, Parameters};
 use hpge_validation::repo_path;
 use plotters::prelude::*;
 

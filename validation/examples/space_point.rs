@@ -3,9 +3,9 @@
 //! (x in the space's column order, the bias last). Used to reproduce a failed training row.
 //! `DUMP=file.csv` writes every node (r, z, phi, charge, undepleted, kind) for a look.
 
-use hpge_solver::{
-    Carrier, FieldSettings, NodeKind, deepest_depression_v, deepest_empty_depression_v, solve_point,
-};
+use hpge_solver::drift::Carrier;
+use hpge_solver::field::{NodeKind, deepest_depression_v, deepest_empty_depression_v};
+use hpge_solver::{FieldSettings, solve_point};
 use hpge_surrogate::{ExactSolver, ParameterSpace};
 use hpge_validation::repo_path;
 

@@ -15,7 +15,8 @@
 //!
 //! `cargo run --release -p hpge-validation --example superposition_estimates -- DETECTOR U_B`
 
-use hpge_solver::{Detector, FieldSettings, NodeKind, Parameters, solve_point};
+use hpge_solver::field::NodeKind;
+use hpge_solver::{Detector, FieldSettings, Parameters, solve_point};
 use hpge_validation::repo_path;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {

@@ -2,9 +2,8 @@
 //! The full table (default tolerance, every detector type, 4x finer references) is
 //! `cargo run --release -p hpge-validation --example accuracy_table` (reports/accuracy/).
 
-use hpge_solver::{
-    Detector, FieldSettings, Parameters, cv_curve, solve_point, solve_point_on_grid,
-};
+use hpge_solver::field::solve_point_on_grid;
+use hpge_solver::{Detector, FieldSettings, Parameters, cv_curve, solve_point};
 use hpge_validation::{LongCoax, accuracy_cases, accuracy_row, repo_path};
 
 fn detector(name: &str) -> Detector {

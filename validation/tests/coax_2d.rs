@@ -1,7 +1,8 @@
 //! The 2D field solver on detectors/coax-analytic.toml (a 10 mm slice of an infinitely long coax
 //! with reflecting ends) against the closed form: c12 / 10 mm = 2 pi eps / ln(b / r_d).
 
-use hpge_solver::{Detector, FieldSettings, Parameters, Termination, solve_point};
+use hpge_solver::field::Termination;
+use hpge_solver::{Detector, FieldSettings, Parameters, solve_point};
 use hpge_validation::{LongCoax, repo_path};
 
 fn coax() -> Detector {

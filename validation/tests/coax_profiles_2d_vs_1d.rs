@@ -1,5 +1,5 @@
 //! The 2D solver on the long coax with radial rz-model profiles against the 1D high-precision
-//! radial reference (validation/src/radial1d.rs): within 0.5% (solver issue, validation item 2).
+//! radial reference (validation/src/problems/radial1d/): within 0.5% (solver issue, validation item 2).
 
 use std::path::Path;
 

@@ -2,9 +2,11 @@
 //! on wgpu (GPU issue acceptance). Without an adapter these tests are skipped with one line,
 //! unless HPGE_REQUIRE_GPU=1 (CI, on Mesa's software Vulkan).
 
+use hpge_solver::field::NodeKind;
+use hpge_solver::gpu::{gpu_adapter, gpu_test_gate};
 use hpge_solver::{
-    Backend, Detector, FieldSettings, Method, NodeKind, Parameters, PointResult, Precision,
-    cv_curve, gpu_adapter, gpu_test_gate, solve_point,
+    Backend, Detector, FieldSettings, Method, Parameters, PointResult, Precision, cv_curve,
+    solve_point,
 };
 use hpge_validation::{LongCoax, repo_path};
 

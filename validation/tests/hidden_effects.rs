@@ -5,7 +5,7 @@
 //! per data set on 2 cores (391 s for the three, test profile). The full
 //! study, every entry on every data set, is `hpge-cv validate discovery` (reports/discovery/);
 //! there `quadratic-z` and `li-slope` are not recovered (degenerate with d_Li and the y at the
-//! paper's noise, see validation/src/hidden.rs).
+//! paper's noise, see validation/src/studies/hidden.rs).
 
 use std::sync::Arc;
 
@@ -16,7 +16,8 @@ use hpge_inference::{
 use hpge_measurement::read_curve;
 use hpge_solver::FieldSettings;
 use hpge_surrogate::{ExactSolver, Surrogate};
-use hpge_validation::{hidden_effects, repo_path, run_hidden, simulate_hidden};
+use hpge_validation::studies::hidden::simulate_hidden;
+use hpge_validation::{hidden_effects, repo_path, run_hidden};
 
 /// The exact solver on a grid twice as coarse as the default (2 mm in the crystal, 0.5 mm across
 /// the front) and a 1% tolerance: about 4x faster, c12 within 0.2% of the default on the

@@ -5,10 +5,9 @@
 //! (mantle)) and ground". Now every quasi-random point of the space solves at every bias from
 //! 25 V on, the held-out row 100004 (the issue's example) included.
 
-use hpge_solver::{
-    Carrier, FieldSettings, Termination, deepest_depression_v, deepest_empty_depression_v,
-    solve_potential,
-};
+use hpge_solver::drift::Carrier;
+use hpge_solver::field::{Termination, deepest_depression_v, deepest_empty_depression_v};
+use hpge_solver::{FieldSettings, solve_potential};
 use hpge_surrogate::{ExactSolver, ParameterSpace, Sequence, SequenceKind};
 use hpge_validation::repo_path;
 use rayon::prelude::*;

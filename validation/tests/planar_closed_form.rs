@@ -17,7 +17,8 @@
 //!   refined; c12 is then eps A / T instead of eps A / w (-5.1% at 509 V). The band is excluded
 //!   from the c12 check and asserted as such; `c12_near_full_depletion` records the issue.
 
-use hpge_solver::{Detector, FieldSettings, Parameters, PointResult, Termination, solve_point};
+use hpge_solver::field::Termination;
+use hpge_solver::{Detector, FieldSettings, Parameters, PointResult, solve_point};
 use hpge_validation::{PlanarPn, repo_path};
 
 fn planar(params: &Parameters) -> Detector {

@@ -1,16 +1,17 @@
 //! Issue 18: the C-V curve across an ICPC's pinch-off window. The weighting-potential c12 (every
 //! pocket a floating conductor: the small-signal response) drops at pinch-off; the quasi-static
 //! capacitance -dQ/dU of the read-out contact's charge in the nonlinear solutions (carriers that
-//! spill from the pocket during a slow ramp counted, `hpge_solver::quasi_static_c12_pf`) is
+//! spill from the pocket during a slow ramp counted, `hpge_solver::field::quasi_static_c12_pf`) is
 //! continuous there. Below pinch-off the two are independent routes to the same number (Gauss's
 //! law on the nonlinear solutions against the weighting potentials); on the planar p-n wafer the
 //! quasi-static one meets the closed form eps A / w.
 //! The figure: `cargo run --release -p hpge-validation --example quasi_static_cv` (reports/pockets/).
 
-use hpge_solver::{
-    Detector, FieldSettings, Grid, Mesh, Parameters, contact_charge_c, pinch_off_voltage,
-    quasi_static_c12_pf, solve_fast, solve_point_on_grid,
+use hpge_solver::field::{
+    Mesh, contact_charge_c, quasi_static_c12_pf, solve_fast, solve_point_on_grid,
 };
+use hpge_solver::grid::Grid;
+use hpge_solver::{Detector, FieldSettings, Parameters, pinch_off_voltage};
 use hpge_validation::{PlanarPn, repo_path};
 
 fn fixed(det: &Detector, spacing_mm: f64) -> (FieldSettings, Grid) {

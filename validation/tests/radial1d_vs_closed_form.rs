@@ -5,7 +5,8 @@
 
 use std::f64::consts::PI;
 
-use hpge_validation::{DEFAULT_NODES, LongCoax, RadialReference, RadialSolution};
+use hpge_validation::problems::radial1d::DEFAULT_NODES;
+use hpge_validation::{LongCoax, RadialReference, RadialSolution};
 
 const A_MM: f64 = 6.0;
 const B_MM: f64 = 37.5;

@@ -1,8 +1,7 @@
 //! The shipped detector and impurity files load and say what their comments claim.
 
-use hpge_solver::{
-    BoundaryKind, ContactPotential, Detector, Parameters, PassiveKind, Region, WorldSide,
-};
+use hpge_solver::detector::{BoundaryKind, ContactPotential, PassiveKind, Region, WorldSide};
+use hpge_solver::{Detector, Parameters};
 use hpge_validation::repo_path;
 
 fn load(name: &str) -> Detector {

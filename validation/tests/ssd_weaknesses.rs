@@ -1,8 +1,8 @@
 //! The weaknesses users report for SolidStateDetectors.jl (DESIGN.md) do not occur here.
 
-use hpge_solver::{
-    Detector, FieldSettings, Grid, Mesh, NodeKind, Parameters, solve_fast, solve_point,
-};
+use hpge_solver::field::{Mesh, NodeKind, solve_fast};
+use hpge_solver::grid::Grid;
+use hpge_solver::{Detector, FieldSettings, Parameters, solve_point};
 use hpge_validation::{LongCoax, repo_path};
 
 fn load(name: &str) -> Detector {

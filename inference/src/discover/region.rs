@@ -3,7 +3,8 @@
 //! undepleted bulk is a conductor), so a misfit over [U_a, U_b] is a misfit of that volume's
 //! impurities (or of what bounds it).
 
-use hpge_solver::{Detector, FieldSettings, NodeKind, PointResult, solve_point};
+use hpge_solver::field::NodeKind;
+use hpge_solver::{Detector, FieldSettings, PointResult, solve_point};
 use serde::Serialize;
 
 use crate::{Error, Result};

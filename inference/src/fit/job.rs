@@ -6,7 +6,8 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use hpge_solver::{Detector, FieldSettings, GridOverrides, Parameters};
-use hpge_surrogate::{ExactSolver, Surrogate, fnv1a};
+use hpge_surrogate::hash::fnv1a;
+use hpge_surrogate::{ExactSolver, Surrogate};
 
 use super::exact_check::exact_check;
 use super::run::{Fit, FitSettings, fit};

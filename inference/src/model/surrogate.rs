@@ -1,6 +1,7 @@
 //! The trained surrogate as a [`CvModel`].
 
-use hpge_surrogate::{Surrogate, Voltages};
+use hpge_surrogate::Surrogate;
+use hpge_surrogate::model::Voltages;
 
 use super::CvModel;
 use crate::{Error, Result};

@@ -2,7 +2,8 @@
 //! p_zeta,E along z and r) and the detector's cross-section (Fig. 9): with the manufacturer's model
 //! and with the example density (d_Li = 3 mm, as `reports/make-figures.sh` draws it).
 
-use hpge_solver::{Detector, LogTransform, Parameters};
+use hpge_solver::impurity::LogTransform;
+use hpge_solver::{Detector, Parameters};
 use serde_json::json;
 
 use super::ctx::{Ctx, verdict};

@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use hpge_inference::fit::FitOptions;
-use hpge_solver::LogTransform;
+use hpge_solver::impurity::LogTransform;
 use serde_json::{Value, json};
 
 use super::{Ctx, verdict};

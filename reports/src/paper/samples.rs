@@ -1,7 +1,7 @@
 //! The paper's Fig. 16 (section 7): the distributions of zeta_1^bot and zeta_4^bot over the
 //! generated training and test samples (the points of `data/training/train.csv` and `test.csv`).
 
-use hpge_solver::LogTransform;
+use hpge_solver::impurity::LogTransform;
 use hpge_surrogate::{ParameterSpace, Sequence, SequenceKind};
 use serde_json::json;
 

@@ -10,10 +10,16 @@ use std::path::{Path, PathBuf};
 use super::models::{ModeDetectors, NamedModel, manufacturer};
 use crate::plot::{self, Corner, Curve, LineFigure};
 use crate::{Error, Result};
-use hpge_solver::{
-    AdlModel, DriftSettings, ElectricField, FieldSettings, PointStatus, field_line,
-    normalise_signals, point_status, reference_contact, rise_time_10_90_ns, solve_point,
-};
+use hpge_solver::drift::AdlModel;
+use hpge_solver::drift::DriftSettings;
+use hpge_solver::drift::ElectricField;
+use hpge_solver::drift::PointStatus;
+use hpge_solver::drift::field_line;
+use hpge_solver::drift::normalise_signals;
+use hpge_solver::drift::point_status;
+use hpge_solver::drift::reference_contact;
+use hpge_solver::drift::rise_time_10_90_ns;
+use hpge_solver::{FieldSettings, solve_point};
 use serde_json::{Value, json};
 
 /// V/m per V/cm.

@@ -7,7 +7,8 @@
 
 use std::path::Path;
 
-use hpge_surrogate::{DataSet, EpochRecord, Figures, Surrogate};
+use hpge_surrogate::model::EpochRecord;
+use hpge_surrogate::{DataSet, Figures, Surrogate};
 use serde_json::json;
 
 use super::ctx::{Ctx, verdict};

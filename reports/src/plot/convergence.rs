@@ -3,14 +3,14 @@
 
 use std::path::Path;
 
-use hpge_solver::ConvergenceRow;
+use hpge_solver::field::ConvergenceRow;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::style::{PALETTE, err};
 use crate::error::Result;
 
-/// Draws the rows of a convergence study (`hpge_solver::convergence_study`).
+/// Draws the rows of a convergence study (`hpge_solver::field::convergence_study`).
 pub fn convergence(rows: &[ConvergenceRow], title: &str, path: &Path) -> Result<()> {
     render!(path, (1000, 700), |root, _svg| draw(&root, rows, title))
 }

@@ -5,7 +5,8 @@
 
 use std::path::{Path, PathBuf};
 
-use hpge_validation::{CoverageReport, ParameterCoverage, binomial_interval};
+use hpge_validation::CoverageReport;
+use hpge_validation::studies::coverage::{ParameterCoverage, binomial_interval};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
@@ -398,7 +399,7 @@ fn coverage<DB: DrawingBackend>(
 
 #[cfg(test)]
 mod tests {
-    use hpge_validation::{COVERAGE_LEVELS, ks_uniform};
+    use hpge_validation::studies::coverage::{COVERAGE_LEVELS, ks_uniform};
 
     use super::*;
 

@@ -3,7 +3,11 @@
 
 use std::path::Path;
 
-use hpge_solver::{BoundaryKind, Detector, PassiveKind, Region, WorldSide};
+use hpge_solver::Detector;
+use hpge_solver::detector::BoundaryKind;
+use hpge_solver::detector::PassiveKind;
+use hpge_solver::detector::Region;
+use hpge_solver::detector::WorldSide;
 use plotters::coord::Shift;
 use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;

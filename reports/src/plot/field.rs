@@ -2,7 +2,8 @@
 
 use std::path::Path;
 
-use hpge_solver::{Detector, PotentialPoint};
+use hpge_solver::Detector;
+use hpge_solver::field::PotentialPoint;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 

@@ -35,7 +35,8 @@ pub(crate) fn build(spec: &DetectorSpec, file: &Path, overrides: &Parameters) ->
     // World.
     let w = &spec.world;
     let num = |q: &crate::expr::Quantity, key: &str| {
-        q.eval(&params).map_err(|m| Error::invalid(file, key, m))
+        q.eval(&params)
+            .map_err(|e| Error::invalid(file, key, e.to_string()))
     };
     let r_max = num(&w.r_max_mm, "world.r_max_mm")?;
     let z_min = num(&w.z_min_mm, "world.z_min_mm")?;
@@ -348,7 +349,8 @@ pub(crate) fn build(spec: &DetectorSpec, file: &Path, overrides: &Parameters) ->
         passives,
         grid: match &spec.grid {
             Some(g) => {
-                g.validate().map_err(|m| Error::invalid(file, "grid", m))?;
+                g.validate()
+                    .map_err(|e| Error::invalid(file, "grid", e.to_string()))?;
                 Some(g.clone())
             }
             None => None,

@@ -2,7 +2,9 @@
 //! is defined and a drift can start), undepleted semiconductor, a contact, or outside the crystal.
 
 use super::field::ElectricField;
-use crate::{Detector, Error, PointResult, Region, Result};
+use crate::detector::{Detector, Region};
+use crate::error::{Error, Result};
+use crate::field::PointResult;
 
 /// Where a point (r, z) lies at a solved bias: what [`ElectricField::at`] needs to give a field.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -2,7 +2,8 @@
 //! crossings and the 10-90% rise time.
 
 use super::signal::Pulse;
-use crate::{Detector, Error, Result};
+use crate::detector::Detector;
+use crate::error::{Error, Result};
 
 /// End values |Q_k(end)| at or below this (units of the pair charge) cannot be normalised.
 const MIN_END_CHARGE: f64 = 1e-6;

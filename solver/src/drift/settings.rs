@@ -1,5 +1,6 @@
 //! Settings of a drift with documented defaults.
 
+use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};
 
 /// How carriers are drifted and signals sampled.
@@ -43,7 +44,7 @@ impl Default for DriftSettings {
 
 impl DriftSettings {
     /// Checks every field; the message names the field.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<()> {
         for (name, v) in [
             ("max_time_ns", self.max_time_ns),
             ("max_step_ns", self.max_step_ns),
@@ -52,22 +53,34 @@ impl DriftSettings {
             ("sample_ns", self.sample_ns),
         ] {
             if !(v.is_finite() && v > 0.0) {
-                return Err(format!("`{name}` must be a positive number, got {v}"));
+                return Err(Error::invalid_value(
+                    "drift settings",
+                    format!("`{name}` must be a positive number, got {v}"),
+                ));
             }
         }
         if self.step_fraction > 1.0 {
-            return Err(format!(
-                "`step_fraction` must not exceed 1, got {}",
-                self.step_fraction
+            return Err(Error::invalid_value(
+                "drift settings",
+                format!(
+                    "`step_fraction` must not exceed 1, got {}",
+                    self.step_fraction
+                ),
             ));
         }
         if self.max_steps == 0 {
-            return Err("`max_steps` must be at least 1".into());
+            return Err(Error::invalid_value(
+                "drift settings",
+                "`max_steps` must be at least 1",
+            ));
         }
         if self.max_time_ns / self.sample_ns > 1e8 {
-            return Err(format!(
-                "`max_time_ns` / `sample_ns` = {:e} samples is too many (at most 1e8)",
-                self.max_time_ns / self.sample_ns
+            return Err(Error::invalid_value(
+                "drift settings",
+                format!(
+                    "`max_time_ns` / `sample_ns` = {:e} samples is too many (at most 1e8)",
+                    self.max_time_ns / self.sample_ns
+                ),
             ));
         }
         Ok(())
@@ -80,21 +93,36 @@ mod tests {
 
     #[test]
     fn defaults_valid_and_bad_values_named() {
-        assert_eq!(DriftSettings::default().validate(), Ok(()));
+        assert!(DriftSettings::default().validate().is_ok());
         let bad = DriftSettings {
             step_fraction: 2.0,
             ..DriftSettings::default()
         };
-        assert!(bad.validate().unwrap_err().contains("step_fraction"));
+        assert!(
+            bad.validate()
+                .unwrap_err()
+                .to_string()
+                .contains("step_fraction")
+        );
         let bad = DriftSettings {
             sample_ns: f64::NAN,
             ..DriftSettings::default()
         };
-        assert!(bad.validate().unwrap_err().contains("sample_ns"));
+        assert!(
+            bad.validate()
+                .unwrap_err()
+                .to_string()
+                .contains("sample_ns")
+        );
         let bad = DriftSettings {
             max_steps: 0,
             ..DriftSettings::default()
         };
-        assert!(bad.validate().unwrap_err().contains("max_steps"));
+        assert!(
+            bad.validate()
+                .unwrap_err()
+                .to_string()
+                .contains("max_steps")
+        );
     }
 }

@@ -74,9 +74,9 @@ pub fn pulse(
         name: "at_mm_rad".into(),
         message,
     };
-    settings.validate().map_err(|m| Error::Argument {
+    settings.validate().map_err(|e| Error::Argument {
         name: "drift settings".into(),
-        message: m,
+        message: e.to_string(),
     })?;
     let (r_mm, phi_rad, z_mm) = at_mm_rad;
     if !(r_mm.is_finite() && phi_rad.is_finite() && z_mm.is_finite() && r_mm >= 0.0) {

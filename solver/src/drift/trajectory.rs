@@ -101,9 +101,9 @@ pub fn drift_carrier(
     start_mm: [f64; 3],
     settings: &DriftSettings,
 ) -> Result<Drift> {
-    settings.validate().map_err(|m| Error::Argument {
+    settings.validate().map_err(|e| Error::Argument {
         name: "drift settings".into(),
-        message: m,
+        message: e.to_string(),
     })?;
     let velocity_mm_per_ns = |x: [f64; 3]| {
         field.at_cartesian(x).map(|e| {

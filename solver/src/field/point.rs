@@ -342,9 +342,9 @@ fn refined_potential(
     settings: &FieldSettings,
     seed: Option<&Seed>,
 ) -> Result<PotentialPoint> {
-    settings.validate().map_err(|m| Error::Argument {
+    settings.validate().map_err(|e| Error::Argument {
         name: "settings".into(),
-        message: m,
+        message: e.to_string(),
     })?;
     if !bias_v.is_finite() {
         return Err(Error::Argument {

@@ -5,6 +5,7 @@ use serde::{Deserialize, Serialize};
 use super::report::{Backend, Method};
 use super::weighting::WeightingMode;
 use crate::detector::Detector;
+use crate::error::{Error, Result};
 use crate::gpu::Precision;
 use crate::grid::GridSettings;
 
@@ -52,12 +53,17 @@ impl FieldSettings {
     }
 
     /// Checks all fields (the message names the field).
-    pub fn validate(&self) -> Result<(), String> {
-        self.grid.validate().map_err(|m| format!("grid: {m}"))?;
+    pub fn validate(&self) -> Result<()> {
+        self.grid
+            .validate()
+            .map_err(|m| Error::invalid_value("field settings", format!("grid: {m}")))?;
         if self.backend == Backend::Wgpu && self.method != Method::Sor {
-            return Err(format!(
-                "method: the wgpu backend runs the sor method; `{}` (sparse Cholesky) runs on the cpu backend only",
-                self.method.as_str()
+            return Err(Error::invalid_value(
+                "field settings",
+                format!(
+                    "method: the wgpu backend runs the sor method; `{}` (sparse Cholesky) runs on the cpu backend only",
+                    self.method.as_str()
+                ),
             ));
         }
         Ok(())

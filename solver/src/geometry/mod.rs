@@ -18,4 +18,4 @@ pub(crate) use solid::sorted_unique;
 pub(crate) use spec::SolidSpec;
 
 /// Membership tolerance (mm) used for "on the boundary counts as inside".
-pub const BOUNDARY_TOL_MM: f64 = 1e-9;
+pub(crate) const BOUNDARY_TOL_MM: f64 = 1e-9;

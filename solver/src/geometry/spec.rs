@@ -98,7 +98,8 @@ impl Ctx<'_> {
     }
 
     fn num(&self, q: &Quantity, key: &str) -> Result<f64> {
-        q.eval(self.params).map_err(|m| self.err(key, m))
+        q.eval(self.params)
+            .map_err(|e| self.err(key, e.to_string()))
     }
 
     fn pair(&self, q: &[Quantity; 2], key: &str) -> Result<[f64; 2]> {

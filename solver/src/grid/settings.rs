@@ -1,5 +1,6 @@
 //! Grid settings with documented defaults.
 
+use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};
 
 /// How the (r, z) grid is built and refined.
@@ -83,34 +84,42 @@ impl GridSettings {
     /// table and gives its value in TOML syntax (`front_spacing_mm`, `0.1`; `adaptive`, `false`;
     /// `refinement_limits`, `[0.2, 0.1]`), as `--grid KEY=VALUE` does. Unknown keys, values of
     /// the wrong type and invalid results are errors naming the key.
-    pub fn with_overrides(&self, overrides: &[(String, String)]) -> Result<GridSettings, String> {
-        let mut table = toml::Table::try_from(self).map_err(|e| e.to_string())?;
+    pub fn with_overrides(&self, overrides: &[(String, String)]) -> Result<GridSettings> {
+        let mut table = toml::Table::try_from(self)
+            .map_err(|e| Error::invalid_value("grid settings", e.to_string()))?;
         for (key, text) in overrides {
             if !table.contains_key(key) {
                 let known: Vec<&str> = table.keys().map(String::as_str).collect();
-                return Err(format!(
-                    "unknown grid key `{key}` (known: {})",
-                    known.join(", ")
+                return Err(Error::invalid_value(
+                    "grid settings",
+                    format!("unknown grid key `{key}` (known: {})", known.join(", ")),
                 ));
             }
-            let v: toml::Table = toml::from_str(&format!("v = {text}"))
-                .map_err(|_| format!("`{key}`: `{text}` is not a TOML value"))?;
+            let v: toml::Table = toml::from_str(&format!("v = {text}")).map_err(|_| {
+                Error::invalid_value(
+                    "grid settings",
+                    format!("`{key}`: `{text}` is not a TOML value"),
+                )
+            })?;
             table.insert(key.clone(), v["v"].clone());
         }
-        let out: GridSettings = table
-            .try_into()
-            .map_err(|e: toml::de::Error| e.message().to_string())?;
+        let out: GridSettings = table.try_into().map_err(|e: toml::de::Error| {
+            Error::invalid_value("grid settings", e.message().to_string())
+        })?;
         out.validate()?;
         Ok(out)
     }
 
     /// Checks every field; the message names the field.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<()> {
         let pos = |name: &str, v: f64| {
             if v.is_finite() && v > 0.0 {
                 Ok(())
             } else {
-                Err(format!("`{name}` must be a positive number, got {v}"))
+                Err(Error::invalid_value(
+                    "grid settings",
+                    format!("`{name}` must be a positive number, got {v}"),
+                ))
             }
         };
         pos(
@@ -121,34 +130,47 @@ impl GridSettings {
         pos("min_tick_distance_mm", self.min_tick_distance_mm)?;
         pos("front_spacing_mm", self.front_spacing_mm)?;
         if self.min_tick_distance_mm > self.max_spacing_semiconductor_mm.min(self.max_spacing_mm) {
-            return Err("`min_tick_distance_mm` must not exceed the largest spacings".into());
+            return Err(Error::invalid_value(
+                "grid settings",
+                "`min_tick_distance_mm` must not exceed the largest spacings",
+            ));
         }
         if !(self.max_distance_ratio.is_finite() && self.max_distance_ratio >= 1.5) {
-            return Err(format!(
-                "`max_distance_ratio` must be at least 1.5, got {}",
-                self.max_distance_ratio
+            return Err(Error::invalid_value(
+                "grid settings",
+                format!(
+                    "`max_distance_ratio` must be at least 1.5, got {}",
+                    self.max_distance_ratio
+                ),
             ));
         }
         if !(self.tolerance.is_finite() && self.tolerance >= MIN_TOLERANCE && self.tolerance < 1.0)
         {
-            return Err(format!(
-                "`tolerance` (relative error of c12) must lie in [{MIN_TOLERANCE:e}, 1), got {}",
-                self.tolerance
+            return Err(Error::invalid_value(
+                "grid settings",
+                format!(
+                    "`tolerance` (relative error of c12) must lie in [{MIN_TOLERANCE:e}, 1), got {}",
+                    self.tolerance
+                ),
             ));
         }
         if self.max_adaptive_passes == 0 {
-            return Err("`max_adaptive_passes` must be at least 1".into());
+            return Err(Error::invalid_value(
+                "grid settings",
+                "`max_adaptive_passes` must be at least 1",
+            ));
         }
         if self.max_nodes < 100 {
-            return Err(format!(
-                "`max_nodes` must be at least 100, got {}",
-                self.max_nodes
+            return Err(Error::invalid_value(
+                "grid settings",
+                format!("`max_nodes` must be at least 100, got {}", self.max_nodes),
             ));
         }
         for (k, l) in self.refinement_limits.iter().enumerate() {
             if !(l.is_finite() && *l > 0.0 && *l < 1.0) {
-                return Err(format!(
-                    "`refinement_limits[{k}]` must lie in (0, 1), got {l}"
+                return Err(Error::invalid_value(
+                    "grid settings",
+                    format!("`refinement_limits[{k}]` must lie in (0, 1), got {l}"),
                 ));
             }
         }
@@ -162,28 +184,49 @@ mod tests {
 
     #[test]
     fn defaults_are_valid_and_bad_values_named() {
-        assert_eq!(GridSettings::default().validate(), Ok(()));
+        assert!(GridSettings::default().validate().is_ok());
         let bad = GridSettings {
             max_distance_ratio: 1.0,
             ..GridSettings::default()
         };
-        assert!(bad.validate().unwrap_err().contains("max_distance_ratio"));
+        assert!(
+            bad.validate()
+                .unwrap_err()
+                .to_string()
+                .contains("max_distance_ratio")
+        );
         let bad = GridSettings {
             refinement_limits: vec![0.2, 1.5],
             ..GridSettings::default()
         };
-        assert!(bad.validate().unwrap_err().contains("refinement_limits[1]"));
+        assert!(
+            bad.validate()
+                .unwrap_err()
+                .to_string()
+                .contains("refinement_limits[1]")
+        );
         let bad = GridSettings {
             min_tick_distance_mm: f64::NAN,
             ..GridSettings::default()
         };
-        assert!(bad.validate().unwrap_err().contains("min_tick_distance_mm"));
+        assert!(
+            bad.validate()
+                .unwrap_err()
+                .to_string()
+                .contains("min_tick_distance_mm")
+        );
         for t in [0.0, -1e-3, 1e-9, f64::NAN, 1.0] {
             let bad = GridSettings {
                 tolerance: t,
                 ..GridSettings::default()
             };
-            assert!(bad.validate().unwrap_err().contains("tolerance"), "{t}");
+            assert!(
+                bad.validate()
+                    .unwrap_err()
+                    .to_string()
+                    .contains("tolerance"),
+                "{t}"
+            );
         }
     }
 
@@ -202,15 +245,18 @@ mod tests {
         assert_eq!(g.refinement_limits, vec![0.2, 0.1]);
         let e = GridSettings::default()
             .with_overrides(&[kv("front_spacing", "0.1")])
-            .unwrap_err();
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("unknown grid key `front_spacing`"), "{e}");
         let e = GridSettings::default()
             .with_overrides(&[kv("adaptive", "yes")])
-            .unwrap_err();
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("adaptive"), "{e}");
         let e = GridSettings::default()
             .with_overrides(&[kv("tolerance", "0")])
-            .unwrap_err();
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("tolerance"), "{e}");
     }
 }

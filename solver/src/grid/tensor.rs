@@ -2,6 +2,7 @@
 
 use super::GridSettings;
 use super::axis::limit_ratio;
+use crate::error::{Error, Result};
 
 /// A non-uniform tensor grid over the world; node (i, j) sits at (r\[i\], z\[j\]) in mm.
 ///
@@ -15,16 +16,20 @@ pub struct Grid {
 
 impl Grid {
     /// A grid from explicit ticks (each strictly increasing, at least two).
-    pub fn new(r_mm: Vec<f64>, z_mm: Vec<f64>) -> Result<Self, String> {
+    pub fn new(r_mm: Vec<f64>, z_mm: Vec<f64>) -> Result<Self> {
         for (name, t) in [("r", &r_mm), ("z", &z_mm)] {
             if t.len() < 2 {
-                return Err(format!("the {name} axis needs at least two ticks"));
+                return Err(Error::invalid_value(
+                    "grid ticks",
+                    format!("the {name} axis needs at least two ticks"),
+                ));
             }
             if t.windows(2)
                 .any(|w| w[1] <= w[0] || w[1].is_nan() || !w[0].is_finite() || !w[1].is_finite())
             {
-                return Err(format!(
-                    "the {name} ticks must be finite and strictly increasing"
+                return Err(Error::invalid_value(
+                    "grid ticks",
+                    format!("the {name} ticks must be finite and strictly increasing"),
                 ));
             }
         }

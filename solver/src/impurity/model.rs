@@ -1,5 +1,7 @@
 //! The open set of impurity-density models, and the two simple ones (constant, linear in z).
 
+use crate::error::{Error, Result};
+
 /// What a model says at one point.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct PointDensity {
@@ -37,10 +39,11 @@ pub struct ConstantModel {
 
 impl ConstantModel {
     /// A constant density; errors if it is not finite.
-    pub fn new(zeta_cm3: f64) -> Result<Self, String> {
+    pub fn new(zeta_cm3: f64) -> Result<Self> {
         if !zeta_cm3.is_finite() {
-            return Err(format!(
-                "the density must be a finite number, got {zeta_cm3}"
+            return Err(Error::invalid_value(
+                "impurity model",
+                format!("the density must be a finite number, got {zeta_cm3}"),
             ));
         }
         Ok(ConstantModel { zeta_cm3 })
@@ -74,12 +77,7 @@ pub struct LinearZModel {
 
 impl LinearZModel {
     /// The linear model; errors unless all values are finite and z_top_mm > z_bottom_mm.
-    pub fn new(
-        bottom_cm3: f64,
-        top_cm3: f64,
-        z_bottom_mm: f64,
-        z_top_mm: f64,
-    ) -> Result<Self, String> {
+    pub fn new(bottom_cm3: f64, top_cm3: f64, z_bottom_mm: f64, z_top_mm: f64) -> Result<Self> {
         for (name, value) in [
             ("bottom_cm3", bottom_cm3),
             ("top_cm3", top_cm3),
@@ -87,12 +85,18 @@ impl LinearZModel {
             ("z_top_mm", z_top_mm),
         ] {
             if !value.is_finite() {
-                return Err(format!("`{name}` must be a finite number, got {value}"));
+                return Err(Error::invalid_value(
+                    "impurity model",
+                    format!("`{name}` must be a finite number, got {value}"),
+                ));
             }
         }
         if z_top_mm <= z_bottom_mm {
-            return Err(format!(
-                "the top z ({z_top_mm} mm) must be greater than the bottom z ({z_bottom_mm} mm)"
+            return Err(Error::invalid_value(
+                "impurity model",
+                format!(
+                    "the top z ({z_top_mm} mm) must be greater than the bottom z ({z_bottom_mm} mm)"
+                ),
             ));
         }
         Ok(LinearZModel {

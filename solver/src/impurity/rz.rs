@@ -3,6 +3,7 @@
 use super::model::{ImpurityModel, PointDensity};
 use super::spline::ClampedNaturalSpline;
 use super::transform::LogTransform;
+use crate::error::{Error, Result};
 
 /// zeta_RZ(r, z) (paper Eqs. (18)-(21)):
 ///
@@ -38,24 +39,28 @@ impl RzModel {
         z_bottom_mm: f64,
         z_top_mm: f64,
         transform: LogTransform,
-    ) -> Result<Self, String> {
+    ) -> Result<Self> {
         transform.validate()?;
         if !(z_bottom_mm.is_finite() && z_top_mm.is_finite() && z_top_mm > z_bottom_mm) {
-            return Err(format!(
-                "need finite z_bottom_mm < z_top_mm, got {z_bottom_mm} and {z_top_mm}"
+            return Err(Error::invalid_value(
+                "r-z model",
+                format!("need finite z_bottom_mm < z_top_mm, got {z_bottom_mm} and {z_top_mm}"),
             ));
         }
         for (name, ys) in [("y_bot", &y_bot), ("y_top", &y_top)] {
             for (i, &y) in ys.iter().enumerate() {
                 if y.is_nan() || y.abs() > 1.0 {
-                    return Err(format!("{name}[{i}] = {y} is not a number in [-1, 1]"));
+                    return Err(Error::invalid_value(
+                        "r-z model",
+                        format!("{name}[{i}] = {y} is not a number in [-1, 1]"),
+                    ));
                 }
             }
         }
-        let bottom =
-            ClampedNaturalSpline::new(&knots_mm, &y_bot).map_err(|e| format!("y_bot: {e}"))?;
-        let top =
-            ClampedNaturalSpline::new(&knots_mm, &y_top).map_err(|e| format!("y_top: {e}"))?;
+        let bottom = ClampedNaturalSpline::new(&knots_mm, &y_bot)
+            .map_err(|e| Error::invalid_value("r-z model", format!("y_bot: {e}")))?;
+        let top = ClampedNaturalSpline::new(&knots_mm, &y_top)
+            .map_err(|e| Error::invalid_value("r-z model", format!("y_top: {e}")))?;
         Ok(RzModel {
             knots_mm,
             bottom,
@@ -70,9 +75,12 @@ impl RzModel {
     /// The model with a quadratic z term of amplitude `y_quad` added to y (zero at both faces,
     /// `y_quad` at mid-height; see [`Self::y_at`]). Used by model discovery's `quadratic-z`
     /// extension. Errors: `y_quad` not finite.
-    pub fn with_quadratic(mut self, y_quad: f64) -> Result<Self, String> {
+    pub fn with_quadratic(mut self, y_quad: f64) -> Result<Self> {
         if !y_quad.is_finite() {
-            return Err(format!("y_quad = {y_quad} is not a finite number"));
+            return Err(Error::invalid_value(
+                "r-z model",
+                format!("y_quad = {y_quad} is not a finite number"),
+            ));
         }
         self.y_quad = y_quad;
         Ok(self)
@@ -91,13 +99,16 @@ impl RzModel {
         z_bottom_mm: f64,
         z_top_mm: f64,
         transform: LogTransform,
-    ) -> Result<Self, String> {
+    ) -> Result<Self> {
         let n = knots_mm.len();
         if p_zeta_y.len() != 2 * n {
-            return Err(format!(
-                "p_zeta_y has {} values, but {n} knots need {}",
-                p_zeta_y.len(),
-                2 * n
+            return Err(Error::invalid_value(
+                "r-z model",
+                format!(
+                    "p_zeta_y has {} values, but {n} knots need {}",
+                    p_zeta_y.len(),
+                    2 * n
+                ),
             ));
         }
         let (bot, top) = p_zeta_y.split_at(n);
@@ -176,13 +187,13 @@ impl RzModel {
     ///
     /// Errors name the index and the reason: not finite, |zeta| > zeta_max (1e11 cm^-3 for the
     /// default transform), or nonzero but too small for y to be a normal f64.
-    pub fn p_zeta_y_from_p_zeta(p_zeta_cm3: &[f64], t: &LogTransform) -> Result<Vec<f64>, String> {
+    pub fn p_zeta_y_from_p_zeta(p_zeta_cm3: &[f64], t: &LogTransform) -> Result<Vec<f64>> {
         p_zeta_cm3
             .iter()
             .enumerate()
             .map(|(i, &zeta)| {
                 t.y_of_zeta_cm3(zeta)
-                    .map_err(|e| format!("p_zeta[{i}]: {e}"))
+                    .map_err(|e| Error::invalid_value("r-z model", format!("p_zeta[{i}]: {e}")))
             })
             .collect()
     }
@@ -315,7 +326,9 @@ mod tests {
         let bad = LogTransform { g: -1.0, ..t };
         assert!(RzModel::new(k.clone(), ok.clone(), ok.clone(), 0.0, 70.0, bad).is_err());
         assert!(RzModel::from_p_zeta_y(k, &[0.5; 7], 0.0, 70.0, t).is_err());
-        let e = RzModel::p_zeta_y_from_p_zeta(&[1e10, 2e11], &t).unwrap_err();
+        let e = RzModel::p_zeta_y_from_p_zeta(&[1e10, 2e11], &t)
+            .unwrap_err()
+            .to_string();
         assert!(e.starts_with("p_zeta[1]"), "{e}");
     }
 

@@ -165,7 +165,8 @@ impl ImpuritySpec {
                     .zeta_cm3
                     .ok_or_else(|| keys.err("zeta_cm3", "model \"constant\" needs `zeta_cm3`"))?;
                 let zeta = keys.finite("zeta_cm3", zeta)?;
-                let model = ConstantModel::new(zeta).map_err(|e| keys.err(model_key, e))?;
+                let model =
+                    ConstantModel::new(zeta).map_err(|e| keys.err(model_key, e.to_string()))?;
                 Ok(Box::new(model))
             }
             ModelKind::LinearZ => {
@@ -178,7 +179,7 @@ impl ImpuritySpec {
                 let top = keys.finite("top_cm3", top)?;
                 check_context(ctx)?;
                 let model = LinearZModel::new(bottom, top, ctx.z_bottom_mm, ctx.z_top_mm)
-                    .map_err(|e| keys.err(model_key, e))?;
+                    .map_err(|e| keys.err(model_key, e.to_string()))?;
                 Ok(Box::new(model))
             }
             ModelKind::Rz => Ok(Box::new(self.build_rz(ctx, keys)?)),
@@ -242,7 +243,9 @@ impl ImpuritySpec {
             _ => return Err(keys.err("model", need)),
         };
         let transform = self.transform.unwrap_or_default();
-        transform.validate().map_err(|e| keys.err("transform", e))?;
+        transform
+            .validate()
+            .map_err(|e| keys.err("transform", e.to_string()))?;
         check_context(ctx)?;
         let knots = self.knots(ctx, keys)?;
         let n = knots.len();
@@ -266,7 +269,7 @@ impl ImpuritySpec {
             transform,
         )
         .and_then(|m| m.with_quadratic(self.y_quad.unwrap_or(0.0)))
-        .map_err(|e| keys.err("model", e))
+        .map_err(|e| keys.err("model", e.to_string()))
     }
 
     /// The spec's `knots_mm` or the context's default, validated: non-empty, finite,
@@ -366,7 +369,7 @@ fn ys_from_zeta(
             keys.finite(&indexed, zeta)?;
             transform
                 .y_of_zeta_cm3(zeta)
-                .map_err(|e| keys.err(&indexed, e))
+                .map_err(|e| keys.err(&indexed, e.to_string()))
         })
         .collect()
 }

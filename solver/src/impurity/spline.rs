@@ -1,5 +1,7 @@
 //! Cubic splines with a clamped start and a natural end, constant outside their knots.
 
+use crate::error::{Error, Result};
+
 /// A cubic spline S(r) through knots r_1 < ... < r_n (mm) with values y_1..y_n, as used for
 /// y_bot(r) and y_top(r) of the paper's zeta_RZ model (Eq. (21) `eq:Y_RZ` and the text after it):
 ///
@@ -30,34 +32,49 @@ impl ClampedNaturalSpline {
     /// It is strictly diagonally dominant, so elimination without pivoting is stable.
     ///
     /// Errors: lengths differ, no knots, a non-finite knot or value, knots not strictly increasing.
-    pub fn new(knots_mm: &[f64], values: &[f64]) -> Result<Self, String> {
+    pub fn new(knots_mm: &[f64], values: &[f64]) -> Result<Self> {
         if knots_mm.len() != values.len() {
-            return Err(format!(
-                "{} values for {} knots: the lengths must match",
-                values.len(),
-                knots_mm.len()
+            return Err(Error::invalid_value(
+                "spline",
+                format!(
+                    "{} values for {} knots: the lengths must match",
+                    values.len(),
+                    knots_mm.len()
+                ),
             ));
         }
         if knots_mm.is_empty() {
-            return Err("a spline needs at least one knot".to_string());
+            return Err(Error::invalid_value(
+                "spline",
+                "a spline needs at least one knot".to_string(),
+            ));
         }
         for (i, (&r, &y)) in knots_mm.iter().zip(values).enumerate() {
             if !r.is_finite() {
-                return Err(format!("knot {i} is not a finite number: {r}"));
+                return Err(Error::invalid_value(
+                    "spline",
+                    format!("knot {i} is not a finite number: {r}"),
+                ));
             }
             if !y.is_finite() {
-                return Err(format!("value {i} is not a finite number: {y}"));
+                return Err(Error::invalid_value(
+                    "spline",
+                    format!("value {i} is not a finite number: {y}"),
+                ));
             }
         }
         for (i, pair) in knots_mm.windows(2).enumerate() {
             if pair[1] <= pair[0] {
-                return Err(format!(
-                    "knots must be strictly increasing: knot {} ({} mm) is not greater than knot {} \
+                return Err(Error::invalid_value(
+                    "spline",
+                    format!(
+                        "knots must be strictly increasing: knot {} ({} mm) is not greater than knot {} \
                      ({} mm)",
-                    i + 1,
-                    pair[1],
-                    i,
-                    pair[0]
+                        i + 1,
+                        pair[1],
+                        i,
+                        pair[0]
+                    ),
                 ));
             }
         }
@@ -201,7 +218,9 @@ mod tests {
         assert!(ClampedNaturalSpline::new(&[], &[]).is_err());
         assert!(ClampedNaturalSpline::new(&[1.0, f64::NAN], &[1.0, 2.0]).is_err());
         assert!(ClampedNaturalSpline::new(&[1.0, 2.0], &[1.0, f64::INFINITY]).is_err());
-        let e = ClampedNaturalSpline::new(&[1.0, 3.0, 3.0], &[0.0; 3]).unwrap_err();
+        let e = ClampedNaturalSpline::new(&[1.0, 3.0, 3.0], &[0.0; 3])
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("strictly increasing"), "{e}");
         assert!(ClampedNaturalSpline::new(&[2.0, 1.0], &[0.0; 2]).is_err());
     }

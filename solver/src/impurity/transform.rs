@@ -6,6 +6,7 @@
 
 use super::solve::{bracket_increasing, solve_increasing};
 use crate::constants::CM3_TO_M3;
+use crate::error::{Error, Result};
 
 /// The transform x = T(y) (paper Eq. (20)) together with the density map zeta(x) (Eq. (18)).
 ///
@@ -47,21 +48,33 @@ impl Default for LogTransform {
 
 impl LogTransform {
     /// Checks the parameters: all finite, v >= 1, 0 < x_l < x_u, g > 0.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<()> {
         let LogTransform { v, x_l, x_u, g } = *self;
         for (name, value) in [("v", v), ("x_l", x_l), ("x_u", x_u), ("g", g)] {
             if !value.is_finite() {
-                return Err(format!("`{name}` must be a finite number, got {value}"));
+                return Err(Error::invalid_value(
+                    "impurity transform",
+                    format!("`{name}` must be a finite number, got {value}"),
+                ));
             }
         }
         if v < 1.0 {
-            return Err(format!("`v` must be at least 1, got {v}"));
+            return Err(Error::invalid_value(
+                "impurity transform",
+                format!("`v` must be at least 1, got {v}"),
+            ));
         }
         if !(x_l > 0.0 && x_l < x_u) {
-            return Err(format!("need 0 < x_l < x_u, got x_l = {x_l}, x_u = {x_u}"));
+            return Err(Error::invalid_value(
+                "impurity transform",
+                format!("need 0 < x_l < x_u, got x_l = {x_l}, x_u = {x_u}"),
+            ));
         }
         if g <= 0.0 {
-            return Err(format!("`g` must be positive, got {g}"));
+            return Err(Error::invalid_value(
+                "impurity transform",
+                format!("`g` must be positive, got {g}"),
+            ));
         }
         Ok(())
     }
@@ -204,10 +217,11 @@ impl LogTransform {
     /// Errors: a non-finite density; |zeta| above [`Self::zeta_cm3_max`] (1e-12 relative slack is
     /// allowed: |zeta| >= zeta_max gives exactly +-1); a nonzero |zeta| so small that |y| would be
     /// below f64::MIN_POSITIVE (see [`Self::zeta_cm3_min_nonzero`]).
-    pub fn y_of_zeta_cm3(&self, zeta_cm3: f64) -> Result<f64, String> {
+    pub fn y_of_zeta_cm3(&self, zeta_cm3: f64) -> Result<f64> {
         if !zeta_cm3.is_finite() {
-            return Err(format!(
-                "the density must be a finite number, got {zeta_cm3}"
+            return Err(Error::invalid_value(
+                "impurity transform",
+                format!("the density must be a finite number, got {zeta_cm3}"),
             ));
         }
         if zeta_cm3 == 0.0 {
@@ -215,10 +229,13 @@ impl LogTransform {
         }
         let max = self.zeta_cm3_max();
         if zeta_cm3.abs() > max * (1.0 + 1e-12) {
-            return Err(format!(
-                "|zeta| = {:e} cm^-3 is larger than the largest density the transform can \
+            return Err(Error::invalid_value(
+                "impurity transform",
+                format!(
+                    "|zeta| = {:e} cm^-3 is larger than the largest density the transform can \
                  express, {max:e} cm^-3 (y = 1)",
-                zeta_cm3.abs()
+                    zeta_cm3.abs()
+                ),
             ));
         }
         if zeta_cm3.abs() >= max {
@@ -228,11 +245,14 @@ impl LogTransform {
             .y_of_x(self.x_of_zeta_m3(zeta_cm3 * CM3_TO_M3))
             .clamp(-1.0, 1.0);
         if y.is_nan() || y.abs() < f64::MIN_POSITIVE {
-            return Err(format!(
-                "|zeta| = {:e} cm^-3 is too small to represent: its y underflows f64 (the \
+            return Err(Error::invalid_value(
+                "impurity transform",
+                format!(
+                    "|zeta| = {:e} cm^-3 is too small to represent: its y underflows f64 (the \
                  smallest nonzero density is about {:e} cm^-3; use 0 for none)",
-                zeta_cm3.abs(),
-                self.zeta_cm3_min_nonzero()
+                    zeta_cm3.abs(),
+                    self.zeta_cm3_min_nonzero()
+                ),
             ));
         }
         Ok(y)
@@ -255,7 +275,7 @@ mod tests {
     #[test]
     fn default_is_valid_and_paper_values() {
         let t = LogTransform::default();
-        assert_eq!(t.validate(), Ok(()));
+        assert!(t.validate().is_ok());
         assert_eq!((t.v, t.x_l, t.x_u, t.g), (1000.0, 14.0, 17.0, 1000.0));
     }
 
@@ -303,9 +323,9 @@ mod tests {
         assert_eq!(t.x_of_y(-1.0), -17.0);
         assert!(rel(t.zeta_cm3_max(), 1e11) < 1e-14);
         assert!(rel(t.zeta_cm3_of_y(-1.0), -1e11) < 1e-14);
-        assert_eq!(t.y_of_zeta_cm3(1e11), Ok(1.0));
-        assert_eq!(t.y_of_zeta_cm3(-1e11), Ok(-1.0));
-        assert_eq!(t.y_of_zeta_cm3(1e11 * (1.0 + 5e-13)), Ok(1.0));
+        assert_eq!(t.y_of_zeta_cm3(1e11).ok(), Some(1.0));
+        assert_eq!(t.y_of_zeta_cm3(-1e11).ok(), Some(-1.0));
+        assert_eq!(t.y_of_zeta_cm3(1e11 * (1.0 + 5e-13)).ok(), Some(1.0));
         assert!((t.y_of_x(17.0) - 1.0).abs() < 1e-15);
     }
 
@@ -316,7 +336,7 @@ mod tests {
         assert_eq!(t.y_of_x(0.0), 0.0);
         assert_eq!(t.zeta_m3_of_x(0.0), 0.0);
         assert_eq!(t.x_of_zeta_m3(0.0), 0.0);
-        assert_eq!(t.y_of_zeta_cm3(0.0), Ok(0.0));
+        assert_eq!(t.y_of_zeta_cm3(0.0).ok(), Some(0.0));
         assert!(t.y_of_x(f64::NAN).is_nan());
         assert!(t.x_of_zeta_m3(f64::NAN).is_nan());
         assert_eq!(t.y_of_x(f64::INFINITY), f64::INFINITY);
@@ -337,10 +357,10 @@ mod tests {
     #[test]
     fn y_of_zeta_errors() {
         let t = LogTransform::default();
-        let too_large = t.y_of_zeta_cm3(1.1e11).unwrap_err();
+        let too_large = t.y_of_zeta_cm3(1.1e11).unwrap_err().to_string();
         assert!(too_large.contains("larger than"), "{too_large}");
         assert!(t.y_of_zeta_cm3(-2e11).is_err());
-        let too_small = t.y_of_zeta_cm3(1e-3).unwrap_err();
+        let too_small = t.y_of_zeta_cm3(1e-3).unwrap_err().to_string();
         assert!(too_small.contains("too small"), "{too_small}");
         assert!(t.y_of_zeta_cm3(-1.0).is_err());
         assert!(t.y_of_zeta_cm3(f64::NAN).is_err());
@@ -434,7 +454,7 @@ mod tests {
                     prop_assert!(z.abs() >= min * (1.0 - 1e-9), "zeta = {z:e}");
                     prop_assert!(y.abs() <= 1.0);
                     prop_assert!(rel(t.zeta_cm3_of_y(y), z) < 1e-12, "zeta = {z:e}");
-                    prop_assert_eq!(t.y_of_zeta_cm3(-z), Ok(-y));
+                    prop_assert_eq!(t.y_of_zeta_cm3(-z).ok(), Some(-y));
                 }
                 Err(_) => prop_assert!(z.abs() < min * (1.0 + 1e-9), "zeta = {z:e}"),
             }

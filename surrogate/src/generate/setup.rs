@@ -26,19 +26,23 @@ impl Shard {
     /// The whole range in one shard.
     pub const WHOLE: Shard = Shard { k: 0, m: 1 };
 
-    /// Parses `K/M`.
-    pub fn parse(s: &str) -> std::result::Result<Shard, String> {
+    /// Parses `K/M`; the error is an [`Error::Argument`] named by the text.
+    pub fn parse(s: &str) -> Result<Shard> {
+        let bad = |message: String| Error::Argument {
+            name: s.to_string(),
+            message,
+        };
         let (k, m) = s
             .split_once('/')
-            .ok_or_else(|| format!("`{s}`: expected K/M, e.g. 0/4"))?;
+            .ok_or_else(|| bad("expected K/M, e.g. 0/4".to_string()))?;
         let num = |t: &str| {
             t.trim()
                 .parse::<u64>()
-                .map_err(|e| format!("`{s}`: `{t}` is not a whole number ({e})"))
+                .map_err(|e| bad(format!("`{t}` is not a whole number ({e})")))
         };
         let (k, m) = (num(k)?, num(m)?);
         if m == 0 || k >= m {
-            return Err(format!("`{s}`: need 0 <= K < M"));
+            return Err(bad("need 0 <= K < M".to_string()));
         }
         Ok(Shard { k, m })
     }
@@ -155,7 +159,9 @@ impl Generator {
         if shard.m == 0 || shard.k >= shard.m {
             return Err(arg("--shard", "need 0 <= K < M".into()));
         }
-        settings.validate().map_err(|m| arg("solver settings", m))?;
+        settings
+            .validate()
+            .map_err(|e| arg("solver settings", e.to_string()))?;
         let exact = ExactSolver::new(space.clone(), detector_file, settings.clone())?;
         let space_text = toml::to_string(&space).unwrap_or_default();
         let settings_json = toml::to_string(&settings).unwrap_or_default();

@@ -5,7 +5,9 @@
 
 use std::sync::Arc;
 
-use hpge_solver::{ContactPotential, Detector, Primitive, Solid};
+use hpge_solver::Detector;
+use hpge_solver::detector::ContactPotential;
+use hpge_solver::geometry::{Primitive, Solid};
 
 use super::quadratic_z::base_inputs;
 use super::{Baseline, Candidate, ExactVariant, Extension, Predictor, one_more};

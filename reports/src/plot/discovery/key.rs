@@ -1,7 +1,8 @@
 //! The key beside the panels.
 
 use hpge_inference::Discovery;
-use hpge_solver::{BoundingBox, Detector};
+use hpge_solver::Detector;
+use hpge_solver::geometry::BoundingBox;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 

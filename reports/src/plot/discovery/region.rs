@@ -1,7 +1,8 @@
 //! The right panel: the detector's r-z cross-section with each window's probed region.
 
 use hpge_inference::Discovery;
-use hpge_solver::{BoundingBox, Detector};
+use hpge_solver::Detector;
+use hpge_solver::geometry::BoundingBox;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 

@@ -6,6 +6,8 @@
 //! every field direction by the band structure: four L valleys for electrons (`electrons.rs`),
 //! Bruyneel's anisotropic valence-band model for holes (`holes.rs`). No temperature scaling.
 
+use crate::error::Result;
+
 mod electrons;
 mod holes;
 mod parameters;
@@ -32,7 +34,7 @@ pub struct AdlModel {
 
 impl AdlModel {
     /// The model for `params`; `Err` names the invalid field (see [`AdlParameters::validate`]).
-    pub fn new(params: AdlParameters) -> Result<Self, String> {
+    pub fn new(params: AdlParameters) -> Result<Self> {
         params.validate()?;
         let alpha = -std::f64::consts::FRAC_PI_4 - params.phi110_deg.to_radians();
         let (s, c) = alpha.sin_cos();

@@ -1,5 +1,6 @@
 //! Parameters of the ADL drift model with their published defaults at 78 K.
 
+use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};
 
 /// The empirical longitudinal drift velocity along one crystal axis (Caughey and Thomas, Proc.
@@ -34,20 +35,26 @@ impl AxisParameters {
             - self.mun_cm2_per_vs * e_v_per_cm
     }
 
-    fn validate(&self, name: &str) -> Result<(), String> {
+    fn validate(&self, name: &str) -> Result<()> {
         for (key, v) in [
             ("mu0_cm2_per_vs", self.mu0_cm2_per_vs),
             ("beta", self.beta),
             ("e0_v_per_cm", self.e0_v_per_cm),
         ] {
             if !(v.is_finite() && v > 0.0) {
-                return Err(format!("`{name}.{key}` must be a positive number, got {v}"));
+                return Err(Error::invalid_value(
+                    "ADL parameters",
+                    format!("`{name}.{key}` must be a positive number, got {v}"),
+                ));
             }
         }
         if !self.mun_cm2_per_vs.is_finite() {
-            return Err(format!(
-                "`{name}.mun_cm2_per_vs` must be finite, got {}",
-                self.mun_cm2_per_vs
+            return Err(Error::invalid_value(
+                "ADL parameters",
+                format!(
+                    "`{name}.mun_cm2_per_vs` must be finite, got {}",
+                    self.mun_cm2_per_vs
+                ),
             ));
         }
         Ok(())
@@ -109,7 +116,7 @@ impl AdlParameters {
     /// Checks every field; the message names the field. Mobilities, exponents, field scales and
     /// masses must be positive and finite, the two masses must differ (the inter-valley
     /// repopulation is undefined for isotropic valleys), the angle finite.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<()> {
         self.e100.validate("e100")?;
         self.e111.validate("e111")?;
         self.h100.validate("h100")?;
@@ -119,16 +126,22 @@ impl AdlParameters {
             ("mt_over_me", self.mt_over_me),
         ] {
             if !(v.is_finite() && v > 0.0) {
-                return Err(format!("`{key}` must be a positive number, got {v}"));
+                return Err(Error::invalid_value(
+                    "ADL parameters",
+                    format!("`{key}` must be a positive number, got {v}"),
+                ));
             }
         }
         if (self.ml_over_me - self.mt_over_me).abs() <= 1e-12 * self.ml_over_me {
-            return Err("`ml_over_me` and `mt_over_me` must differ (anisotropic L valleys)".into());
+            return Err(Error::invalid_value(
+                "ADL parameters",
+                "`ml_over_me` and `mt_over_me` must differ (anisotropic L valleys)",
+            ));
         }
         if !self.phi110_deg.is_finite() {
-            return Err(format!(
-                "`phi110_deg` must be finite, got {}",
-                self.phi110_deg
+            return Err(Error::invalid_value(
+                "ADL parameters",
+                format!("`phi110_deg` must be finite, got {}", self.phi110_deg),
             ));
         }
         Ok(())

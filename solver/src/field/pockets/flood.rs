@@ -22,9 +22,8 @@
 use std::cmp::{Ordering, Reverse};
 use std::collections::BinaryHeap;
 
-use crate::field::mesh::{Mesh, NodeKind};
-
 use crate::carrier::Carrier;
+use crate::field::mesh::{Mesh, NodeKind};
 
 /// A level with a total order (for the heap); ties broken by node index (deterministic).
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -172,7 +172,7 @@ fn solve_point_on_wgpu_matches_cpu() {
         backend: Backend::Wgpu,
         ..FieldSettings::default()
     };
-    assert!(wrong.validate().unwrap_err().contains("wgpu"));
+    assert!(wrong.validate().unwrap_err().to_string().contains("wgpu"));
     if !gpu_test_gate() {
         return;
     }

@@ -6,9 +6,11 @@
 
 use serde::Serialize;
 
-use hpge_solver::{Detector, FieldSettings, Parameters, solve_point, solve_point_on_grid};
+use hpge_solver::field::solve_point_on_grid;
+use hpge_solver::{Detector, FieldSettings, Parameters, solve_point};
 
-use crate::{Result, repo_path};
+use crate::error::Result;
+use crate::repo::repo_path;
 
 /// One detector with its biases (V): undepleted, in the pinch-off window where there is one,
 /// fully depleted.

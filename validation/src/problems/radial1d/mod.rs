@@ -49,7 +49,7 @@
 //!    r phi'(r) = -(q / eps) int_s^r zeta(t) t dt.
 //!    ```
 //!    A front facing a contact (r_c, phi_c) solves phi_c - beta + (q / eps) psi_s(r_c) = 0 (for a
-//!    uniform zeta this is the closed form of [`crate::LongCoax`]); a layer between two fronts
+//!    uniform zeta this is the closed form of [`LongCoax`](crate::problems::coax::LongCoax)); a layer between two fronts
 //!    (s1, beta1), (s2, beta2) solves int_{s1}^{s2} zeta t dt = 0 (no net charge: the field vanishes
 //!    at both ends) and beta2 - beta1 + (q / eps) psi_{s1}(s2) = 0. The integrals are exact
 //!    (cumulative moments int zeta t dt and int zeta t ln(t / a) dt at the nodes plus adaptive
@@ -67,7 +67,7 @@
 //! # Accuracy (measured; tests/radial1d_vs_closed_form.rs)
 //!
 //! - Uniform 1e10 cm^-3 (a = 6, b = 37.5 mm) at the ten voltages of the reference table, against
-//!   [`crate::LongCoax`]: c' within 3e-13 relative and r_d within 8e-13 mm at 251, 1001 and 4001
+//!   [`LongCoax`](crate::problems::coax::LongCoax): c' within 3e-13 relative and r_d within 8e-13 mm at 251, 1001 and 4001
 //!   nodes; from 1 V to 3501 V (front 1.1 um from the contact) within 1e-11 at 251 to 8001 nodes.
 //! - Two-step p-type-mantle profile (junction layer between two fronts, then front to contact)
 //!   against its closed form, 1 V to 3000 V: fronts within 5e-13 mm, c' within 1e-12 (and 1e-13
