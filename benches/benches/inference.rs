@@ -7,8 +7,9 @@
 use std::hint::black_box;
 
 use criterion::Criterion;
+use hpge_inference::posterior::NoiseKind;
 use hpge_inference::{
-    CvModel, Data, FitSettings, Likelihood, NoiseKind, NoiseSettings, Posterior, Prior, PriorSpec,
+    CvModel, Data, FitSettings, Likelihood, NoiseSettings, Posterior, Prior, PriorSpec,
     SampleSettings, SamplerKind, SurrogateModel, fit, load_data,
 };
 use hpge_surrogate::Surrogate;

@@ -5,10 +5,12 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 use anyhow::{Context, Result, bail};
+use hpge_inference::posterior::NoiseKind;
+use hpge_inference::sampler::Phase;
+use hpge_inference::summary::interval_contains;
 use hpge_inference::{
-    CvData, CvModel, Data, ExactModel, Fit, FitSettings, Likelihood, NoiseKind, Posterior, Prior,
-    PriorSpec, SampleSettings, SamplerKind, Status, SurrogateModel, exact_check, fit,
-    interval_contains, load_data,
+    CvData, CvModel, Data, ExactModel, Fit, FitSettings, Likelihood, Posterior, Prior, PriorSpec,
+    SampleSettings, SamplerKind, Status, SurrogateModel, exact_check, fit, load_data,
 };
 use hpge_surrogate::{ExactSolver, Surrogate, fnv1a};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -151,11 +153,11 @@ pub fn progress_printer(quiet: bool) -> (ProgressBar, impl Fn(&Status) + Sync) {
     let b = bar.clone();
     let f = move |s: &Status| {
         let msg = match s.phase {
-            hpge_inference::Phase::Tuning => format!(
+            Phase::Tuning => format!(
                 "tuning cycle {}: acceptance {:.2}, R-hat {:.3}",
                 s.cycle, s.acceptance, s.rhat_max
             ),
-            hpge_inference::Phase::Sampling => format!(
+            Phase::Sampling => format!(
                 "sampling: {} draws per chain, R-hat {:.4}, min ESS {:.0}, acceptance {:.2}",
                 s.draws, s.rhat_max, s.ess_min, s.acceptance
             ),

@@ -2,13 +2,11 @@
 //! the posterior predictive, the modes of a multimodal posterior, and the exact-solver check.
 
 mod exact_check;
-mod optimise;
 mod predictive;
 mod run;
 mod summary;
 
 pub use exact_check::{ExactCheck, ParameterShift, exact_check};
-pub use optimise::nelder_mead;
 pub(crate) use predictive::thin_indices;
 pub use predictive::{Predictive, predictive};
 pub use run::{Fit, FitSettings, draw_range, fit};

@@ -2,7 +2,7 @@
 //! global mode along z and r.
 
 use anyhow::Result;
-use hpge_inference::{LEVELS, Predictive};
+use hpge_inference::fit::{LEVELS, Predictive};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
