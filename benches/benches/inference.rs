@@ -7,9 +7,10 @@
 use std::hint::black_box;
 
 use criterion::Criterion;
+use hpge_inference::posterior::NoiseKind;
 use hpge_inference::{
-    CvModel, FitSettings, Likelihood, NoiseKind, NoiseSettings, Posterior, Prior, PriorSpec,
-    SampleSettings, SamplerKind, SurrogateModel, fit,
+    CvModel, FitSettings, Likelihood, NoiseSettings, Posterior, Prior, PriorSpec, SampleSettings,
+    SamplerKind, SurrogateModel, fit,
 };
 use hpge_measurement::{Data, load_data};
 use hpge_surrogate::Surrogate;

@@ -5,6 +5,7 @@ use std::path::PathBuf;
 /// Errors of the inference crate. Every variant names the file (and key) at fault, so the
 /// command line can print a message a user can act on.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum Error {
     /// A failure in the surrogate layer (or, through it, the solver).
     #[error(transparent)]
@@ -47,6 +48,24 @@ pub enum Error {
         what: String,
         /// Why.
         message: String,
+    },
+    /// A model extension cannot build its detector at this point (e.g. a Li thickness slope
+    /// that leaves less than the thinnest layer allowed, an impurity model the extension cannot
+    /// modify): the point lies outside the extended model's domain.
+    #[error("`{extension}`: {message}")]
+    Extension {
+        /// The extension, in words (e.g. "a Li thickness slope").
+        extension: String,
+        /// Why the detector cannot be built.
+        message: String,
+    },
+    /// A catalogue entry does not apply to the start model or detector (model discovery).
+    #[error("{reason}")]
+    NotApplicable {
+        /// The entry's name (e.g. `radial`).
+        extension: String,
+        /// Why, in words.
+        reason: String,
     },
     /// A value given through the API or the command line is invalid.
     #[error("`{name}`: {message}")]
@@ -102,6 +121,27 @@ pub enum Error {
 pub type Result<T, E = Error> = std::result::Result<T, E>;
 
 impl Error {
+    /// Whether a sampler (or an optimiser) may treat this error of a model evaluation as a
+    /// rejected proposal, zero posterior density: a failed solve, a point outside the model's
+    /// domain, a numerical failure of a curve. I/O, malformed files, invalid values and
+    /// arguments, and GPU failures are not: they end the run.
+    pub fn is_recoverable(&self) -> bool {
+        match self {
+            Error::Surrogate(e) => e.is_recoverable(),
+            Error::Numerical { .. } | Error::Extension { .. } => true,
+            Error::Io { .. }
+            | Error::Format { .. }
+            | Error::Invalid { .. }
+            | Error::NotApplicable { .. }
+            | Error::Argument { .. }
+            | Error::BadOption { .. }
+            | Error::DetectorMismatch { .. } => false,
+            Error::Solver(e) => e.is_recoverable(),
+            Error::Measurement(_) => false,
+            Error::Context { inner, .. } => inner.is_recoverable(),
+        }
+    }
+
     /// This error with what was being read or done when it happened.
     pub fn context(self, context: impl Into<String>) -> Self {
         Error::Context {

@@ -7,6 +7,7 @@ use std::path::PathBuf;
 /// Every variant names where the problem is (the file and, where there is one, the key path inside
 /// it) so that the command line can print a message a user can act on.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum Error {
     /// A file could not be read.
     #[error("{}: cannot read the file: {source}", file.display())]
@@ -219,6 +220,33 @@ pub enum Error {
 pub type Result<T, E = Error> = std::result::Result<T, E>;
 
 impl Error {
+    /// Whether a sampler may treat this error as a rejected proposal (zero posterior density):
+    /// a solve at one point that failed (not converged, singular, an undepleted bridge between
+    /// contacts). Bad files, settings, arguments and GPU failures are not: they end a run.
+    pub fn is_recoverable(&self) -> bool {
+        match self {
+            Error::NotConverged { .. }
+            | Error::Singular { .. }
+            | Error::UndepletedBridge { .. } => true,
+            Error::Io { .. }
+            | Error::Parse { .. }
+            | Error::Invalid { .. }
+            | Error::Overlap { .. }
+            | Error::NoGpuAdapter { .. }
+            | Error::Gpu { .. }
+            | Error::Argument { .. }
+            | Error::GridOption { .. }
+            | Error::Syntax { .. }
+            | Error::InteractionInContact { .. }
+            | Error::InteractionUndepleted { .. }
+            | Error::InteractionOutside { .. }
+            | Error::NoNetCharge { .. }
+            | Error::Expression { .. }
+            | Error::InvalidValue { .. } => false,
+            Error::ScanPointFailed { source, .. } => source.is_recoverable(),
+        }
+    }
+
     /// Shorthand for [`Error::Invalid`].
     pub fn invalid(
         file: impl Into<PathBuf>,

@@ -6,9 +6,10 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use anyhow::{Context, Result};
+use hpge_inference::discover::catalogue;
 use hpge_inference::{
     CvModel, DiscoverInputs, DiscoverSettings, Discovery, FitSettings, PriorSpec, Progress,
-    SampleSettings, SamplerKind, Status, catalogue, discover,
+    SampleSettings, SamplerKind, Status, discover,
 };
 use indicatif::ProgressBar;
 

@@ -4,7 +4,9 @@
 use std::path::Path;
 
 use anyhow::Result;
+use hpge_inference::fit::FitSummary;
 use hpge_inference::fit::{FitFiles, FitJob};
+use hpge_inference::sampler::Phase;
 use hpge_inference::{CvModel, FitSettings, SamplerKind, Status};
 use hpge_reports::fit::{FitObserver, FitRun, run_fit, summary_text};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -64,11 +66,11 @@ pub fn progress_printer(quiet: bool) -> (ProgressBar, impl Fn(&Status) + Sync) {
     let b = bar.clone();
     let f = move |s: &Status| {
         let msg = match s.phase {
-            hpge_inference::Phase::Tuning => format!(
+            Phase::Tuning => format!(
                 "tuning cycle {}: acceptance {:.2}, R-hat {:.3}",
                 s.cycle, s.acceptance, s.rhat_max
             ),
-            hpge_inference::Phase::Sampling => format!(
+            Phase::Sampling => format!(
                 "sampling: {} draws per chain, R-hat {:.4}, min ESS {:.0}, acceptance {:.2}",
                 s.draws, s.rhat_max, s.ess_min, s.acceptance
             ),
@@ -183,7 +185,7 @@ pub fn run(o: &FitOptions, print_json: bool, allow_unconverged: bool) -> Result<
 }
 
 /// Why a fit did not converge: the largest R-hat, the smallest bulk ESS, the stop reason.
-fn unconverged_text(sm: &hpge_inference::FitSummary) -> String {
+fn unconverged_text(sm: &FitSummary) -> String {
     let worst = sm
         .parameters
         .iter()

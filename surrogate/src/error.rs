@@ -4,6 +4,7 @@ use std::path::PathBuf;
 
 /// Errors of the surrogate crate (each names the file and key at fault where there is one).
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum Error {
     /// A solver-side failure (bad detector, failed solve) while building a data set.
     #[error(transparent)]
@@ -116,3 +117,25 @@ pub enum Error {
 
 /// Result alias of the surrogate crate.
 pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+impl Error {
+    /// Whether a sampler may treat this error as a rejected proposal (zero posterior density):
+    /// a point outside the model's domain, or a failed solve of the exact solver. Bad files,
+    /// arguments and training failures are not.
+    pub fn is_recoverable(&self) -> bool {
+        match self {
+            Error::Solver(e) => e.is_recoverable(),
+            Error::OutsideDomain { .. } => true,
+            Error::Io { .. }
+            | Error::Parse { .. }
+            | Error::Invalid { .. }
+            | Error::Training { .. }
+            | Error::Argument { .. }
+            | Error::RunFile { .. }
+            | Error::ModelPath { .. }
+            | Error::Checkpoint { .. }
+            | Error::DataForModel { .. }
+            | Error::Parameters { .. } => false,
+        }
+    }
+}

@@ -8,10 +8,8 @@ use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Instant;
 
-use hpge_inference::{
-    CvModel, ExactModel, LaplaceSettings, Likelihood, NoiseSettings, Posterior, Prior, PriorSpec,
-    laplace_fit,
-};
+use hpge_inference::discover::{LaplaceFit, LaplaceSettings, laplace_fit};
+use hpge_inference::{CvModel, ExactModel, Likelihood, NoiseSettings, Posterior, Prior, PriorSpec};
 use hpge_measurement::{CvData, read_curve};
 use hpge_solver::FieldSettings;
 use hpge_surrogate::{ExactSolver, Surrogate};
@@ -54,7 +52,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let post = Posterior::new(model.as_ref(), &prior, &lik)?;
         let base: Vec<f64> = BASE_TRUTH.iter().map(|(_, v)| *v).collect();
         let starts = [base, vec![1.0, 0.7, 0.6], vec![4.5, 0.5, 0.4]];
-        let mut best: Option<hpge_inference::LaplaceFit> = None;
+        let mut best: Option<LaplaceFit> = None;
         for s in &starts {
             if let Ok(f) = laplace_fit(&post, s, &LaplaceSettings::default())
                 && best.as_ref().is_none_or(|b| f.chi2 < b.chi2)

@@ -2,6 +2,7 @@
 
 /// Errors of the validation crate.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum Error {
     /// A closed form asked outside its domain.
     #[error("{quantity} = {value} is outside the closed form's domain: {why}")]
@@ -23,3 +24,15 @@ pub enum Error {
 
 /// Result alias of the validation crate.
 pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+impl Error {
+    /// Whether a sampler may treat this error as a rejected proposal (zero posterior density):
+    /// a closed form asked outside its domain, or a recoverable error of the crate below.
+    pub fn is_recoverable(&self) -> bool {
+        match self {
+            Error::Domain { .. } => true,
+            Error::Solver(e) => e.is_recoverable(),
+            Error::Inference(e) => e.is_recoverable(),
+        }
+    }
+}

@@ -15,20 +15,11 @@
 
 use super::checks::{Elpd, block_partition};
 use super::laplace::LaplaceFit;
-use crate::posterior::Cholesky;
+use crate::numerics::Cholesky;
 
 /// H = covariance^-1 (d x d, row-major); None when the covariance is not positive definite.
 fn precision(cov: &[f64], d: usize) -> Option<Vec<f64>> {
-    let ch = Cholesky::new(cov, d)?;
-    let mut h = vec![0.0; d * d];
-    for q in 0..d {
-        let mut unit = vec![0.0; d];
-        unit[q] = 1.0;
-        for (p, v) in ch.solve(&unit).into_iter().enumerate() {
-            h[p * d + q] = v;
-        }
-    }
-    Some(h)
+    Some(Cholesky::new(cov, d)?.inverse())
 }
 
 /// ln N(y; m, S) for a small dense S; None when S is not positive definite.

@@ -12,24 +12,30 @@ use super::laplace::{LaplaceFit, laplace_fit};
 use super::settings::{DiscoverSettings, ModelFit, Progress};
 use super::summary::Gap;
 use crate::fit::thin_indices;
-use crate::posterior::Cholesky;
+use crate::fit::{Fit, fit};
+use crate::model::CvModel;
+use crate::numerics::Cholesky;
+use crate::posterior::{Likelihood, Posterior};
+use crate::prior::Prior;
 use crate::prior::PriorDistribution;
-use crate::{CvModel, Fit, Likelihood, Posterior, Prior, Result, fit};
+use crate::rejection::unless_rejected;
+use crate::{Error, Result};
 
-/// Predictive draws of an MCMC fit: at most `n` thinned draws.
-pub(super) fn mcmc_draws(posterior: &Posterior, fit: &Fit, n: usize) -> PredictiveDraws {
+/// Predictive draws of an MCMC fit: at most `n` thinned draws (a draw whose curve fails
+/// recoverably is left out; any other model error is returned).
+pub(super) fn mcmc_draws(posterior: &Posterior, fit: &Fit, n: usize) -> Result<PredictiveDraws> {
     let all = fit.samples.all();
     let mut draws = PredictiveDraws {
         curves: Vec::new(),
         sigmas: Vec::new(),
     };
     for i in thin_indices(all.len(), n) {
-        if let Ok(ev) = posterior.evaluate(all[i]) {
+        if let Some(ev) = unless_rejected(posterior.evaluate(all[i]))? {
             draws.sigmas.push(posterior.likelihood.sigma(&ev.c_p));
             draws.curves.push(ev.c_p);
         }
     }
-    draws
+    Ok(draws)
 }
 
 /// Draws of the Laplace approximation N(theta*, H^-1) (inside the prior's support) with the
@@ -50,14 +56,11 @@ pub(super) fn laplace_draws(
     let Some(ch) = Cholesky::new(&lf.covariance, d) else {
         return draws;
     };
-    let l = ch.lower();
     let mut tries = 0;
     while draws.curves.len() < n && tries < 100 * n {
         tries += 1;
         let e: Vec<f64> = (0..d).map(|_| StandardNormal.sample(&mut rng)).collect();
-        let dt: Vec<f64> = (0..d)
-            .map(|p| (0..=p).map(|q| l[p * d + q] * e[q]).sum())
-            .collect();
+        let dt = ch.mul_lower(&e);
         let theta: Vec<f64> = lf.theta.iter().zip(&dt).map(|(t, s)| t + s).collect();
         if !posterior.prior.ln_density(&theta).is_finite() {
             continue;
@@ -115,7 +118,7 @@ pub(super) fn mcmc_fit(
     let f = fit(&posterior, &settings.fit, inputs.clone(), &|s| {
         progress.sampling(s)
     })?;
-    let draws = mcmc_draws(&posterior, &f, settings.draws);
+    let draws = mcmc_draws(&posterior, &f, settings.draws)?;
     let c_mode = f.predictive.c_mode_pf.clone();
     Ok(ModelFit {
         model: prior.name.clone(),
@@ -200,7 +203,7 @@ pub(super) fn best_laplace(
     match (best, first_err) {
         (Some(b), _) => Ok(b),
         (None, Some(e)) => Err(e),
-        (None, None) => Err(crate::Error::Argument {
+        (None, None) => Err(Error::Argument {
             name: "start points".into(),
             message: "none given".into(),
         }),

@@ -16,9 +16,11 @@
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::posterior::Cholesky;
+use crate::numerics::Cholesky;
+use crate::posterior::Posterior;
 use crate::prior::PriorDistribution;
-use crate::{Error, Posterior, Result};
+use crate::rejection::unless_rejected;
+use crate::{Error, Result};
 
 /// Settings of the quick fit.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -213,10 +215,11 @@ pub fn laplace_fit(
         let delta = ch.solve(&g.iter().map(|v| -v).collect::<Vec<_>>());
         let mut trial: Vec<f64> = theta.iter().zip(&delta).map(|(t, s)| t + s).collect();
         clamp(posterior, &mut trial);
-        let ev = posterior.evaluate(&trial);
+        // A recoverable failure at the trial point rejects the step; any other error is returned.
+        let ev = unless_rejected(posterior.evaluate(&trial))?;
         evaluations += 1;
         match ev {
-            Ok(ev) if ev.ln_posterior > current.ln_posterior => {
+            Some(ev) if ev.ln_posterior > current.ln_posterior => {
                 let gain = ev.ln_posterior - current.ln_posterior;
                 theta = trial;
                 current = ev;
@@ -246,15 +249,7 @@ pub fn laplace_fit(
         what: "Laplace approximation".into(),
         message: "the Hessian at the mode is not positive definite".into(),
     })?;
-    let mut covariance = vec![0.0; d * d];
-    for q in 0..d {
-        let mut unit = vec![0.0; d];
-        unit[q] = 1.0;
-        let col = ch.solve(&unit);
-        for p in 0..d {
-            covariance[p * d + q] = col[p];
-        }
-    }
+    let covariance = ch.inverse();
     let ln_evidence = current.ln_posterior + 0.5 * d as f64 * (2.0 * std::f64::consts::PI).ln()
         - 0.5 * ch.ln_det();
     Ok(LaplaceFit {

@@ -15,14 +15,15 @@ mod settings;
 mod summary;
 
 pub use catalogue::{
-    Affine, AffineKind, Baseline, CalibrationScale, Candidate, ExactVariant, Extension, LiSlope,
-    Predictor, QuadraticZ, Radial, Scaled, Shifted, StrayCapacitance, catalogue,
+    Affine, AffineKind, Baseline, CalibrationScale, Candidate, ExactVariant, Extension,
+    ExtensionPredictor, LiSlope, Modifier, QuadraticZ, Radial, Scaled, Shifted, StrayCapacitance,
+    catalogue,
 };
 pub use checks::{
     Elpd, PredictiveDraws, ResidualCheck, Window, delta_elpd, leave_window_out, residual_check,
 };
 pub use laplace::{LaplaceFit, LaplaceSettings, laplace_fit};
-pub use region::{Region, probed_region};
+pub use region::{ProbedRegion, probed_region};
 pub use run::discover;
 pub use settings::{DiscoverInputs, DiscoverSettings, Discovery, ModelFit, Progress};
 pub use summary::{CandidateScore, Disagreement, DiscoverySummary, Gap, NotApplicable};

@@ -11,7 +11,7 @@ use crate::{Error, Result};
 
 /// A region of the (r, z) half plane: where most of the swept volume lies.
 #[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct Region {
+pub struct ProbedRegion {
     /// [lo, hi] radius, mm: the 5% and 95% quantiles of the swept volume's radius.
     pub r_mm: [f64; 2],
     /// [lo, hi] height, mm: the 5% and 95% quantiles of the swept volume's height.
@@ -77,7 +77,7 @@ pub fn probed_region(
     settings: &FieldSettings,
     u_lo_v: Option<f64>,
     u_hi_v: f64,
-) -> Result<Region> {
+) -> Result<ProbedRegion> {
     let solve =
         |u: f64| solve_point(det, u, settings, None).map_err(|e| Error::Surrogate(e.into()));
     let hi = solve(u_hi_v)?;
@@ -108,7 +108,7 @@ pub fn probed_region(
         by_z.push((zn, v));
         volume_mm3 += v;
     }
-    let region = Region {
+    let region = ProbedRegion {
         r_mm: [
             weighted_quantile(&mut by_r, REGION_TAIL),
             weighted_quantile(&mut by_r, 1.0 - REGION_TAIL),

@@ -4,14 +4,17 @@
 use std::sync::Arc;
 use std::time::Instant;
 
-use super::catalogue::{Baseline, Predictor, catalogue};
+use super::catalogue::{Baseline, ExtensionPredictor, catalogue};
 use super::checks::delta_elpd;
 use super::fits::{best_laplace, bind, gap, laplace_model_fit, mcmc_fit, start_points};
 use super::laplace::{LaplaceFit, laplace_fit};
 use super::region::probed_region;
 use super::settings::{DiscoverInputs, DiscoverSettings, Discovery, Progress};
 use super::summary::{CandidateScore, Disagreement, DiscoverySummary, NotApplicable};
-use crate::{CvModel, ExactModel, Posterior, Prior, Result};
+use crate::Result;
+use crate::model::{CvModel, ExactModel};
+use crate::posterior::Posterior;
+use crate::prior::Prior;
 
 /// Runs the workflow (see the module docs).
 pub fn discover(
@@ -19,10 +22,7 @@ pub fn discover(
     settings: &DiscoverSettings,
     progress: &dyn Progress,
 ) -> Result<Discovery> {
-    settings.validate().map_err(|m| crate::Error::Argument {
-        name: "discover settings".into(),
-        message: m,
-    })?;
+    settings.validate()?;
     let t0 = Instant::now();
     let lik = inp.likelihood;
     let volts = inp.surrogate.voltages().to_vec();
@@ -48,9 +48,9 @@ pub fn discover(
     // The exact solver's own error is the likelihood's 1% + 1 pF term (sigma_p = 0).
     let lik_exact = lik.with_sigma_rel(0.0);
     let (predictor, model, lik_p) = if settings.exact {
-        (Predictor::Exact, exact_model.clone(), &lik_exact)
+        (ExtensionPredictor::Exact, exact_model.clone(), &lik_exact)
     } else {
-        (Predictor::Surrogate, inp.surrogate.clone(), lik)
+        (ExtensionPredictor::Surrogate, inp.surrogate.clone(), lik)
     };
     let prior0 = Prior::bind(inp.start, &model.inputs(), &model.domain())?;
     let p0 = Posterior::new(model.as_ref(), &prior0, lik_p)?;
@@ -113,9 +113,9 @@ pub fn discover(
         }
         match ext.build(&base) {
             Ok(c) => candidates.push(c),
-            Err(reason) => not_applicable.push(NotApplicable {
+            Err(e) => not_applicable.push(NotApplicable {
                 name: ext.name().into(),
-                reason,
+                reason: e.to_string(),
             }),
         }
     }
@@ -126,8 +126,8 @@ pub fn discover(
     for c in &candidates {
         let tc = Instant::now();
         let (baseline, lik_c) = match c.predictor {
-            Predictor::Surrogate => (&base_fit, lik),
-            Predictor::Exact => {
+            ExtensionPredictor::Surrogate => (&base_fit, lik),
+            ExtensionPredictor::Exact => {
                 if base_exact.is_none() {
                     progress.stage("quick fit of the start model (exact solver)");
                     let p = Posterior::new(exact_model.as_ref(), &exact_prior, &lik_exact)?;
@@ -190,7 +190,7 @@ pub fn discover(
         progress.stage(&format!("full fit: {} + {}", inp.start.name, c.name));
         let prior = &quick[i].1;
         let (af, before_ref) = match c.predictor {
-            Predictor::Surrogate => {
+            ExtensionPredictor::Surrogate => {
                 let af = mcmc_fit(
                     c.model.as_ref(),
                     prior,
@@ -203,7 +203,7 @@ pub fn discover(
                 after_gap = gap(&af, lik, m.summary.converged, &m.mode.clone(), "mcmc");
                 (af, before.elpd.clone())
             }
-            Predictor::Exact => {
+            ExtensionPredictor::Exact => {
                 elpd_method = "laplace-linear".into();
                 let p = Posterior::new(c.model.as_ref(), prior, &lik_exact)?;
                 let lf = quick[i].0.clone();

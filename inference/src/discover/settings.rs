@@ -9,7 +9,12 @@ use serde::Serialize;
 use super::checks::{Elpd, ResidualCheck};
 use super::laplace::{LaplaceFit, LaplaceSettings};
 use super::summary::DiscoverySummary;
-use crate::{CvModel, Fit, FitSettings, Likelihood, PriorSpec, Status};
+use crate::fit::{Fit, FitSettings};
+use crate::model::CvModel;
+use crate::posterior::Likelihood;
+use crate::prior::PriorSpec;
+use crate::sampler::Status;
+use crate::{Error, Result};
 
 /// Settings of the workflow.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -60,19 +65,26 @@ impl Default for DiscoverSettings {
 }
 
 impl DiscoverSettings {
-    /// Checks the values (the message names the field).
-    pub fn validate(&self) -> std::result::Result<(), String> {
+    /// Checks the values (an [`Error::Argument`] named `discover settings`, whose message names
+    /// the field).
+    pub fn validate(&self) -> Result<()> {
+        let bad = |message: String| {
+            Err(Error::Argument {
+                name: "discover settings".into(),
+                message,
+            })
+        };
         if self.min_run < 2 {
-            return Err(format!("min_run: {} < 2", self.min_run));
+            return bad(format!("min_run: {} < 2", self.min_run));
         }
         if !(self.window_p > 0.0 && self.window_p < 1.0) {
-            return Err(format!("window_p: {} is not in (0, 1)", self.window_p));
+            return bad(format!("window_p: {} is not in (0, 1)", self.window_p));
         }
         if self.elpd_blocks < 2 {
-            return Err(format!("elpd_blocks: {} < 2", self.elpd_blocks));
+            return bad(format!("elpd_blocks: {} < 2", self.elpd_blocks));
         }
         if self.draws < 100 {
-            return Err(format!("draws: {} < 100", self.draws));
+            return bad(format!("draws: {} < 100", self.draws));
         }
         Ok(())
     }

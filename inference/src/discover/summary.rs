@@ -7,7 +7,7 @@ use serde::Serialize;
 
 use super::DiscoverSettings;
 use super::checks::Window;
-use super::region::Region;
+use super::region::ProbedRegion;
 
 /// A window of structured disagreement and the detector region it probes.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -16,7 +16,7 @@ pub struct Disagreement {
     #[serde(rename = "voltages_V")]
     pub voltages_v: [f64; 2],
     /// The region the depletion front sweeps across the window (start model's best fit).
-    pub region: Option<Region>,
+    pub region: Option<ProbedRegion>,
     /// Look-elsewhere-corrected posterior-predictive p-value of the window.
     pub p_value: f64,
     /// The run of residuals: voltage indices, sign (+1: data above the model), sum of r^2.

@@ -12,9 +12,13 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use super::predictive::thin_indices;
+use crate::Result;
 use crate::model::CvModel;
+use crate::posterior::Likelihood;
+use crate::prior::Prior;
+use crate::rejection::unless_rejected;
+use crate::sampler::Samples;
 use crate::summary::psis;
-use crate::{Likelihood, Prior, Result, Samples};
 
 /// One parameter's shift.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -52,7 +56,9 @@ pub struct ExactCheck {
     pub seconds: f64,
 }
 
-/// Runs the check on at most `n` draws (evenly thinned) and at the global mode `mode`.
+/// Runs the check on at most `n` draws (evenly thinned) and at the global mode `mode`. A solve
+/// that fails recoverably gives its draw weight 0 (a surrogate curve that fails, NaN); any
+/// other model error is returned.
 #[allow(clippy::too_many_arguments)]
 pub fn exact_check(
     surrogate: &dyn CvModel,
@@ -83,9 +89,9 @@ pub fn exact_check(
     points.push(mode);
     let results: Vec<(f64, Option<Vec<f64>>, Vec<f64>)> = points
         .par_iter()
-        .map(|theta| {
-            let cs = eval(surrogate, theta).unwrap_or_else(|_| vec![f64::NAN; nv]);
-            let ce = eval(exact, theta).ok();
+        .map(|theta| -> Result<_> {
+            let cs = unless_rejected(eval(surrogate, theta))?.unwrap_or_else(|| vec![f64::NAN; nv]);
+            let ce = unless_rejected(eval(exact, theta))?;
             let lr = match &ce {
                 Some(c) => exact_like.ln_likelihood(c, None) - likelihood.ln_likelihood(&cs, None),
                 None => f64::NEG_INFINITY,
@@ -94,9 +100,9 @@ pub fn exact_check(
                 done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1,
                 total,
             );
-            (lr, ce, cs)
+            Ok((lr, ce, cs))
         })
-        .collect();
+        .collect::<Result<_>>()?;
     let (at_mode, draws) = results.split_last().expect("the mode is always there");
     let failed = draws.iter().filter(|r| r.1.is_none()).count();
     let log_ratios: Vec<f64> = draws

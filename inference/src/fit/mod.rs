@@ -3,7 +3,6 @@
 
 mod exact_check;
 mod job;
-mod optimise;
 mod options;
 pub mod outputs;
 mod predictive;
@@ -14,7 +13,6 @@ mod zeta;
 
 pub use exact_check::{ExactCheck, ParameterShift, exact_check};
 pub use job::{FitFiles, FitJob, file_hash};
-pub use optimise::nelder_mead;
 pub use options::{
     DEFAULT_DATA, DEFAULT_DETECTOR, DEFAULT_MODEL, DEFAULT_PRIOR, FitOptions, noise_settings,
     sampler_kind,

@@ -4,7 +4,10 @@
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::{Posterior, Result, Samples};
+use crate::Result;
+use crate::posterior::Posterior;
+use crate::rejection::unless_rejected;
+use crate::sampler::Samples;
 
 /// Per voltage: the median and the central 68.3/95.5/99.7% bands of c_p - c_m (pF), the
 /// measurement and the prediction at the global mode with its sigma.
@@ -40,7 +43,8 @@ pub(crate) fn thin_indices(total: usize, n: usize) -> Vec<usize> {
     (0..n).map(|i| i * total / n).collect()
 }
 
-/// The predictive from at most `n` draws, with the mode's curve `c_mode`.
+/// The predictive from at most `n` draws, with the mode's curve `c_mode`. A draw whose curve
+/// fails recoverably is left out; any other model error is returned.
 pub fn predictive(
     posterior: &Posterior,
     samples: &Samples,
@@ -52,7 +56,11 @@ pub fn predictive(
     let idx = thin_indices(all.len(), n);
     let curves: Vec<Vec<f64>> = idx
         .par_iter()
-        .filter_map(|&i| posterior.evaluate(all[i]).ok().map(|e| e.c_p))
+        .map(|&i| unless_rejected(posterior.evaluate(all[i])))
+        .collect::<Result<Vec<_>>>()?
+        .into_iter()
+        .flatten()
+        .map(|e| e.c_p)
         .collect();
     let c_m = &posterior.likelihood.c_m;
     let nv = c_m.len();

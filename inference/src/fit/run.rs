@@ -5,13 +5,14 @@ use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 
-use super::nelder_mead;
 use super::predictive::{Predictive, predictive, thin_indices};
 use super::summary::{FitSummary, LEVELS, ModeSummary, ParameterSummary};
+use crate::Result;
+use crate::numerics::nelder_mead;
+use crate::posterior::{NoiseSettings, Posterior};
+use crate::rejection::Latch;
+use crate::sampler::{LogDensity, SampleSettings, Samples, Status, sample};
 use crate::summary::{find_modes, marginal_mode, smallest_intervals};
-use crate::{
-    LogDensity, NoiseSettings, Posterior, Result, SampleSettings, Samples, Status, sample,
-};
 
 /// Settings of a fit.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -104,13 +105,17 @@ pub fn fit(
     let (best, _) = samples.best();
     let mut z0 = vec![0.0; d];
     prior.to_unconstrained(&best, &mut z0);
+    // A recoverable model error is a point of zero density; any other ends the fit.
+    let latch = Latch::default();
     let f = |z: &[f64]| {
-        posterior
-            .ln_density_z(z, None)
-            .map(|(l, _)| posterior.output(z, l).1)
-            .unwrap_or(f64::NEG_INFINITY)
+        latch.value(|| {
+            posterior
+                .ln_density_z(z, None)
+                .map(|(l, _)| posterior.output(z, l).1)
+        })
     };
     let (z_mode, _) = nelder_mead(&f, &z0, 0.05, 200 * d + 400, 1e-10);
+    latch.check()?;
     let mut mode = vec![0.0; d];
     prior.from_unconstrained(&z_mode, &mut mode);
     let at_mode = posterior.evaluate(&mode)?;

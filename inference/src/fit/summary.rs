@@ -6,7 +6,9 @@ use std::collections::BTreeMap;
 use serde::Serialize;
 
 use super::ExactCheck;
-use crate::{LocalMode, NoiseSettings, PriorDistribution, SampleSettings, StopReason};
+use crate::posterior::NoiseSettings;
+use crate::prior::PriorDistribution;
+use crate::sampler::{LocalMode, SampleSettings, SamplerStop};
 
 /// Probability contents of the smallest intervals (1, 2 and 3 sigma of a normal).
 pub const LEVELS: [f64; 3] = [0.683, 0.955, 0.997];
@@ -81,7 +83,7 @@ pub struct FitSummary {
     /// Sampler settings (sampler, chains, seed, targets).
     pub settings: SampleSettings,
     /// Why sampling stopped.
-    pub stop: StopReason,
+    pub stop: SamplerStop,
     /// Whether the tuning met its criterion.
     pub tuned: bool,
     /// Tuning cycles (Metropolis).

@@ -17,7 +17,7 @@ use rand::Rng;
 use rand_distr::{Distribution, StandardNormal};
 use serde::{Deserialize, Serialize};
 
-use super::Cholesky;
+use crate::numerics::Cholesky;
 use crate::{CvData, Error, Result};
 
 const LN_SQRT_2PI: f64 = 0.918_938_533_204_672_8;

@@ -1,11 +1,9 @@
 //! The likelihood of a measured C-V curve (the paper's eqs. 12-15, and the variant with the
 //! measured covariance) and the posterior the samplers see.
 
-mod cholesky;
 mod density;
 mod likelihood;
 
-pub use cholesky::Cholesky;
 pub use density::{Evaluation, Posterior};
 pub use likelihood::{Likelihood, NoiseKind, NoiseSettings};
 

@@ -1,5 +1,5 @@
 //! Likelihood: closed forms, gradients against finite differences, the two noise models against
-//! each other; the Cholesky factorisation against a direct product.
+//! each other.
 
 use std::path::PathBuf;
 
@@ -102,28 +102,6 @@ fn covariance_model_needs_a_covariance() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("test.csv") && e.contains("covariance"), "{e}");
-}
-
-#[test]
-fn cholesky_solves_and_inverts() {
-    let a = [4.0, 2.0, 0.4, 2.0, 5.0, 1.0, 0.4, 1.0, 3.0];
-    let c = Cholesky::new(&a, 3).unwrap();
-    let x = c.solve(&[1.0, 2.0, 3.0]);
-    for i in 0..3 {
-        let ax: f64 = (0..3).map(|j| a[i * 3 + j] * x[j]).sum();
-        assert!((ax - [1.0, 2.0, 3.0][i]).abs() < 1e-12);
-    }
-    // Diagonal of the inverse: column i of A^-1 from solve(e_i).
-    let d = c.inverse_diagonal();
-    for i in 0..3 {
-        let mut e = [0.0; 3];
-        e[i] = 1.0;
-        assert!((c.solve(&e)[i] - d[i]).abs() < 1e-12);
-    }
-    // det by cofactors.
-    let det = 4.0 * (15.0 - 1.0) - 2.0 * (6.0 - 0.4) + 0.4 * (2.0 - 2.0);
-    assert!((c.ln_det() - f64::ln(det)).abs() < 1e-12);
-    assert!(Cholesky::new(&[1.0, 2.0, 2.0, 1.0], 2).is_none());
 }
 
 #[test]

@@ -10,19 +10,23 @@
 
 use std::time::Instant;
 
+use std::sync::Arc;
+
 use rand::RngExt;
-use rand::SeedableRng;
 use rand::rngs::StdRng;
 use rand_distr::{Distribution, StandardNormal};
 use rayon::prelude::*;
 
-use std::sync::Arc;
-
-use super::LogDensity;
+use super::engine::{Draw, Engine, Tuned};
 use super::modes::{Modes, search};
-use super::run::{Draw, Engine, Phase, SampleSettings, Status, Tuned};
-use crate::posterior::Cholesky;
-use crate::{Error, Result, rank_rhat};
+use super::settings::SampleSettings;
+use super::start::{chain_rng, start_point};
+use super::status::{Phase, Status};
+use super::target::LogDensity;
+use crate::Result;
+use crate::diagnostics::rank_rhat;
+use crate::numerics::Cholesky;
+use crate::rejection::density_or_rejected;
 
 /// Factor of the scale update per cycle.
 const SCALE_STEP: f64 = 1.25;
@@ -38,8 +42,8 @@ struct Chain<'a> {
     rw_accepted: u64,
     z: Vec<f64>,
     ln_p: f64,
-    /// Lower Cholesky factor of Sigma (row-major).
-    l: Vec<f64>,
+    /// Cholesky factor of Sigma.
+    l: Cholesky,
     /// c.
     scale: f64,
     rng: StdRng,
@@ -47,16 +51,15 @@ struct Chain<'a> {
 }
 
 impl Chain<'_> {
-    fn step(&mut self) -> Draw {
+    /// One step: a mode jump or a random-walk proposal. A recoverable model error rejects the
+    /// proposal; any other error is returned.
+    fn step(&mut self) -> Result<Draw> {
         if let Some(m) = &self.jumps
             && self.rng.random::<f64>() < JUMP_PROBABILITY
         {
             let proposal = m.sample(&mut self.rng);
             self.evaluations += 1;
-            let ln_q = self
-                .target
-                .ln_density(&proposal, None)
-                .unwrap_or(f64::NEG_INFINITY);
+            let ln_q = density_or_rejected(self.target.ln_density(&proposal, None))?;
             let ln_a = ln_q - self.ln_p + m.ln_q(&self.z) - m.ln_q(&proposal);
             let u: f64 = self.rng.random();
             let accepted = ln_q.is_finite() && u.ln() < ln_a;
@@ -64,26 +67,22 @@ impl Chain<'_> {
                 self.z = proposal;
                 self.ln_p = ln_q;
             }
-            return Draw {
+            return Ok(Draw {
                 z: self.z.clone(),
                 ln_density: self.ln_p,
                 accept: f64::from(u8::from(accepted)),
                 divergent: false,
-            };
+            });
         }
         let d = self.z.len();
         let e: Vec<f64> = (0..d)
             .map(|_| StandardNormal.sample(&mut self.rng))
             .collect();
         let s = self.scale.sqrt();
-        let proposal: Vec<f64> = (0..d)
-            .map(|i| self.z[i] + s * (0..=i).map(|k| self.l[i * d + k] * e[k]).sum::<f64>())
-            .collect();
+        let step = self.l.mul_lower(&e);
+        let proposal: Vec<f64> = (0..d).map(|i| self.z[i] + s * step[i]).collect();
         self.evaluations += 1;
-        let ln_q = self
-            .target
-            .ln_density(&proposal, None)
-            .unwrap_or(f64::NEG_INFINITY);
+        let ln_q = density_or_rejected(self.target.ln_density(&proposal, None))?;
         let u: f64 = self.rng.random();
         let accepted = ln_q.is_finite() && u.ln() < ln_q - self.ln_p;
         self.rw_tried += 1;
@@ -92,18 +91,18 @@ impl Chain<'_> {
             self.z = proposal;
             self.ln_p = ln_q;
         }
-        Draw {
+        Ok(Draw {
             z: self.z.clone(),
             ln_density: self.ln_p,
             accept: f64::from(u8::from(accepted)),
             divergent: false,
-        }
+        })
     }
 }
 
 impl Engine for Chain<'_> {
     fn draw(&mut self) -> Result<Draw> {
-        Ok(self.step())
+        self.step()
     }
 
     fn evaluations(&self) -> u64 {
@@ -115,31 +114,6 @@ impl Engine for Chain<'_> {
     }
 }
 
-/// A seeded generator per chain (and per purpose).
-pub(super) fn chain_rng(seed: u64, chain: usize) -> StdRng {
-    StdRng::seed_from_u64(
-        seed ^ (chain as u64)
-            .wrapping_add(1)
-            .wrapping_mul(0x9E37_79B9_7F4A_7C15),
-    )
-}
-
-/// A dispersed start with a finite density.
-pub(super) fn start_point(target: &dyn LogDensity, rng: &mut StdRng) -> Result<(Vec<f64>, f64)> {
-    for _ in 0..1000 {
-        let z = target.initial(rng);
-        if let Ok(l) = target.ln_density(&z, None)
-            && l.is_finite()
-        {
-            return Ok((z, l));
-        }
-    }
-    Err(Error::Numerical {
-        what: "starting points".into(),
-        message: "1000 draws from the prior all have zero posterior density (outside the model's domain, or the model fails there)".into(),
-    })
-}
-
 /// Burn-in and tuning.
 pub(super) fn tune<'a>(
     target: &'a dyn LogDensity,
@@ -149,7 +123,7 @@ pub(super) fn tune<'a>(
 ) -> Result<Tuned<'a>> {
     let d = target.dim();
     let modes = if s.mode_starts > 0 {
-        search(target, s.mode_starts, s.seed)
+        search(target, s.mode_starts, s.seed)?
     } else {
         Modes {
             modes: Vec::new(),
@@ -208,13 +182,13 @@ pub(super) fn tune<'a>(
                 let mut zs = Vec::with_capacity(s.cycle_draws);
                 let mut acc = 0.0;
                 for _ in 0..s.cycle_draws {
-                    let dr = ch.step();
+                    let dr = ch.step()?;
                     acc += dr.accept;
                     zs.push(dr.z);
                 }
-                (zs, acc / s.cycle_draws as f64)
+                Ok((zs, acc / s.cycle_draws as f64))
             })
-            .collect();
+            .collect::<Result<_>>()?;
         // Pooled covariance of the cycle's draws.
         let all: Vec<&Vec<f64>> = runs.iter().flat_map(|r| r.0.iter()).collect();
         let n = all.len() as f64;
@@ -291,12 +265,12 @@ pub(super) fn tune<'a>(
 }
 
 /// Cholesky factor of a covariance, with growing diagonal jitter if it is not positive definite.
-fn factor(sigma: &[f64], d: usize) -> Vec<f64> {
+fn factor(sigma: &[f64], d: usize) -> Cholesky {
     let mut a = sigma.to_vec();
     let mut jitter = 1e-12;
     loop {
         if let Some(c) = Cholesky::new(&a, d) {
-            return c.lower();
+            return c;
         }
         for i in 0..d {
             a[i * d + i] += jitter * (1.0 + sigma[i * d + i]);

@@ -15,11 +15,12 @@ use rand::rngs::StdRng;
 use rand_distr::{Distribution, StandardNormal};
 use rayon::prelude::*;
 
-use super::LogDensity;
-use super::metropolis::chain_rng;
-use super::run::LocalMode;
-use crate::fit::nelder_mead;
-use crate::posterior::Cholesky;
+use super::samples::LocalMode;
+use super::start::chain_rng;
+use super::target::LogDensity;
+use crate::Result;
+use crate::numerics::{Cholesky, nelder_mead};
+use crate::rejection::Latch;
 
 /// Width factor of the mixture components over the Laplace covariance.
 const INFLATE: f64 = 1.5;
@@ -80,15 +81,7 @@ fn laplace_cov(neg_h: &[f64], d: usize) -> Vec<f64> {
         if !a.iter().any(|v| !v.is_finite())
             && let Some(c) = Cholesky::new(&a, d)
         {
-            let mut inv = vec![0.0; d * d];
-            for j in 0..d {
-                let mut e = vec![0.0; d];
-                e[j] = 1.0;
-                let col = c.solve(&e);
-                for i in 0..d {
-                    inv[i * d + j] = col[i];
-                }
-            }
+            let mut inv = c.inverse();
             // Never much wider than the prior's unit scale in z: variances above 4 are scaled
             // down to 4 by D Sigma D with D diagonal (a congruence, so it stays positive
             // definite).
@@ -122,10 +115,12 @@ fn laplace_cov(neg_h: &[f64], d: usize) -> Vec<f64> {
     }
 }
 
-/// Searches for modes from `starts` dispersed points.
-pub(super) fn search(target: &dyn LogDensity, starts: usize, seed: u64) -> Modes {
+/// Searches for modes from `starts` dispersed points. A recoverable model error is a point of
+/// zero density; any other error ends the search and is returned.
+pub(super) fn search(target: &dyn LogDensity, starts: usize, seed: u64) -> Result<Modes> {
     let d = target.dim();
-    let f = |z: &[f64]| target.ln_density(z, None).unwrap_or(f64::NEG_INFINITY);
+    let latch = Latch::default();
+    let f = |z: &[f64]| latch.value(|| target.ln_density(z, None));
     let runs: Vec<(Vec<f64>, f64, u64)> = (0..starts)
         .into_par_iter()
         .filter_map(|s| {
@@ -146,6 +141,7 @@ pub(super) fn search(target: &dyn LogDensity, starts: usize, seed: u64) -> Modes
             Some((z2, l2, 2 * max_evals as u64))
         })
         .collect();
+    latch.check()?;
     let mut evaluations: u64 = runs.iter().map(|r| r.2).sum();
     let mut found: Vec<(Vec<f64>, f64)> = runs
         .into_iter()
@@ -212,7 +208,8 @@ pub(super) fn search(target: &dyn LogDensity, starts: usize, seed: u64) -> Modes
         m.weight /= total;
     }
     modes.sort_by(|a, b| b.weight.total_cmp(&a.weight));
-    Modes { modes, evaluations }
+    latch.check()?;
+    Ok(Modes { modes, evaluations })
 }
 
 impl Modes {

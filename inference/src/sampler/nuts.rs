@@ -11,22 +11,33 @@ use nuts_rs::{
 
 use rand_distr::{Distribution, StandardNormal};
 
-use super::LogDensity;
-use super::metropolis::{chain_rng, start_point};
+use super::engine::{Draw, Engine, Tuned, finish};
 use super::modes::{Modes, search};
-use super::run::{Draw, Engine, Phase, SampleSettings, Samples, Status, Tuned, finish};
+use super::samples::Samples;
+use super::settings::SampleSettings;
+use super::start::{chain_rng, start_point};
+use super::status::{Phase, Status};
+use super::target::LogDensity;
+use crate::rejection::density_or_rejected;
 use crate::{Error, Result};
 
-/// A failed evaluation: a divergence for NUTS, never the end of the run.
+/// A failed evaluation. Recoverable (a rejected point, a non-finite density): a divergence for
+/// NUTS. Otherwise the chain stops and the run returns the error (kept in [`Failure`]).
 #[derive(Debug, thiserror::Error)]
-#[error("{0}")]
-struct Rejected(String);
+#[error("{message}")]
+struct Rejected {
+    message: String,
+    recoverable: bool,
+}
 
 impl LogpError for Rejected {
     fn is_recoverable(&self) -> bool {
-        true
+        self.recoverable
     }
 }
+
+/// The non-recoverable model error that stopped a chain, for the run to return.
+type Failure = Arc<Mutex<Option<Error>>>;
 
 /// Evaluated points of the current draw's trajectory (z, ln p), to give each draw its density
 /// without another evaluation.
@@ -36,6 +47,7 @@ struct Func<'a> {
     target: &'a dyn LogDensity,
     seen: Seen,
     evaluations: Arc<Mutex<u64>>,
+    failure: Failure,
 }
 
 impl HasDims for Func<'_> {
@@ -62,9 +74,23 @@ impl CpuLogpFunc for Func<'_> {
         let lp = self
             .target
             .ln_density(position, Some(gradient))
-            .map_err(|e| Rejected(e.to_string()))?;
+            .map_err(|e| {
+                let rejected = Rejected {
+                    message: e.to_string(),
+                    recoverable: e.is_recoverable(),
+                };
+                if !rejected.recoverable
+                    && let Ok(mut f) = self.failure.lock()
+                {
+                    f.get_or_insert(e);
+                }
+                rejected
+            })?;
         if !lp.is_finite() || gradient.iter().any(|g| !g.is_finite()) {
-            return Err(Rejected("non-finite log density or gradient".into()));
+            return Err(Rejected {
+                message: "non-finite log density or gradient".into(),
+                recoverable: true,
+            });
         }
         self.seen
             .lock()
@@ -85,16 +111,31 @@ impl CpuLogpFunc for Func<'_> {
 struct NutsEngine<'a, C: Chain<CpuMath<Func<'a>>>> {
     chain: C,
     seen: Seen,
+    failure: Failure,
     target: &'a dyn LogDensity,
     step_size: f64,
+}
+
+/// The model's own error when a non-recoverable one stopped the chain, else `fallback`.
+fn failure_or(failure: &Failure, fallback: Error) -> Error {
+    failure
+        .lock()
+        .ok()
+        .and_then(|mut f| f.take())
+        .unwrap_or(fallback)
 }
 
 impl<'a, C: Chain<CpuMath<Func<'a>>>> NutsEngine<'a, C> {
     fn draw(&mut self) -> Result<Draw> {
         self.seen.lock().expect("trajectory").clear();
-        let (z, info) = self.chain.draw().map_err(|e| Error::Numerical {
-            what: "NUTS draw".into(),
-            message: format!("{e:#}"),
+        let (z, info) = self.chain.draw().map_err(|e| {
+            failure_or(
+                &self.failure,
+                Error::Numerical {
+                    what: "NUTS draw".into(),
+                    message: format!("{e:#}"),
+                },
+            )
         })?;
         self.step_size = info.step_size;
         let cached = self
@@ -106,10 +147,7 @@ impl<'a, C: Chain<CpuMath<Func<'a>>>> NutsEngine<'a, C> {
             .map(|(_, l)| *l);
         let ln_density = match cached {
             Some(l) => l,
-            None => self
-                .target
-                .ln_density(&z, None)
-                .unwrap_or(f64::NEG_INFINITY),
+            None => density_or_rejected(self.target.ln_density(&z, None))?,
         };
         Ok(Draw {
             z: z.to_vec(),
@@ -184,6 +222,7 @@ fn worker(
     };
     let mut rng = chain_rng(s.seed, c);
     let seen: Seen = Arc::default();
+    let failure: Failure = Arc::default();
     let setup = || -> Result<_> {
         let z0 = match start {
             Some(z) => z,
@@ -193,13 +232,14 @@ fn worker(
             target,
             seen: seen.clone(),
             evaluations: evaluations.clone(),
+            failure: failure.clone(),
         };
         let mut chain = settings
             .new_chain(c as u64, CpuMath::new(func), &mut rng)
-            .map_err(|e| fail(format!("{e:#}")))?;
+            .map_err(|e| failure_or(&failure, fail(format!("{e:#}"))))?;
         chain
             .set_position(&z0)
-            .map_err(|e| fail(format!("{e:#}")))?;
+            .map_err(|e| failure_or(&failure, fail(format!("{e:#}"))))?;
         Ok(chain)
     };
     let chain = match setup() {
@@ -212,6 +252,7 @@ fn worker(
     let mut engine = NutsEngine {
         chain,
         seen,
+        failure,
         target,
         step_size: 0.0,
     };
@@ -244,7 +285,7 @@ pub(super) fn run(
     // Laplace standard deviation; dispersed prior draws without a search. NUTS does not jump
     // between modes: chains started in different ones make R-hat report it.
     let found = if s.mode_starts > 0 {
-        search(target, s.mode_starts, s.seed)
+        search(target, s.mode_starts, s.seed)?
     } else {
         Modes {
             modes: Vec::new(),

@@ -4,7 +4,8 @@ use rand::Rng;
 use rand_distr::{Distribution, StandardNormal};
 
 use crate::Result;
-use crate::posterior::{Cholesky, Posterior};
+use crate::numerics::Cholesky;
+use crate::posterior::Posterior;
 
 /// A log density on an unconstrained R^d, with the map to the reported parameters.
 pub trait LogDensity: Sync {

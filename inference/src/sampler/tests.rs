@@ -162,3 +162,164 @@ fn nuts_reports_modes_it_cannot_cross() {
     assert!(!r.converged());
     assert!(r.diagnostics[0].rhat > 1.1, "{:?}", r.diagnostics);
 }
+
+/// How [`Failing`] fails.
+#[derive(Clone, Copy)]
+enum Failure {
+    /// Outside the model's domain (recoverable: a rejected point).
+    OutsideDomain,
+    /// A file that cannot be read (not recoverable: the run ends).
+    Io,
+}
+
+/// c_k = 50 + 100 a + 20 b k on five voltages; it fails where a > 0.35, or on every evaluation
+/// after the first `after`.
+struct Failing {
+    volts: Vec<f64>,
+    failure: Failure,
+    after: usize,
+    calls: std::sync::atomic::AtomicUsize,
+}
+
+impl Failing {
+    fn new(failure: Failure, after: usize) -> Self {
+        Self {
+            volts: vec![100.0, 200.0, 300.0, 400.0, 500.0],
+            failure,
+            after,
+            calls: Default::default(),
+        }
+    }
+
+    fn check(&self, x: &[f64]) -> crate::Result<()> {
+        let n = self
+            .calls
+            .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        if x[0] <= 0.35 && n < self.after {
+            return Ok(());
+        }
+        Err(match self.failure {
+            Failure::OutsideDomain => {
+                crate::Error::Surrogate(hpge_surrogate::Error::OutsideDomain {
+                    name: "a".into(),
+                    value: x[0],
+                    lo: 0.0,
+                    hi: 0.35,
+                })
+            }
+            Failure::Io => crate::Error::Io {
+                file: "model.safetensors".into(),
+                action: "cannot read the file",
+                source: std::io::Error::other("the disk is gone"),
+            },
+        })
+    }
+}
+
+impl crate::model::CvModel for Failing {
+    fn inputs(&self) -> Vec<String> {
+        vec!["a".into(), "b".into()]
+    }
+    fn domain(&self) -> Vec<[f64; 2]> {
+        vec![[0.0, 1.0]; 2]
+    }
+    fn voltages(&self) -> &[f64] {
+        &self.volts
+    }
+    fn sigma_rel(&self) -> f64 {
+        0.0
+    }
+    fn curve(&self, x: &[f64], c: &mut [f64]) -> crate::Result<()> {
+        self.check(x)?;
+        for (k, ck) in c.iter_mut().enumerate() {
+            *ck = 50.0 + 100.0 * x[0] + 20.0 * x[1] * k as f64;
+        }
+        Ok(())
+    }
+    fn has_jacobian(&self) -> bool {
+        true
+    }
+    fn curve_jacobian(&self, x: &[f64], c: &mut [f64], jac: &mut [f64]) -> crate::Result<()> {
+        self.curve(x, c)?;
+        for k in 0..c.len() {
+            jac[2 * k] = 100.0;
+            jac[2 * k + 1] = 20.0 * k as f64;
+        }
+        Ok(())
+    }
+    fn describe(&self) -> String {
+        "failing stub".into()
+    }
+}
+
+/// Samples the stub's posterior (data at a = 0.3, b = 0.6) with `settings`.
+fn sample_failing(model: &Failing, settings: &SampleSettings) -> crate::Result<Samples> {
+    use crate::posterior::{Likelihood, NoiseSettings, Posterior};
+    use crate::prior::{Prior, PriorSpec};
+    let spec = PriorSpec::from_toml_str(
+        r#"
+name = "stub"
+[[parameters]]
+name = "a"
+prior = { distribution = "uniform", lo = 0.0, hi = 1.0 }
+[[parameters]]
+name = "b"
+prior = { distribution = "uniform", lo = 0.0, hi = 1.0 }
+"#,
+        std::path::Path::new("stub.toml"),
+    )?;
+    let prior = Prior::bind(&spec, &model.inputs(), &model.domain())?;
+    let c12_pf: Vec<f64> = (0..5).map(|k| 80.0 + 12.0 * k as f64).collect();
+    let data = crate::CvData {
+        voltage_v: model.volts.clone(),
+        sigma_pf: c12_pf.iter().map(|c| 0.01 * c).collect(),
+        c12_pf,
+        covariance_pf2: None,
+        source: "stub.csv".into(),
+    };
+    let likelihood = Likelihood::new(&data, NoiseSettings::default(), 0.0)?;
+    let posterior = Posterior::new(model, &prior, &likelihood)?;
+    sample(&posterior, settings, &|_| {})
+}
+
+use crate::model::CvModel as _;
+
+#[test]
+fn a_recoverable_model_error_is_a_rejected_point() {
+    for kind in [SamplerKind::Metropolis, SamplerKind::Nuts] {
+        let s = SampleSettings {
+            ess_min: 200.0,
+            seed: 5,
+            ..SampleSettings::for_sampler(kind)
+        };
+        let model = Failing::new(Failure::OutsideDomain, usize::MAX);
+        let r = sample_failing(&model, &s).expect("the failures are rejected points");
+        let all = r.all();
+        assert!(!all.is_empty());
+        assert!(
+            all.iter().all(|t| t[0] <= 0.35),
+            "{kind:?}: a draw beyond the failure"
+        );
+    }
+}
+
+#[test]
+fn any_other_model_error_ends_the_run() {
+    for kind in [SamplerKind::Metropolis, SamplerKind::Nuts] {
+        // In the mode search, in the starting points, and while the chains draw.
+        for (mode_starts, after) in [(24, 100), (0, 0), (0, 3000)] {
+            let s = SampleSettings {
+                ess_min: 200.0,
+                mode_starts,
+                ..SampleSettings::for_sampler(kind)
+            };
+            let model = Failing::new(Failure::Io, after);
+            let e = sample_failing(&model, &s).expect_err("an I/O error ends the run");
+            assert!(
+                matches!(e, crate::Error::Io { .. }),
+                "{kind:?}, {mode_starts} starts, after {after}: {e}"
+            );
+            assert!(e.to_string().contains("the disk is gone"), "{e}");
+        }
+    }
+}

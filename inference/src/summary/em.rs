@@ -5,7 +5,7 @@
 use rand::RngExt;
 use rand::rngs::StdRng;
 
-use super::mixture::Component;
+use super::component::Component;
 
 /// Convergence: change of the mean log-likelihood per point between EM iterations.
 const TOLERANCE: f64 = 1e-6;

@@ -6,18 +6,8 @@ use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
 use rayon::prelude::*;
 
+use super::component::Component;
 use super::em::{Prepared, em, kmeans_pp, moments};
-
-/// One Gaussian component of a [`Mixture`].
-#[derive(Debug, Clone, PartialEq)]
-pub struct Component {
-    /// Mixing weight (the weights of a mixture sum to 1).
-    pub weight: f64,
-    /// Mean vector, length `d`.
-    pub mean: Vec<f64>,
-    /// Covariance matrix, row-major `d x d`.
-    pub cov: Vec<f64>,
-}
 
 /// A Gaussian mixture `p(x) = sum_c w_c N(x | mu_c, Sigma_c)`.
 #[derive(Debug, Clone, PartialEq)]

@@ -1,10 +1,12 @@
 //! Posterior summaries: smallest intervals, marginal modes, mixtures over draws (modes), Pareto-k.
 
+mod component;
 mod em;
 mod intervals;
 mod mixture;
 mod pareto;
 
+pub use component::Component;
 pub use intervals::{interval_contains, marginal_mode, smallest_intervals};
-pub use mixture::{Component, Mixture, find_modes, fit_mixture};
+pub use mixture::{Mixture, find_modes, fit_mixture};
 pub use pareto::{Psis, gpd_fit, psis};

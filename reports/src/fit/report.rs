@@ -107,9 +107,13 @@ pub fn write_report(
     let _ = writeln!(r, "|---|---|---|---|---|---|---|---|---|---|---|");
     for p in &sm.parameters {
         let prior = match p.prior {
-            hpge_inference::PriorDistribution::Uniform { lo, hi } => format!("U({lo}, {hi})"),
-            hpge_inference::PriorDistribution::Normal { mean, sd } => format!("N({mean}, {sd})"),
-            hpge_inference::PriorDistribution::TruncatedNormal { mean, sd, .. } => {
+            hpge_inference::prior::PriorDistribution::Uniform { lo, hi } => {
+                format!("U({lo}, {hi})")
+            }
+            hpge_inference::prior::PriorDistribution::Normal { mean, sd } => {
+                format!("N({mean}, {sd})")
+            }
+            hpge_inference::prior::PriorDistribution::TruncatedNormal { mean, sd, .. } => {
                 format!(
                     "N_t({mean}, {sd}) on [{:.4}, {}]",
                     p.support[0], p.support[1]

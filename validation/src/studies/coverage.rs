@@ -8,10 +8,9 @@
 
 use std::time::Instant;
 
-use hpge_inference::{
-    CvModel, FitSettings, Likelihood, Posterior, Prior, draw_range, fit, interval_contains,
-    smallest_intervals,
-};
+use hpge_inference::fit::draw_range;
+use hpge_inference::summary::{interval_contains, smallest_intervals};
+use hpge_inference::{CvModel, FitSettings, Likelihood, Posterior, Prior, fit};
 use rand::RngExt;
 use rand::SeedableRng;
 use rand::rngs::StdRng;
@@ -207,9 +206,14 @@ pub fn coverage(
                     n,
                 )
             };
-            if data_model.curve(&x, &mut c).is_err() {
-                tick();
-                return Ok(None);
+            // A truth whose curve fails recoverably is skipped; any other error ends the study.
+            match data_model.curve(&x, &mut c) {
+                Ok(()) => {}
+                Err(e) if e.is_recoverable() => {
+                    tick();
+                    return Ok(None);
+                }
+                Err(e) => return Err(e.into()),
             }
             let c_m = template
                 .with_sigma_rel(data_sigma_rel)

@@ -14,9 +14,10 @@ use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Instant;
 
+use hpge_inference::discover::{Baseline, ExtensionPredictor, catalogue};
 use hpge_inference::{
-    Baseline, CvData, CvModel, DiscoverInputs, DiscoverSettings, Discovery, ExactModel, Likelihood,
-    NoiseSettings, Prior, PriorSpec, Progress, catalogue, discover,
+    CvData, CvModel, DiscoverInputs, DiscoverSettings, Discovery, ExactModel, Likelihood,
+    NoiseSettings, Prior, PriorSpec, Progress, discover,
 };
 use hpge_surrogate::ExactSolver;
 use rand::SeedableRng;
@@ -170,10 +171,10 @@ pub fn hidden_curve(
             spec: start,
             mode: &theta0,
             model,
-            predictor: hpge_inference::Predictor::Exact,
+            predictor: ExtensionPredictor::Exact,
             exact,
         };
-        let c = ext.build(&base).map_err(argument)?;
+        let c = ext.build(&base).map_err(|e| argument(e.to_string()))?;
         (c.model, c.spec, c.start)
     };
     for (name, v) in &h.truth {

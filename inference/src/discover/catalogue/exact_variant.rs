@@ -1,21 +1,23 @@
-//! The exact field solver with effects outside the surrogate's space: the space's inputs set on
-//! the detector as usual ([`ExactSolver::detector`]), then the extension's own inputs applied to
-//! the built detector (its impurity model, a contact's geometry) before the C-V curve is solved.
+//! The exact field solver with effects outside the surrogate's space: the exact model's inputs
+//! set on the detector as usual ([`ExactSolver::detector`]), then the extension's own inputs
+//! applied to the built detector (its impurity model, a contact's geometry) before the C-V curve
+//! is solved.
 
 use hpge_solver::{Detector, cv_curve};
 use hpge_surrogate::ExactSolver;
 
-use crate::model::{CvModel, check_domain};
+use crate::model::{CvModel, ExactModel, check_domain};
 use crate::{Error, Result};
 
 /// Applies an extension's values (`extra`, in the order of [`ExactVariant`]'s added inputs) to a
-/// detector built at the space's values; an error names what cannot be built.
-pub type Modifier = fn(&mut Detector, &[f64]) -> std::result::Result<(), String>;
+/// detector built at the space's values; an error ([`Error::Extension`], a rejected point for
+/// a sampler) names what cannot be built.
+pub type Modifier = fn(&mut Detector, &[f64]) -> Result<()>;
 
-/// The exact solver with added inputs.
+/// The exact model ([`ExactModel`]) with added inputs.
 pub struct ExactVariant {
-    solver: ExactSolver,
-    volts: Vec<f64>,
+    /// The exact solver on the space's inputs, bound to the voltages.
+    base: ExactModel,
     names: Vec<String>,
     domain: Vec<[f64; 2]>,
     n_space: usize,
@@ -33,7 +35,7 @@ impl ExactVariant {
         modify: Modifier,
         label: &str,
     ) -> Result<Self> {
-        let base = crate::ExactModel::new(solver.clone(), volts)?;
+        let base = ExactModel::new(solver.clone(), volts)?;
         let mut names = base.inputs();
         let mut domain = base.domain();
         let n_space = names.len();
@@ -42,8 +44,7 @@ impl ExactVariant {
             domain.push(*r);
         }
         Ok(Self {
-            solver: solver.clone(),
-            volts: volts.to_vec(),
+            base,
             names,
             domain,
             n_space,
@@ -54,11 +55,8 @@ impl ExactVariant {
 
     /// The detector at inputs `x` (space values, then the extension's).
     pub fn detector(&self, x: &[f64]) -> Result<Detector> {
-        let mut det = self.solver.detector(&x[..self.n_space])?;
-        (self.modify)(&mut det, &x[self.n_space..]).map_err(|message| Error::Argument {
-            name: self.label.clone(),
-            message,
-        })?;
+        let mut det = self.base.solver.detector(&x[..self.n_space])?;
+        (self.modify)(&mut det, &x[self.n_space..])?;
         Ok(det)
     }
 }
@@ -73,18 +71,18 @@ impl CvModel for ExactVariant {
     }
 
     fn voltages(&self) -> &[f64] {
-        &self.volts
+        self.base.voltages()
     }
 
     fn sigma_rel(&self) -> f64 {
-        0.0
+        self.base.sigma_rel()
     }
 
     /// c12 (pF) from the field solver ([`cv_curve`]) on the modified detector.
     fn curve(&self, x: &[f64], c_pf: &mut [f64]) -> Result<()> {
         check_domain(&self.names, &self.domain, x)?;
         let det = self.detector(x)?;
-        let curve = cv_curve(&det, &self.volts, &self.solver.settings, |_, _| {})
+        let curve = cv_curve(&det, self.voltages(), &self.base.solver.settings, |_, _| {})
             .map_err(|e| Error::Surrogate(e.into()))?;
         for (c, p) in c_pf.iter_mut().zip(&curve.points) {
             *c = p.c12_pf;
@@ -104,10 +102,6 @@ impl CvModel for ExactVariant {
     }
 
     fn describe(&self) -> String {
-        format!(
-            "exact solver ({}) with {}",
-            self.solver.detector_file.display(),
-            self.label
-        )
+        format!("{} with {}", self.base.describe(), self.label)
     }
 }

@@ -10,8 +10,9 @@ use hpge_solver::detector::ContactPotential;
 use hpge_solver::geometry::{Primitive, Solid};
 
 use super::quadratic_z::base_inputs;
-use super::{Baseline, Candidate, ExactVariant, Extension, Predictor, one_more};
+use super::{Baseline, Candidate, ExactVariant, Extension, ExtensionPredictor, one_more};
 use crate::prior::PriorDistribution;
+use crate::{Error, Result};
 
 /// Domain of s, mm.
 pub const SLOPE_RANGE_MM: [f64; 2] = [-4.0, 4.0];
@@ -19,12 +20,22 @@ pub const SLOPE_RANGE_MM: [f64; 2] = [-4.0, 4.0];
 pub const SLOPE_PRIOR_SD_MM: f64 = 1.0;
 /// The thinnest layer allowed anywhere, mm.
 const MIN_THICKNESS_MM: f64 = 0.05;
+/// The effect, in words (names it in errors and descriptions).
+const LABEL: &str = "a Li thickness slope";
+
+/// The error of a slope that cannot be applied.
+fn cannot(message: String) -> Error {
+    Error::Extension {
+        extension: LABEL.into(),
+        message,
+    }
+}
 
 /// Replaces the bias contact's tube r in [r_in, r_in + d] by a layer of thickness
 /// d + s (t - 1/2): the cone with those radii, keeping the tube's rounded ends (within the
 /// rounding radius of each end the layer keeps at least the tube's shape). s = 0 leaves the
 /// contact unchanged.
-fn set_slope(det: &mut Detector, extra: &[f64]) -> Result<(), String> {
+fn set_slope(det: &mut Detector, extra: &[f64]) -> Result<()> {
     let s = extra[0];
     let mut found = false;
     for c in det.contacts.iter_mut() {
@@ -39,16 +50,16 @@ fn set_slope(det: &mut Detector, extra: &[f64]) -> Result<(), String> {
             round_outer_mm,
         }) = c.geometry.clone()
         else {
-            return Err(format!(
+            return Err(cannot(format!(
                 "contact {} is not a single tube: the Li thickness slope needs a tube-shaped n+ layer",
                 c.label()
-            ));
+            )));
         };
         let d = r_out_mm - r_in_mm;
         if d - 0.5 * s.abs() < MIN_THICKNESS_MM {
-            return Err(format!(
+            return Err(cannot(format!(
                 "a slope of {s} mm on a {d} mm layer leaves less than {MIN_THICKNESS_MM} mm"
-            ));
+            )));
         }
         if s == 0.0 {
             found = true;
@@ -86,7 +97,9 @@ fn set_slope(det: &mut Detector, extra: &[f64]) -> Result<(), String> {
     if found {
         Ok(())
     } else {
-        Err("the detector has no contact at the bias potential (the n+ layer)".into())
+        Err(cannot(
+            "the detector has no contact at the bias potential (the n+ layer)".into(),
+        ))
     }
 }
 
@@ -107,23 +120,22 @@ impl Extension for LiSlope {
          little at low voltage"
     }
 
-    fn build(&self, base: &Baseline) -> std::result::Result<Candidate, String> {
+    fn build(&self, base: &Baseline) -> Result<Candidate> {
         let volts = base.model.voltages();
         let model = ExactVariant::new(
             base.exact,
             volts,
             &[("d_li_slope_mm", SLOPE_RANGE_MM)],
             set_slope,
-            "a Li thickness slope",
-        )
-        .map_err(|e| e.to_string())?;
+            LABEL,
+        )?;
         let mut x = base_inputs(base)?;
         x.push(0.1);
-        model.detector(&x).map_err(|e| e.to_string())?;
+        model.detector(&x)?;
         Ok(one_more(
             self,
             base,
-            Predictor::Exact,
+            ExtensionPredictor::Exact,
             Arc::new(model),
             (
                 "d_li_slope_mm",

@@ -6,7 +6,7 @@
 //! An entry builds a [`Candidate`]: a [`CvModel`] whose inputs are the start model's plus the
 //! effect's, and a prior spec that contains the start model's parameters (the start model is the
 //! candidate at the effect's null value, so the two nest). Entries that need predictions the
-//! surrogate was not trained for run on the exact field solver ([`Predictor::Exact`]).
+//! surrogate was not trained for run on the exact field solver ([`ExtensionPredictor::Exact`]).
 
 mod affine;
 mod exact_variant;
@@ -22,32 +22,33 @@ use hpge_surrogate::ExactSolver;
 use serde::Serialize;
 
 pub use affine::{Affine, AffineKind, Scaled, Shifted};
-pub use exact_variant::ExactVariant;
+pub use exact_variant::{ExactVariant, Modifier};
 pub use li_slope::LiSlope;
 pub use quadratic_z::QuadraticZ;
 pub use radial::Radial;
 pub use scale::CalibrationScale;
 pub use stray::StrayCapacitance;
 
+use crate::Result;
 use crate::model::CvModel;
 use crate::prior::{ParameterSpec, PriorDistribution, PriorSpec};
 
 /// What computes a candidate's curves.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
-pub enum Predictor {
+pub enum ExtensionPredictor {
     /// The trained surrogate (the effect is in its space, or acts on its output).
     Surrogate,
     /// The exact field solver (the effect is outside the surrogate's space).
     Exact,
 }
 
-impl Predictor {
+impl ExtensionPredictor {
     /// `surrogate` or `exact`.
     pub fn as_str(&self) -> &'static str {
         match self {
-            Predictor::Surrogate => "surrogate",
-            Predictor::Exact => "exact",
+            ExtensionPredictor::Surrogate => "surrogate",
+            ExtensionPredictor::Exact => "exact",
         }
     }
 }
@@ -63,7 +64,7 @@ pub struct Baseline<'a> {
     /// runs on the exact solver).
     pub model: Arc<dyn CvModel>,
     /// Which of the two `model` is.
-    pub predictor: Predictor,
+    pub predictor: ExtensionPredictor,
     /// The exact solver on the surrogate's space and detector.
     pub exact: &'a ExactSolver,
 }
@@ -78,7 +79,7 @@ pub struct Candidate {
     /// The residual signature it explains.
     pub signature: String,
     /// What computes its curves.
-    pub predictor: Predictor,
+    pub predictor: ExtensionPredictor,
     /// The extended model.
     pub model: Arc<dyn CvModel>,
     /// Its prior: the start model's parameters (possibly split) and the added ones.
@@ -97,8 +98,9 @@ pub trait Extension: Send + Sync {
     fn description(&self) -> &'static str;
     /// The residual pattern the effect leaves when the start model lacks it.
     fn signature(&self) -> &'static str;
-    /// The extended model, or why the entry does not apply to this start model or detector.
-    fn build(&self, base: &Baseline) -> std::result::Result<Candidate, String>;
+    /// The extended model, or why the entry does not apply to this start model or detector
+    /// (its text is the report's reason).
+    fn build(&self, base: &Baseline) -> Result<Candidate>;
 }
 
 /// Every entry, in a fixed order (the report lists them this way).
@@ -136,7 +138,7 @@ pub(crate) fn with_parameter(
 pub(crate) fn one_more(
     ext: &dyn Extension,
     base: &Baseline,
-    predictor: Predictor,
+    predictor: ExtensionPredictor,
     model: Arc<dyn CvModel>,
     parameter: (&str, &str, &str, PriorDistribution),
     null: f64,

@@ -8,26 +8,33 @@ use std::sync::Arc;
 
 use hpge_solver::Detector;
 
-use super::{Baseline, Candidate, ExactVariant, Extension, Predictor, one_more};
-use crate::prior::PriorDistribution;
+use super::{Baseline, Candidate, ExactVariant, Extension, ExtensionPredictor, one_more};
+use crate::prior::{Prior, PriorDistribution};
+use crate::{Error, Result};
 
 /// Domain of y_quad.
 pub const QUAD_RANGE: [f64; 2] = [-0.5, 0.5];
 /// Prior sd of y_quad: 0.15 in y is a factor of ~3 in density at mid-height.
 pub const QUAD_PRIOR_SD: f64 = 0.15;
+/// The effect, in words (names it in errors and descriptions).
+const LABEL: &str = "a quadratic z term y_quad";
 
 /// Sets y_quad on the detector's rz impurity model.
-fn set_quadratic(det: &mut Detector, extra: &[f64]) -> Result<(), String> {
+fn set_quadratic(det: &mut Detector, extra: &[f64]) -> Result<()> {
+    let cannot = |message: String| Error::Extension {
+        extension: LABEL.into(),
+        message,
+    };
     let mut spec = det.semiconductor.impurity_spec().clone();
     if spec.model.as_str() != "rz" {
-        return Err(format!(
+        return Err(cannot(format!(
             "the quadratic z term needs the rz impurity model, the detector has `{}`",
             spec.model.as_str()
-        ));
+        )));
     }
     spec.y_quad = Some(extra[0]);
     det.set_impurity(&spec, Path::new("(quadratic-z extension)"))
-        .map_err(|e| e.to_string())
+        .map_err(|e| cannot(e.to_string()))
 }
 
 /// The catalogue entry.
@@ -47,24 +54,22 @@ impl Extension for QuadraticZ {
          middle height; faces and full depletion fit"
     }
 
-    fn build(&self, base: &Baseline) -> std::result::Result<Candidate, String> {
+    fn build(&self, base: &Baseline) -> Result<Candidate> {
         let volts = base.model.voltages();
         let model = ExactVariant::new(
             base.exact,
             volts,
             &[("y_quad", QUAD_RANGE)],
             set_quadratic,
-            "a quadratic z term y_quad",
-        )
-        .map_err(|e| e.to_string())?;
-        let x0 = base_inputs(base)?;
-        let mut x = x0.clone();
+            LABEL,
+        )?;
+        let mut x = base_inputs(base)?;
         x.push(0.0);
-        model.detector(&x).map_err(|e| e.to_string())?;
+        model.detector(&x)?;
         Ok(one_more(
             self,
             base,
-            Predictor::Exact,
+            ExtensionPredictor::Exact,
             Arc::new(model),
             (
                 "y_quad",
@@ -83,10 +88,9 @@ impl Extension for QuadraticZ {
 }
 
 /// The start mode as model inputs of the surrogate's space (for a dry run of a modifier).
-pub(super) fn base_inputs(base: &Baseline) -> std::result::Result<Vec<f64>, String> {
+pub(super) fn base_inputs(base: &Baseline) -> Result<Vec<f64>> {
     let names = base.model.inputs();
-    let prior =
-        crate::Prior::bind(base.spec, &names, &base.model.domain()).map_err(|e| e.to_string())?;
+    let prior = Prior::bind(base.spec, &names, &base.model.domain())?;
     let mut x = vec![0.0; names.len()];
     prior.expand(base.mode, &mut x);
     Ok(x)

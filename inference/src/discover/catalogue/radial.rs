@@ -5,6 +5,7 @@
 
 use super::{Baseline, Candidate, Extension};
 use crate::prior::{ParameterSpec, PriorDistribution, PriorSpec};
+use crate::{Error, Result};
 
 /// Prior sd of each freed knot's y around the start model's shared value: 0.5 in y is a factor
 /// of ~10^1.5 in density near 1e10 cm^-3, and reaches a p-type mantle layer (the paper's mantle
@@ -33,7 +34,7 @@ impl Extension for Radial {
          and c12 probes the outer radii; a good fit near full depletion"
     }
 
-    fn build(&self, base: &Baseline) -> std::result::Result<Candidate, String> {
+    fn build(&self, base: &Baseline) -> Result<Candidate> {
         let mut parameters = Vec::new();
         let mut start = Vec::new();
         let mut added = Vec::new();
@@ -62,10 +63,13 @@ impl Extension for Radial {
             }
         }
         if added.is_empty() {
-            return Err(format!(
-                "the start model {} ties no y knots together: zeta already depends on r",
-                base.spec.name
-            ));
+            return Err(Error::NotApplicable {
+                extension: self.name().into(),
+                reason: format!(
+                    "the start model {} ties no y knots together: zeta already depends on r",
+                    base.spec.name
+                ),
+            });
         }
         let mut spec = base.spec.clone();
         spec.name = format!("{}+radial", base.spec.name);

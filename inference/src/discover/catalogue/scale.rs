@@ -4,6 +4,7 @@
 use std::sync::Arc;
 
 use super::{Affine, Baseline, Candidate, Extension, one_more};
+use crate::Result;
 use crate::prior::PriorDistribution;
 
 /// Domain of s.
@@ -28,7 +29,7 @@ impl Extension for CalibrationScale {
         "the same relative residual at every voltage, below and above full depletion"
     }
 
-    fn build(&self, base: &Baseline) -> std::result::Result<Candidate, String> {
+    fn build(&self, base: &Baseline) -> Result<Candidate> {
         let model = Affine::scale(base.model.clone(), "cal_scale", SCALE_RANGE);
         Ok(one_more(
             self,

@@ -4,6 +4,7 @@
 use std::sync::Arc;
 
 use super::{Affine, Baseline, Candidate, Extension, one_more};
+use crate::Result;
 use crate::prior::PriorDistribution;
 
 /// Domain of c_s, pF.
@@ -28,7 +29,7 @@ impl Extension for StrayCapacitance {
          towards full depletion where c12 is smallest, flat beyond it"
     }
 
-    fn build(&self, base: &Baseline) -> std::result::Result<Candidate, String> {
+    fn build(&self, base: &Baseline) -> Result<Candidate> {
         let model = Affine::shift(base.model.clone(), "c_stray_pf", STRAY_RANGE_PF);
         Ok(one_more(
             self,

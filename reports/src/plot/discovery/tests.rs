@@ -2,9 +2,9 @@
 
 use std::collections::BTreeMap;
 
-use hpge_inference::{
-    Disagreement, DiscoverSettings, DiscoverySummary, Elpd, Gap, ModelFit, Region, ResidualCheck,
-    Window,
+use hpge_inference::DiscoverSettings;
+use hpge_inference::discover::{
+    Disagreement, DiscoverySummary, Elpd, Gap, ModelFit, ProbedRegion, ResidualCheck, Window,
 };
 
 use super::layout::*;
@@ -100,7 +100,7 @@ fn model_fit(model: &str, residuals: Vec<f64>) -> ModelFit {
     }
 }
 
-fn window(v: &[f64], lo: f64, hi: f64, p: f64, region: Option<Region>) -> Disagreement {
+fn window(v: &[f64], lo: f64, hi: f64, p: f64, region: Option<ProbedRegion>) -> Disagreement {
     let first = v.iter().position(|&x| x == lo).unwrap();
     let last = v.iter().position(|&x| x == hi).unwrap();
     Disagreement {
@@ -136,7 +136,7 @@ fn synthetic(extended: bool) -> Discovery {
         })
         .collect();
     let after: Vec<f64> = (0..v.len()).map(|k| wiggle(k, 0.7)).collect();
-    let region = |r: [f64; 2], z: [f64; 2]| Region {
+    let region = |r: [f64; 2], z: [f64; 2]| ProbedRegion {
         r_mm: r,
         z_mm: z,
         nodes: 100,

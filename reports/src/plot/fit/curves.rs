@@ -1,7 +1,7 @@
 //! Figures against a coordinate: the posterior predictive against the bias and zeta at the
 //! global mode along z and r.
 
-use hpge_inference::{LEVELS, Predictive};
+use hpge_inference::fit::{LEVELS, Predictive};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 

@@ -1,7 +1,7 @@
 //! What the figures of a fit share: the grid of panels, axis labels and ranges, the interval
 //! colours and the legend strip above the panels.
 
-use hpge_inference::ParameterSummary;
+use hpge_inference::fit::ParameterSummary;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};

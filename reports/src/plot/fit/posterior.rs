@@ -1,6 +1,7 @@
 //! Figures of the draws: marginals, 2D marginals of pairs, traces.
 
-use hpge_inference::{Fit, LEVELS, ParameterSummary};
+use hpge_inference::Fit;
+use hpge_inference::fit::{LEVELS, ParameterSummary};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 

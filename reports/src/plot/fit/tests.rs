@@ -2,10 +2,12 @@
 
 use std::collections::BTreeMap;
 
-use hpge_inference::{
-    ChainDraws, Diagnostics, FitSummary, LEVELS, NoiseSettings, ParameterSummary, Predictive,
-    PriorDistribution, SampleSettings, Samples, StopReason, marginal_mode, smallest_intervals,
-};
+use hpge_inference::diagnostics::Diagnostics;
+use hpge_inference::fit::{FitSummary, LEVELS, ParameterSummary, Predictive};
+use hpge_inference::prior::PriorDistribution;
+use hpge_inference::sampler::{ChainDraws, SamplerStop, Samples};
+use hpge_inference::summary::{marginal_mode, smallest_intervals};
+use hpge_inference::{NoiseSettings, SampleSettings};
 
 use super::*;
 
@@ -85,7 +87,7 @@ fn synthetic_fit(d: usize, chains: usize) -> Fit {
         settings: SampleSettings::default(),
         chains,
         diagnostics,
-        stop: StopReason::Converged,
+        stop: SamplerStop::Converged,
         tuned: true,
         cycles: 3,
         local_modes: Vec::new(),
@@ -147,7 +149,7 @@ fn synthetic_fit(d: usize, chains: usize) -> Fit {
         inputs: BTreeMap::new(),
         likelihood: NoiseSettings::default(),
         settings: SampleSettings::default(),
-        stop: StopReason::Converged,
+        stop: SamplerStop::Converged,
         tuned: true,
         tuning_cycles: 3,
         tuning_seconds: 1.0,

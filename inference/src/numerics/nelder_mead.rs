@@ -1,6 +1,7 @@
 //! A small Nelder-Mead simplex maximiser (Nelder & Mead 1965, with the standard coefficients
-//! 1, 2, 1/2, 1/2): refines the best draw to the global mode. Written by hand: a few hundred
-//! evaluations of a cheap function, no bounds (the samplers' unconstrained coordinates).
+//! 1, 2, 1/2, 1/2): the samplers' mode search, and the refinement of a fit's best draw to the
+//! global mode. Written by hand: a few hundred evaluations of a cheap function, no bounds (the
+//! samplers' unconstrained coordinates).
 
 /// Maximises `f` from `x0` with initial steps `step`; stops after `max_evals` evaluations or when
 /// the simplex's values agree within `tol`. Returns (x, f(x)).

@@ -1,0 +1,145 @@
+//! What a sampling run is asked to do: the sampler, chains, seed, convergence targets and
+//! budgets.
+
+use serde::{Deserialize, Serialize};
+
+use crate::{Error, Result};
+
+/// Which sampler (a closed set).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum SamplerKind {
+    /// Adaptive Metropolis (BAT.jl's default): multivariate-normal proposals whose covariance
+    /// and scale are tuned in cycles.
+    #[default]
+    Metropolis,
+    /// The No-U-Turn sampler (nuts-rs) with the model's gradient.
+    Nuts,
+}
+
+impl SamplerKind {
+    /// Parses `metropolis` (or `mh`) or `nuts`.
+    pub fn parse(s: &str) -> Option<Self> {
+        match s {
+            "metropolis" | "mh" | "am" => Some(SamplerKind::Metropolis),
+            "nuts" => Some(SamplerKind::Nuts),
+            _ => None,
+        }
+    }
+
+    /// The name.
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            SamplerKind::Metropolis => "metropolis",
+            SamplerKind::Nuts => "nuts",
+        }
+    }
+}
+
+/// Sampling settings. Defaults: 4 chains (the paper's BAT.jl run), BAT.jl's acceptance window
+/// [0.15, 0.35] and burn-in criterion R-hat <= 1.1, then sampling on to the stricter R-hat <= 1.01
+/// and ESS >= 1000 of Vehtari et al. (2021).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SampleSettings {
+    /// The sampler.
+    pub sampler: SamplerKind,
+    /// Chains (>= 2), run in parallel.
+    pub chains: usize,
+    /// Seed of everything random.
+    pub seed: u64,
+    /// Target R-hat for the whole run.
+    pub rhat_max: f64,
+    /// Target bulk and tail ESS (each parameter).
+    pub ess_min: f64,
+    /// Metropolis: draws per chain per tuning cycle.
+    pub cycle_draws: usize,
+    /// Metropolis: most tuning cycles.
+    pub max_cycles: usize,
+    /// Metropolis: the acceptance window of the tuning (BAT.jl: [0.15, 0.35]).
+    pub acceptance: [f64; 2],
+    /// Metropolis: burn-in ends when R-hat over the last two cycles is below this (BAT.jl: 1.1).
+    pub burnin_rhat: f64,
+    /// Nelder-Mead starts of the mode search before tuning (0: no search; chains then start at
+    /// dispersed prior draws). Metropolis starts chains in the modes found and jumps between
+    /// them; NUTS starts chains in the modes of weight >= 1%.
+    pub mode_starts: usize,
+    /// NUTS: tuning draws per chain.
+    pub nuts_tune: usize,
+    /// NUTS: maximum tree depth.
+    pub nuts_max_depth: u64,
+    /// Draws per chain between convergence checks.
+    pub batch_draws: usize,
+    /// Keep every `thin`-th draw.
+    pub thin: usize,
+    /// Most kept draws per chain.
+    pub max_draws: usize,
+    /// Stop sampling (not tuning) after this many seconds.
+    pub max_seconds: f64,
+}
+
+impl Default for SampleSettings {
+    fn default() -> Self {
+        Self::for_sampler(SamplerKind::Metropolis)
+    }
+}
+
+impl SampleSettings {
+    /// The defaults of one sampler.
+    pub fn for_sampler(sampler: SamplerKind) -> Self {
+        let metropolis = sampler == SamplerKind::Metropolis;
+        Self {
+            sampler,
+            chains: 4,
+            seed: 0,
+            rhat_max: 1.01,
+            ess_min: 1000.0,
+            cycle_draws: 1000,
+            max_cycles: 40,
+            acceptance: [0.15, 0.35],
+            burnin_rhat: 1.1,
+            mode_starts: 24,
+            nuts_tune: 600,
+            nuts_max_depth: 8,
+            batch_draws: if metropolis { 2000 } else { 200 },
+            thin: if metropolis { 4 } else { 1 },
+            max_draws: 100_000,
+            max_seconds: 600.0,
+        }
+    }
+
+    /// Checks the values.
+    pub fn validate(&self) -> Result<()> {
+        let bad = |name: &str, message: String| {
+            Err(Error::Argument {
+                name: name.into(),
+                message,
+            })
+        };
+        if self.chains < 2 {
+            return bad(
+                "chains",
+                format!("need at least 2 chains for R-hat, got {}", self.chains),
+            );
+        }
+        if !(self.rhat_max > 1.0 && self.burnin_rhat > 1.0) {
+            return bad("rhat_max", "R-hat targets must exceed 1".into());
+        }
+        if !(self.acceptance[0] > 0.0
+            && self.acceptance[0] < self.acceptance[1]
+            && self.acceptance[1] < 1.0)
+        {
+            return bad(
+                "acceptance",
+                format!("need 0 < lo < hi < 1, got {:?}", self.acceptance),
+            );
+        }
+        if self.cycle_draws < 20 || self.batch_draws < 10 || self.thin == 0 || self.max_draws < 10 {
+            return bad(
+                "draws",
+                "cycle_draws >= 20, batch_draws >= 10, thin >= 1, max_draws >= 10".into(),
+            );
+        }
+        Ok(())
+    }
+}
