@@ -92,8 +92,11 @@ pub fn noise_settings(likelihood: &str) -> Result<hpge_inference::NoiseSettings>
 
 /// The fit's progress on stderr: the job's warnings and a one-line description, the sampling
 /// spinner (one line per update when stderr is not a terminal), the exact check's bar.
+/// The sampling spinner and the function that updates it.
+type Spinner = (ProgressBar, Box<dyn Fn(&Status) + Sync + Send>);
+
 struct Display {
-    sampling: std::sync::Mutex<Option<(ProgressBar, Box<dyn Fn(&Status) + Sync + Send>)>>,
+    sampling: std::sync::Mutex<Option<Spinner>>,
     exact: std::sync::Mutex<Option<ProgressBar>>,
 }
 

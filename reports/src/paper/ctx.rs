@@ -77,7 +77,6 @@ pub struct Row {
 }
 
 /// What a run collects: its rows, figure files, step times and numbers for report.json.
-
 pub struct Ctx {
     /// The output folder.
     pub out: PathBuf,
