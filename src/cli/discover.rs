@@ -13,7 +13,9 @@ use hpge_inference::{
 };
 use indicatif::ProgressBar;
 
-use super::fit::{noise_settings, progress_printer, setup};
+use hpge_inference::fit::noise_settings;
+
+use super::fit::{progress_printer, setup};
 
 /// `hpge-cv discover` arguments.
 #[derive(Debug, clap::Args)]

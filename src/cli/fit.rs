@@ -7,7 +7,7 @@ use anyhow::Result;
 use hpge_inference::fit::FitSummary;
 use hpge_inference::fit::{FitFiles, FitJob};
 use hpge_inference::sampler::Phase;
-use hpge_inference::{CvModel, FitSettings, SamplerKind, Status};
+use hpge_inference::{CvModel, FitSettings, Status};
 use hpge_reports::fit::{FitObserver, FitRun, run_fit, summary_text};
 use indicatif::{ProgressBar, ProgressStyle};
 
@@ -46,11 +46,6 @@ pub fn setup(
     Ok(job)
 }
 
-/// Parses the sampler name.
-pub fn sampler_kind(name: &str) -> Result<SamplerKind> {
-    Ok(hpge_inference::fit::sampler_kind(name)?)
-}
-
 /// A progress line on stderr: a spinner on a terminal, one line per update otherwise.
 pub fn progress_printer(quiet: bool) -> (ProgressBar, impl Fn(&Status) + Sync) {
     let bar = if quiet {
@@ -83,11 +78,6 @@ pub fn progress_printer(quiet: bool) -> (ProgressBar, impl Fn(&Status) + Sync) {
         }
     };
     (bar, f)
-}
-
-/// The paper's noise constants with the likelihood named by `--likelihood`.
-pub fn noise_settings(likelihood: &str) -> Result<hpge_inference::NoiseSettings> {
-    Ok(hpge_inference::fit::noise_settings(likelihood)?)
 }
 
 /// The fit's progress on stderr: the job's warnings and a one-line description, the sampling

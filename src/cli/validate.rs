@@ -8,7 +8,9 @@ use hpge_inference::{CvModel, ExactModel, FitSettings, SampleSettings};
 use hpge_validation::{CoverageSettings, coverage as run_coverage};
 use indicatif::{ProgressBar, ProgressStyle};
 
-use super::fit::{noise_settings, sampler_kind, setup};
+use hpge_inference::fit::{noise_settings, sampler_kind};
+
+use super::fit::setup;
 
 /// Options of `validate coverage`.
 pub struct CoverageOptions<'a> {

@@ -17,7 +17,9 @@ use hpge_validation::{HiddenOutcome, hidden_effects, run_hidden};
 use serde::Serialize;
 
 use super::discover::Printer;
-use super::fit::{noise_settings, progress_printer, setup};
+use hpge_inference::fit::noise_settings;
+
+use super::fit::{progress_printer, setup};
 use hpge_reports::discover::write_outputs;
 
 /// `hpge-cv validate discovery` arguments.
