@@ -2,11 +2,13 @@
 //! sharded (Slurm job arrays), merged.
 
 mod exact;
+mod lock;
 mod merge;
 mod run;
 mod setup;
 
 pub use exact::ExactSolver;
+pub use lock::{FolderLock, LOCK_FILE};
 pub use merge::{MergeReport, merge};
 pub use run::{RunInfo, RunReport, format_row, read_rows, run};
 pub use setup::{Fingerprint, Generator, Sample, Shard};

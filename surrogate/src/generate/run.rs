@@ -6,7 +6,8 @@
 //! fingerprint must match (else the run refuses: no mixing of spaces, detectors or settings), a
 //! last line without its newline (a write cut by the kill) is cut off, the indices present are
 //! skipped, and the rest are solved. Sorted by index, the rows equal those of an uninterrupted
-//! run in every column but `seconds` (wall time).
+//! run in every column but `seconds` (wall time). While a run writes it holds the folder's lock
+//! (`generate.lock`, `lock.rs`): a second process on the same folder is refused.
 
 use std::collections::HashSet;
 use std::fs::OpenOptions;
@@ -149,6 +150,8 @@ pub fn run(
     progress: impl Fn(usize, usize) + Sync,
 ) -> Result<RunReport> {
     std::fs::create_dir_all(out).map_err(io(out, "cannot create the output folder"))?;
+    // One writer per folder, held until this function returns (`lock.rs`).
+    let _lock = super::lock::FolderLock::acquire(out)?;
     let info_path = out.join("generate.json");
     let rows_path = out.join("rows.csv");
     let info = RunInfo {
