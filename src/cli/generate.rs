@@ -19,6 +19,7 @@ pub struct GenerateOptions<'a> {
     pub threads: Option<usize>,
     pub seed: u64,
     pub sequence: SequenceKind,
+    pub curve_points: u64,
     pub grid: &'a super::args::GridArgs,
 }
 
@@ -29,7 +30,8 @@ pub fn generate(o: &GenerateOptions<'_>) -> Result<()> {
     let settings = o.grid.apply(&FieldSettings::default(), &det)?;
     let g = Generator::new(
         space, o.detector, settings, o.sequence, o.seed, o.offset, o.n, o.shard,
-    )?;
+    )?
+    .with_curve_points(o.curve_points)?;
     let bar = ProgressBar::new(0);
     bar.set_style(
         ProgressStyle::with_template(

@@ -291,6 +291,11 @@ struct GenerateArgs {
     /// Sequence.
     #[arg(long, value_enum, default_value = "golden")]
     sequence: SequenceArg,
+    /// Curve mode: K rows per quasi-random parameter point, its biases a shifted stratification
+    /// of the bias range solved as one C-V curve (faster per row; --n and --offset count rows
+    /// and must be multiples of K). 1: every row its own point.
+    #[arg(long, value_name = "K", default_value_t = 1)]
+    curve_points: u64,
     #[command(flatten)]
     grid: args::GridArgs,
 }
@@ -610,6 +615,7 @@ pub fn run(cli: Cli) -> Result<()> {
                 SequenceArg::Golden => hpge_surrogate::SequenceKind::Golden,
                 SequenceArg::Sobol => hpge_surrogate::SequenceKind::Sobol,
             },
+            curve_points: a.curve_points,
             grid: &a.grid,
         }),
         Command::Merge(a) => generate::merge_shards(&a.dirs, &a.out),

@@ -6,6 +6,8 @@ mod lock;
 mod merge;
 mod run;
 mod setup;
+#[cfg(test)]
+mod tests;
 
 pub use exact::ExactSolver;
 pub use lock::{FolderLock, LOCK_FILE};
