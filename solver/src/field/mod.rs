@@ -25,7 +25,7 @@ pub use capacitance::CapacitanceMatrix;
 pub use charge::{contact_charge_c, quasi_static_c12_pf};
 pub use convergence::{ConvergenceRow, convergence_study};
 pub use curve::{Continuation, CvCurve, CvPoint, cv_curve, cv_curve_with, normalise_voltages};
-pub use depletion::{PotentialSolution, solve_fast};
+pub use depletion::{PotentialSolution, solve_fast, solve_fast_with};
 pub use full_depletion::full_depletion_voltage;
 pub use mesh::{Mesh, NodeKind};
 pub use pinch_off::{curve_pinch_off_voltage, pinch_off_voltage};

@@ -2,7 +2,7 @@
 
 use super::adaptive::{Accuracy, Weighed, refinement_marks, undepleted_nodes, weigh};
 use super::capacitance::CapacitanceMatrix;
-use super::depletion::{PotentialSolution, solve_fast};
+use super::depletion::{PotentialSolution, solve_fast_with};
 use super::mesh::Mesh;
 use super::report::{Backend, Method, SolveReport};
 use super::settings::FieldSettings;
@@ -183,7 +183,7 @@ pub(crate) fn solve_point_with(
         ..
     } = refined_potential(det, bias_v, settings, seed)?;
     let solve =
-        |mesh: &Mesh, guess: Option<&[f64]>| potential_on(det, bias_v, settings, mesh, guess);
+        |mesh: &Mesh, guess: Option<&Guess>| potential_on(det, bias_v, settings, mesh, guess);
     let fully_depleted = |mesh: &Mesh, pot: &PotentialSolution| {
         undepleted_nodes(mesh, pot) == 0
             && super::front::crossings(mesh, &pot.phi_v, &pot.undepleted, pot.bounds_v)
@@ -216,7 +216,7 @@ pub(crate) fn solve_point_with(
     };
     let (mut mesh, mut pot) = match start_grid {
         Some(grid) if grid != mesh.grid => {
-            let guess = mesh.grid.interpolate_to(&potential.phi_v, &grid);
+            let guess = Guess::interpolated(&mesh.grid, &potential, &grid);
             let m = Mesh::new(det, grid);
             let p = solve(&m, Some(&guess))?;
             reports.push(p.report.clone());
@@ -244,7 +244,7 @@ pub(crate) fn solve_point_with(
         let c12_err_pf = (0..2)
             .filter_map(|phase| mesh.grid.coarsened_phase(&keep_r, &keep_z, phase))
             .map(|h| {
-                let guess = mesh.grid.interpolate_to(&pot.phi_v, &h);
+                let guess = Guess::interpolated(&mesh.grid, &pot, &h);
                 let hm = Mesh::new(det, h);
                 solve(&hm, Some(&guess))
                     .and_then(|hp| weigh(det, settings, &hm, &hp, bias_v, pair))
@@ -275,7 +275,7 @@ pub(crate) fn solve_point_with(
             }
             return Ok(finish(mesh, pot, w, reports, accuracy));
         };
-        let guess = mesh.grid.interpolate_to(&pot.phi_v, &finer);
+        let guess = Guess::interpolated(&mesh.grid, &pot, &finer);
         mesh = Mesh::new(det, finer);
         pot = solve(&mesh, Some(&guess))?;
         reports.push(pot.report.clone());
@@ -294,9 +294,9 @@ pub fn solve_point_on_grid(
     guess: Option<(&Grid, &[f64])>,
 ) -> Result<PointResult> {
     let pair = pair(det)?;
-    let seed = guess.map(|(g, phi)| g.interpolate_to(phi, &grid));
+    let seed = guess.map(|(g, phi)| Guess::field(g.interpolate_to(phi, &grid)));
     let mesh = Mesh::new(det, grid);
-    let pot = potential_on(det, bias_v, settings, &mesh, seed.as_deref())?;
+    let pot = potential_on(det, bias_v, settings, &mesh, seed.as_ref())?;
     let w = weigh(det, settings, &mesh, &pot, bias_v, pair)?;
     let undepleted_nodes = undepleted_nodes(&mesh, &pot);
     Ok(PointResult {
@@ -317,16 +317,47 @@ pub fn solve_point_on_grid(
     })
 }
 
+/// A starting point for a potential solve: node fields on the new grid.
+struct Guess {
+    /// The potential (V).
+    phi_v: Vec<f64>,
+    /// The potential without pocket ties, where it differs (`PotentialSolution::untied_phi_v`).
+    untied_phi_v: Option<Vec<f64>>,
+}
+
+impl Guess {
+    /// A solution on grid `from`, interpolated to `to`.
+    fn interpolated(from: &Grid, pot: &PotentialSolution, to: &Grid) -> Self {
+        Self {
+            phi_v: from.interpolate_to(&pot.phi_v, to),
+            untied_phi_v: pot
+                .untied_phi_v
+                .as_ref()
+                .map(|u| from.interpolate_to(u, to)),
+        }
+    }
+
+    /// A potential alone.
+    fn field(phi_v: Vec<f64>) -> Self {
+        Self {
+            phi_v,
+            untied_phi_v: None,
+        }
+    }
+}
+
 /// The potential with depletion on one mesh by the settings' method and backend.
 fn potential_on(
     det: &Detector,
     bias_v: f64,
     settings: &FieldSettings,
     mesh: &Mesh,
-    guess: Option<&[f64]>,
+    guess: Option<&Guess>,
 ) -> Result<PotentialSolution> {
+    let untied = guess.and_then(|g| g.untied_phi_v.as_deref());
+    let guess = guess.map(|g| g.phi_v.as_slice());
     match (settings.backend, settings.method) {
-        (Backend::Cpu, Method::Fast) => solve_fast(mesh, det, bias_v, guess),
+        (Backend::Cpu, Method::Fast) => solve_fast_with(mesh, det, bias_v, guess, untied),
         (Backend::Cpu, Method::Sor) => super::sor::solve_sor(mesh, det, bias_v, guess),
         // (Wgpu, Fast) is rejected by validate().
         (Backend::Wgpu, _) => {
@@ -355,25 +386,25 @@ fn refined_potential(
     pair(det)?;
     let gs = &settings.grid;
     let mut grid = Grid::initial(det, gs);
-    let mut guess: Option<Vec<f64>> = None;
+    let mut guess: Option<Guess> = None;
     if let Some(sd) = seed {
         let sr = overlapping(grid.r_mm(), &sd.front_r_mm);
         let sz = overlapping(grid.z_mm(), &sd.front_z_mm);
         if let Some(g) = grid.split(&sr, &sz, gs.front_spacing_mm, gs) {
             grid = g;
         }
-        guess = Some(sd.grid.interpolate_to(&sd.phi_v, &grid));
+        guess = Some(Guess::field(sd.grid.interpolate_to(&sd.phi_v, &grid)));
     }
     let mut reports = Vec::new();
     let solve =
-        |mesh: &Mesh, guess: Option<&[f64]>| potential_on(det, bias_v, settings, mesh, guess);
+        |mesh: &Mesh, guess: Option<&Guess>| potential_on(det, bias_v, settings, mesh, guess);
     let mut mesh = Mesh::new(det, grid.clone());
-    let mut pot = solve(&mesh, guess.as_deref())?;
+    let mut pot = solve(&mesh, guess.as_ref())?;
     reports.push(pot.report.clone());
     // Moves to a finer grid: the current potential, interpolated, seeds the new solve.
     let mut advance =
         |grid: &mut Grid, mesh: &mut Mesh, pot: &mut PotentialSolution, finer: Grid| {
-            let g = grid.interpolate_to(&pot.phi_v, &finer);
+            let g = Guess::interpolated(grid, pot, &finer);
             *mesh = Mesh::new(det, finer.clone());
             *grid = finer;
             *pot = solve(mesh, Some(&g))?;

@@ -219,6 +219,7 @@ pub fn solve_sor_with(
         undepleted,
         bounds_v: (lo, hi),
         pockets,
+        untied_phi_v: None,
         report: SolveReport {
             backend: Backend::Cpu,
             method: Method::Sor,

@@ -162,6 +162,7 @@ pub(crate) fn solve_sor_wgpu_with(
         undepleted,
         bounds_v: bounds,
         pockets,
+        untied_phi_v: None,
         report: SolveReport {
             method: Method::Sor,
             backend: Backend::Wgpu,
