@@ -57,11 +57,7 @@ enum Command {
     /// The paper's section 9 (field strength along r and normalised n+ pulses for three impurity
     /// models at 3000 V) into a folder; `report paper` will call it.
     #[command(hide = true)]
-    PaperSection9 {
-        /// Output folder.
-        #[arg(long, value_name = "DIR", default_value = "reports/section9")]
-        out: PathBuf,
-    },
+    PaperSection9(hpge_reports::paper::Section9Options),
     /// c12 at one bias for constant impurity densities (the paper's sensitivity scan).
     Sensitivity(SensitivityArgs),
     /// Raw pulser data (a directory of .npy pulse files) to a C-V curve with its covariance.
@@ -317,9 +313,9 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Pulse(a) => pulse::run(&a),
         Command::Convergence(a) => convergence::run(&a),
         Command::Field(a) => field::run(&a),
-        Command::PaperSection9 { out } => {
+        Command::PaperSection9(o) => {
             for f in hpge_reports::paper::section9_compute::section9(
-                &out,
+                &o.out,
                 &hpge_reports::paper::section9_compute::Section9Inputs::default(),
             )? {
                 eprintln!("wrote {}", f.display());
