@@ -180,6 +180,7 @@ pub fn log_spaced(lo: f64, hi: f64, n: usize) -> Result<Vec<f64>> {
 
 #[cfg(test)]
 mod tests {
+    use super::*;
 
     #[test]
     fn zeta_ranges() {
