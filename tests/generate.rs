@@ -1,5 +1,5 @@
 //! Training-set generation as a user runs it (issue: training sets): determinism, shards and
-//! merge equal one run, kill -9 and resume, refusal to mix runs, bad input.
+//! merge equal one run, kill -9 and resume, refusal to mix runs, one writer per folder, bad input.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -103,6 +103,53 @@ fn shards_merge_to_the_single_run_and_runs_are_deterministic() {
         dirs[1].to_str().unwrap(),
     ]);
     assert_eq!(o.status.code(), Some(2));
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn a_second_process_on_the_same_folder_is_refused() {
+    // Issue 20: two `generate` processes on one --out both appended (30 samples, 58 rows). The
+    // second must refuse while the first runs; the kill test below shows a killed holder does
+    // not leave the folder locked.
+    let d = temp("lock");
+    let out = d.join("busy");
+    let mut first = bin()
+        .args([
+            "generate",
+            "--space",
+            "spaces/super-siegfried-rz.toml",
+            "--detector",
+            "detectors/super-siegfried-k1.toml",
+            "--n",
+            "5000",
+            "--out",
+            out.to_str().unwrap(),
+            "--threads",
+            "1",
+            "--grid",
+            "adaptive=false",
+        ])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    // Wait until the first run holds the lock (it writes its pid into the lock file).
+    let lock = out.join("generate.lock");
+    let t0 = std::time::Instant::now();
+    while !std::fs::read_to_string(&lock).is_ok_and(|t| t.contains("pid")) {
+        assert!(
+            t0.elapsed().as_secs() < 60,
+            "the first run never took the lock"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    let o = generate(&out, "5000", &["--threads", "1"]);
+    let _ = first.kill();
+    let _ = first.wait();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("another `generate` process"), "{err}");
+    assert!(err.contains(&format!("pid {}", first.id())), "{err}");
     let _ = std::fs::remove_dir_all(&d);
 }
 

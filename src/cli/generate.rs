@@ -23,7 +23,8 @@ pub fn generate(o: &GenerateOptions) -> Result<()> {
         o.offset,
         o.n,
         o.shard,
-    )?;
+    )?
+    .with_curve_points(o.curve_points)?;
     let bar = ProgressBar::new(0);
     bar.set_style(
         ProgressStyle::with_template(

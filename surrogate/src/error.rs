@@ -106,6 +106,17 @@ pub enum Error {
         /// Name of the model's parameter space.
         space: String,
     },
+    /// An output folder another process is writing (`generate`'s one-writer lock).
+    #[error(
+        "{}: another `generate` process is writing this folder ({holder}); wait for it to finish or use another --out",
+        folder.display()
+    )]
+    Locked {
+        /// The folder.
+        folder: PathBuf,
+        /// Who holds the lock (pid, host, start time), as it wrote itself into the lock file.
+        holder: String,
+    },
     /// A parameter list (NAME=VALUE pairs, or bare values in the model's order) that does not
     /// fit the model's inputs.
     #[error("{message}")]
@@ -135,6 +146,7 @@ impl Error {
             | Error::ModelPath { .. }
             | Error::Checkpoint { .. }
             | Error::DataForModel { .. }
+            | Error::Locked { .. }
             | Error::Parameters { .. } => false,
         }
     }

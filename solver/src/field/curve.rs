@@ -83,6 +83,30 @@ pub fn cv_curve(
     settings: &FieldSettings,
     progress: impl Fn(usize, usize) + Sync,
 ) -> Result<CvCurve> {
+    cv_curve_with(det, volts, settings, Continuation::Seeded, progress)
+}
+
+/// How the points of a curve pass information to each other.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Continuation {
+    /// Each point starts from its neighbour's grid split at the neighbour's front and its
+    /// rescaled potential ([`cv_curve`]): fastest for dense curves (tens of volts apart).
+    Seeded,
+    /// Each point starts cold, as [`crate::solve_point`] does; only the weighting stage of fully
+    /// depleted biases is shared. For sparse voltage sets (hundreds of volts apart) the
+    /// neighbour's front lies far from the new one, and splitting the grid there costs more
+    /// than it saves (measured: `validation/examples/curve_vs_points.rs`).
+    Cold,
+}
+
+/// [`cv_curve`] with a choice of [`Continuation`].
+pub fn cv_curve_with(
+    det: &Detector,
+    volts: &[f64],
+    settings: &FieldSettings,
+    continuation: Continuation,
+    progress: impl Fn(usize, usize) + Sync,
+) -> Result<CvCurve> {
     use rayon::prelude::*;
     use std::sync::atomic::{AtomicUsize, Ordering};
     let volts = normalise_voltages(volts)?;
@@ -123,7 +147,9 @@ pub fn cv_curve(
                 if depleted_mesh.is_none() && p.fully_depleted() {
                     depleted_mesh = Some(p.mesh.clone());
                 }
-                prev = Some(p.seed(scale));
+                if continuation == Continuation::Seeded {
+                    prev = Some(p.seed(scale));
+                }
                 progress(done.fetch_add(1, Ordering::Relaxed) + 1, volts.len());
             }
             Ok((points, depleted_mesh))

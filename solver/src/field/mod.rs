@@ -24,7 +24,7 @@ pub use adaptive::Accuracy;
 pub use capacitance::CapacitanceMatrix;
 pub use charge::{contact_charge_c, quasi_static_c12_pf};
 pub use convergence::{ConvergenceRow, convergence_study};
-pub use curve::{CvCurve, CvPoint, cv_curve, normalise_voltages};
+pub use curve::{Continuation, CvCurve, CvPoint, cv_curve, cv_curve_with, normalise_voltages};
 pub use depletion::{PotentialSolution, solve_fast};
 pub use full_depletion::full_depletion_voltage;
 pub use mesh::{Mesh, NodeKind};

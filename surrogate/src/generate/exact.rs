@@ -4,7 +4,8 @@
 
 use std::path::{Path, PathBuf};
 
-use hpge_solver::{Detector, FieldSettings, ImpuritySpec, Parameters, cv_curve, solve_point};
+use hpge_solver::field::{Continuation, cv_curve_with};
+use hpge_solver::{Detector, FieldSettings, ImpuritySpec, Parameters, solve_point};
 
 use crate::error::{Error, Result};
 use crate::hash::fnv1a;
@@ -144,8 +145,19 @@ impl ExactSolver {
     /// c12 (pF) along a C-V curve: `params` as for [`ExactSolver::detector`], `volts` the biases
     /// (V, increasing). Each point is seeded from its neighbour ([`cv_curve`]).
     pub fn curve(&self, params: &[f64], volts: &[f64]) -> Result<Vec<f64>> {
+        self.curve_with(params, volts, Continuation::Seeded)
+    }
+
+    /// [`ExactSolver::curve`] with a choice of how the points pass information on
+    /// ([`Continuation`]: seeded for dense voltage lists, cold for sparse ones).
+    pub fn curve_with(
+        &self,
+        params: &[f64],
+        volts: &[f64],
+        continuation: Continuation,
+    ) -> Result<Vec<f64>> {
         let det = self.detector(params)?;
-        let curve = cv_curve(&det, volts, &self.settings, |_, _| {})?;
+        let curve = cv_curve_with(&det, volts, &self.settings, continuation, |_, _| {})?;
         if curve.points.len() != volts.len() {
             return Err(Error::Argument {
                 name: "volts".into(),

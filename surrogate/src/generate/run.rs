@@ -6,7 +6,8 @@
 //! fingerprint must match (else the run refuses: no mixing of spaces, detectors or settings), a
 //! last line without its newline (a write cut by the kill) is cut off, the indices present are
 //! skipped, and the rest are solved. Sorted by index, the rows equal those of an uninterrupted
-//! run in every column but `seconds` (wall time).
+//! run in every column but `seconds` (wall time). While a run writes it holds the folder's lock
+//! (`generate.lock`, `lock.rs`): a second process on the same folder is refused.
 
 use std::collections::HashSet;
 use std::fs::OpenOptions;
@@ -149,6 +150,8 @@ pub fn run(
     progress: impl Fn(usize, usize) + Sync,
 ) -> Result<RunReport> {
     std::fs::create_dir_all(out).map_err(io(out, "cannot create the output folder"))?;
+    // One writer per folder, held until this function returns (`lock.rs`).
+    let _lock = super::lock::FolderLock::acquire(out)?;
     let info_path = out.join("generate.json");
     let rows_path = out.join("rows.csv");
     let info = RunInfo {
@@ -199,6 +202,32 @@ pub fn run(
     } else {
         (Vec::new(), false)
     };
+    let mut done: HashSet<u64> = existing.iter().map(|r| r.0).collect();
+    // Curve mode writes a point's rows in one write, so only a cut-off last write leaves a
+    // point with some of its rows: those are removed and the point solved again.
+    let partial: Vec<u64> = g
+        .units()
+        .filter(|&p| {
+            let have = g.rows_of(p).filter(|i| done.contains(i)).count();
+            have > 0 && (have as u64) < g.curve_points()
+        })
+        .collect();
+    let mut repaired = repaired;
+    if !partial.is_empty() {
+        let drop: HashSet<u64> = partial.iter().flat_map(|&p| g.rows_of(p)).collect();
+        let mut text = format!("{}\n", info.header);
+        for (i, line) in &existing {
+            if !drop.contains(i) {
+                text.push_str(line);
+                text.push('\n');
+            }
+        }
+        let tmp = out.join("rows.csv.tmp");
+        std::fs::write(&tmp, text).map_err(io(&tmp, "cannot write"))?;
+        std::fs::rename(&tmp, &rows_path).map_err(io(&rows_path, "cannot replace"))?;
+        done.retain(|i| !drop.contains(i));
+        repaired = true;
+    }
     let mut file = OpenOptions::new()
         .create(true)
         .append(true)
@@ -213,38 +242,38 @@ pub fn run(
         file.write_all(format!("{}\n", info.header).as_bytes())
             .map_err(io(&rows_path, "cannot write the header"))?;
     }
-    let done: HashSet<u64> = existing.iter().map(|r| r.0).collect();
     let todo: Vec<u64> = g
-        .shard
-        .indices(g.offset, g.n)
-        .filter(|i| !done.contains(i))
+        .units()
+        .filter(|&p| g.rows_of(p).any(|i| !done.contains(&i)))
         .collect();
-    let total = done.len() + todo.len();
+    let written = todo.len() * g.curve_points() as usize;
+    let total = done.len() + written;
     let file = Mutex::new(file);
     let counter = std::sync::atomic::AtomicUsize::new(done.len());
     let failed = Mutex::new(Vec::new());
     let error: Mutex<Option<Error>> = Mutex::new(None);
     let work = || {
-        todo.par_iter().for_each(|&i| {
+        todo.par_iter().for_each(|&p| {
             if error.lock().map(|e| e.is_some()).unwrap_or(true) {
                 return;
             }
-            let s = g.sample(i);
-            let line = format_row(&s) + "\n";
+            let samples = g.unit(p);
+            let text: String = samples.iter().map(|s| format_row(s) + "\n").collect();
             let mut f = file.lock().unwrap_or_else(|e| e.into_inner());
-            if let Err(e) = f.write_all(line.as_bytes()) {
+            if let Err(e) = f.write_all(text.as_bytes()) {
                 *error.lock().unwrap_or_else(|e| e.into_inner()) =
                     Some(io(&rows_path, "cannot append a row (disk full?)")(e));
                 return;
             }
             drop(f);
-            if s.status != "ok" {
+            for s in samples.iter().filter(|s| s.status != "ok") {
                 failed
                     .lock()
                     .unwrap_or_else(|e| e.into_inner())
-                    .push((i, s.status.clone()));
+                    .push((s.index, s.status.clone()));
             }
-            let n = counter.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+            let n = counter.fetch_add(samples.len(), std::sync::atomic::Ordering::Relaxed)
+                + samples.len();
             progress(n, total);
         })
     };
@@ -266,7 +295,7 @@ pub fn run(
     failed.sort();
     Ok(RunReport {
         resumed: done.len(),
-        written: todo.len(),
+        written,
         total,
         failed,
         repaired,
@@ -276,7 +305,7 @@ pub fn run(
 fn describe(i: &RunInfo) -> String {
     let f = &i.fingerprint;
     format!(
-        "space {} {}, detector {} {}, settings {}, {} seed {}, indices {}..{}, shard {}/{}",
+        "space {} {}, detector {} {}, settings {}, {} seed {}, indices {}..{}, shard {}/{}{}",
         f.space,
         f.space_hash,
         f.detector,
@@ -287,7 +316,12 @@ fn describe(i: &RunInfo) -> String {
         f.offset,
         f.offset + f.n,
         i.shard.k,
-        i.shard.m
+        i.shard.m,
+        if f.curve_points > 1 {
+            format!(", {} rows per curve", f.curve_points)
+        } else {
+            String::new()
+        }
     )
 }
 

@@ -76,6 +76,20 @@ pub struct Fingerprint {
     pub offset: u64,
     /// Number of samples of the whole run.
     pub n: u64,
+    /// Rows per parameter point in curve mode (1: every row its own quasi-random point; see
+    /// [`Generator::with_curve_points`]). Absent from the files of point-mode runs, so their
+    /// fingerprints are what they were before curve mode existed.
+    #[serde(default = "one", skip_serializing_if = "is_one")]
+    pub curve_points: u64,
+}
+
+fn one() -> u64 {
+    1
+}
+
+#[allow(clippy::trivially_copy_pass_by_ref)] // serde's skip_serializing_if passes a reference
+fn is_one(k: &u64) -> bool {
+    *k == 1
 }
 
 /// A configured run.
@@ -175,6 +189,7 @@ impl Generator {
             seed,
             offset,
             n,
+            curve_points: 1,
         };
         let g = Self {
             space,
@@ -188,6 +203,129 @@ impl Generator {
             exact,
         };
         Ok(g)
+    }
+
+    /// Curve mode: every quasi-random parameter point gets `k` rows, its own set of `k` biases
+    /// solved as one C-V curve ([`hpge_solver::field::cv_curve_with`], cold continuation: the
+    /// weighting stage of fully depleted biases is computed once, each bias otherwise solved as
+    /// in point mode, so a row equals the point-mode solve at its x exactly).
+    ///
+    /// Measured on Super-Siegfried (2-core machine, `curve_vs_points`): no faster than point
+    /// mode with the present solver (a row's cost is its own depletion solves), and a seeded
+    /// continuation was slower for biases hundreds of volts apart. It is kept for its design:
+    /// every parameter point sampled across the whole bias range.
+    ///
+    /// The biases are a randomly shifted stratification of the bias dimension: with u_b the
+    /// point's own quasi-random bias coordinate, row j (0 <= j < k) has the unit coordinate
+    /// (j + u_b) / k, mapped to volts by the dimension's distribution. Each stratum is hit
+    /// uniformly, so over many points the bias is as uniform as in point mode (its marginal is
+    /// the same), while one point's rows share the detector and impurity model. The bias stays
+    /// quasi-random (through u_b) rather than a fixed list, so no two curves sample the same
+    /// voltages. Rows are numbered p k + j for parameter point p; `n` and `offset` count rows
+    /// and must be multiples of `k`. With `k` = 1 this is point mode, unchanged.
+    pub fn with_curve_points(mut self, k: u64) -> Result<Self> {
+        let arg = |message: String| Error::Argument {
+            name: "--curve-points".into(),
+            message,
+        };
+        if k == 0 {
+            return Err(arg("must be at least 1".into()));
+        }
+        if k > 1 && self.bias_dimension().is_none() {
+            return Err(arg(format!(
+                "the space `{}` has no `bias` dimension to spread along a curve",
+                self.space.name
+            )));
+        }
+        if !self.n.is_multiple_of(k) || !self.offset.is_multiple_of(k) {
+            return Err(arg(format!(
+                "--n ({}) and --offset ({}) count rows and must be multiples of {k}",
+                self.n, self.offset
+            )));
+        }
+        self.fingerprint.curve_points = k;
+        Ok(self)
+    }
+
+    /// Rows per parameter point (1 in point mode).
+    pub fn curve_points(&self) -> u64 {
+        self.fingerprint.curve_points
+    }
+
+    /// Column of the space's bias dimension.
+    fn bias_dimension(&self) -> Option<usize> {
+        self.space
+            .targets()
+            .iter()
+            .position(|t| *t == crate::space::Target::Bias)
+    }
+
+    /// This shard's work units: sequence indices of the parameter points (point mode: the row
+    /// indices themselves). Shards stride over points, so one point's rows stay together.
+    pub fn units(&self) -> impl Iterator<Item = u64> + '_ {
+        let k = self.curve_points();
+        self.shard.indices(self.offset / k, self.n / k)
+    }
+
+    /// The row indices of work unit `p`.
+    pub fn rows_of(&self, p: u64) -> std::ops::Range<u64> {
+        let k = self.curve_points();
+        p * k..(p + 1) * k
+    }
+
+    /// Solves work unit `p`: one sample in point mode ([`Generator::sample`]), else the `k`
+    /// rows of parameter point `p` along one C-V curve. A failed curve gives `k` rows with NaN
+    /// c12 and the reason; `seconds` is the curve's wall time shared equally.
+    pub fn unit(&self, p: u64) -> Vec<Sample> {
+        let k = self.curve_points();
+        let Some(b) = self.bias_dimension().filter(|_| k > 1) else {
+            return vec![self.sample(p)];
+        };
+        let start = std::time::Instant::now();
+        let u0 = self.sequence.point(p);
+        let rows: Vec<(Vec<f64>, Vec<f64>)> = (0..k)
+            .map(|j| {
+                let mut u = u0.clone();
+                u[b] = (j as f64 + u0[b]) / k as f64;
+                let x = self.space.from_unit(&u);
+                (u, x)
+            })
+            .collect();
+        let params: Vec<f64> = rows[0]
+            .1
+            .iter()
+            .enumerate()
+            .filter(|(d, _)| *d != b)
+            .map(|(_, v)| *v)
+            .collect();
+        let volts: Vec<f64> = rows.iter().map(|(_, x)| x[b]).collect();
+        // Cold continuation: the biases lie (range / k) apart, too far for a neighbour's front to
+        // help (seeded curves measured 1.7x slower, `validation/examples/curve_vs_points.rs`);
+        // a row then equals the point-mode solve at its x bit for bit.
+        let result = self
+            .exact
+            .curve_with(&params, &volts, hpge_solver::field::Continuation::Cold);
+        let seconds = start.elapsed().as_secs_f64() / k as f64;
+        rows.into_iter()
+            .enumerate()
+            .map(|(j, (u, x))| {
+                let (c12_pf, status) = match &result {
+                    Ok(c) => (c[j], "ok".to_string()),
+                    Err(e) => (
+                        f64::NAN,
+                        format!("failed: {e}").replace([',', '\n', '\r'], ";"),
+                    ),
+                };
+                Sample {
+                    index: p * k + j as u64,
+                    u,
+                    x,
+                    c12_pf,
+                    status,
+                    seconds,
+                }
+            })
+            .collect()
     }
 
     /// The CSV header: index, u_<name>..., <name>..., c12_pF, status, seconds.

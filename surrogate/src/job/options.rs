@@ -51,6 +51,11 @@ pub struct GenerateOptions {
         arg(long, value_enum, default_value_t = SequenceKind::default())
     )]
     pub sequence: SequenceKind,
+    /// Curve mode: K rows per quasi-random parameter point, its biases a shifted stratification
+    /// of the bias range solved as one C-V curve (faster per row; --n and --offset count rows
+    /// and must be multiples of K). 1: every row its own point.
+    #[cfg_attr(feature = "clap", arg(long, value_name = "K", default_value_t = 1))]
+    pub curve_points: u64,
     /// The exact solver's grid and accuracy.
     #[cfg_attr(feature = "clap", command(flatten))]
     pub grid: GridOverrides,

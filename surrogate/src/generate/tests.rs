@@ -1,0 +1,130 @@
+//! Curve mode: rows equal point-mode solves at the same x, the bias strata, resume after a
+//! cut-off write.
+
+use std::path::PathBuf;
+
+use hpge_solver::FieldSettings;
+
+use super::{Generator, Shard, run};
+use crate::sequence::SequenceKind;
+use crate::space::ParameterSpace;
+
+fn repo(p: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..").join(p)
+}
+
+/// Super-Siegfried's space on the default grid without adaptive refinement (fast), `n` rows of
+/// `k` per point.
+fn generator(n: u64, k: u64) -> Generator {
+    let space = ParameterSpace::from_file(&repo("spaces/super-siegfried-rz.toml")).unwrap();
+    let mut settings = FieldSettings::default();
+    settings.grid.adaptive = false;
+    Generator::new(
+        space,
+        &repo("detectors/super-siegfried-k1.toml"),
+        settings,
+        SequenceKind::Golden,
+        0,
+        0,
+        n,
+        Shard::WHOLE,
+    )
+    .unwrap()
+    .with_curve_points(k)
+    .unwrap()
+}
+
+#[test]
+fn curve_rows_are_point_solves_on_bias_strata() {
+    let k = 3;
+    let g = generator(3, k);
+    let rows = g.unit(1);
+    assert_eq!(rows.len(), 3);
+    let b = g.space.dim() - 1; // U_B is the last column of this space
+    let (lo, hi) = (
+        g.space.dimensions[b].range[0],
+        g.space.dimensions[b].range[1],
+    );
+    for (j, r) in rows.iter().enumerate() {
+        assert_eq!(r.index, k + j as u64);
+        assert_eq!(r.status, "ok");
+        // Row j's bias lies in stratum j of the range; the other coordinates are the point's.
+        let u_b = r.u[b];
+        assert!(u_b >= j as f64 / k as f64 && u_b < (j + 1) as f64 / k as f64);
+        assert!((r.x[b] - (lo + u_b * (hi - lo))).abs() < 1e-9 * hi);
+        assert_eq!(r.u[..b], rows[0].u[..b]);
+        // The same number as point mode at this x (cold continuation).
+        let c = g.exact.solve(&r.x).unwrap();
+        assert_eq!(
+            c.to_bits(),
+            r.c12_pf.to_bits(),
+            "row {j}: {c} vs {}",
+            r.c12_pf
+        );
+    }
+    // The three strata's shift is the point's own quasi-random bias coordinate.
+    let shift = rows[0].u[b] * k as f64;
+    for (j, r) in rows.iter().enumerate() {
+        assert!((r.u[b] * k as f64 - j as f64 - shift).abs() < 1e-12);
+    }
+}
+
+#[test]
+fn counts_must_be_multiples_and_the_fingerprint_records_k() {
+    let space = ParameterSpace::from_file(&repo("spaces/super-siegfried-rz.toml")).unwrap();
+    let g = |n| {
+        Generator::new(
+            space.clone(),
+            &repo("detectors/super-siegfried-k1.toml"),
+            FieldSettings::default(),
+            SequenceKind::Golden,
+            0,
+            0,
+            n,
+            Shard::WHOLE,
+        )
+        .unwrap()
+    };
+    let err = g(7).with_curve_points(3).unwrap_err().to_string();
+    assert!(
+        err.contains("--curve-points") && err.contains("multiples of 3"),
+        "{err}"
+    );
+    assert!(g(6).with_curve_points(0).is_err());
+    assert_eq!(
+        g(6).with_curve_points(3).unwrap().fingerprint.curve_points,
+        3
+    );
+    // Point mode leaves the fingerprint's JSON as it was before curve mode.
+    let json = serde_json::to_string(&g(6).fingerprint).unwrap();
+    assert!(!json.contains("curve_points"), "{json}");
+}
+
+#[test]
+fn a_point_cut_off_mid_curve_is_solved_again_without_duplicates() {
+    let dir = std::env::temp_dir().join(format!("hpge-curve-resume-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let g = generator(4, 2);
+    let first = run(&g, &dir, Some(1), |_, _| {}).unwrap();
+    assert_eq!((first.written, first.total), (4, 4));
+    let rows_path = dir.join("rows.csv");
+    let full = std::fs::read_to_string(&rows_path).unwrap();
+    let sorted = |t: &str| {
+        let mut v: Vec<String> = t
+            .lines()
+            .skip(1)
+            .map(|l| l[..l.rfind(',').unwrap()].to_string())
+            .collect();
+        v.sort();
+        v
+    };
+    // Drop the last row: its point keeps one of its two rows.
+    let cut: Vec<&str> = full.lines().collect();
+    std::fs::write(&rows_path, cut[..cut.len() - 1].join("\n") + "\n").unwrap();
+    let again = run(&g, &dir, Some(1), |_, _| {}).unwrap();
+    assert!(again.repaired);
+    assert_eq!((again.resumed, again.written, again.total), (2, 2, 4));
+    let now = std::fs::read_to_string(&rows_path).unwrap();
+    assert_eq!(sorted(&now), sorted(&full));
+    let _ = std::fs::remove_dir_all(&dir);
+}
