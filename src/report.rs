@@ -2,9 +2,8 @@
 //! with this project's numbers ([`hpge_reports::paper::run_paper`]), and a README that sets each
 //! beside the paper's statement about it.
 
-use std::path::PathBuf;
-
 use anyhow::Result;
+use hpge_reports::paper::PaperOptions;
 
 /// `report`: reports made of several commands' results.
 #[derive(Debug, clap::Args)]
@@ -17,21 +16,7 @@ pub struct ReportArgs {
 enum ReportKind {
     /// Every paper figure the project can produce, with its own numbers, and README.md listing
     /// each beside the paper's statement and whether this project agrees (about 10 min on 2 cores).
-    Paper(PaperArgs),
-}
-
-/// Options of `report paper`.
-#[derive(Debug, clap::Args)]
-pub struct PaperArgs {
-    /// Output folder (figures/, fits/, section9/, README.md, report.json).
-    #[arg(long, value_name = "DIR", default_value = "reports/paper")]
-    pub out: PathBuf,
-    /// A fast reduced run (for tests): few voltages and densities, no fits, no section 9.
-    #[arg(long)]
-    pub quick: bool,
-    /// Run the fits' exact-solver re-weighting check (100 draws each, a few minutes more).
-    #[arg(long)]
-    pub exact_check: bool,
+    Paper(PaperOptions),
 }
 
 /// Runs `report`.
@@ -42,7 +27,7 @@ pub fn run(a: &ReportArgs) -> Result<()> {
 }
 
 /// Runs `report paper` with progress on stderr and the fits' summaries on stdout.
-pub fn paper(a: &PaperArgs) -> Result<()> {
+pub fn paper(a: &PaperOptions) -> Result<()> {
     let r = hpge_reports::paper::run_paper(
         a.out.clone(),
         a.quick,

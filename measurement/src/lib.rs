@@ -73,6 +73,7 @@ pub mod circuit;
 mod error;
 pub mod formats;
 pub mod measure;
+mod options;
 pub mod peak;
 pub mod slope;
 pub mod synth;
@@ -85,6 +86,7 @@ pub use formats::{
     write_curve_with_comments, write_pulses,
 };
 pub use measure::{MeasureSettings, Measurement, Problem, VoltagePoint, measure};
+pub use options::{MeasureOptions, SynthOptions};
 pub use slope::depletion_voltage;
 pub use synth::{SynthSettings, synthesize_voltage};
 pub use types::{CvData, PulseSet, Sidecar};

@@ -31,12 +31,17 @@ use crate::{Error, Result};
 /// Charge per keV deposited in germanium, pC: 1 keV / 2.96 eV x e.
 pub const PC_PER_KEV: f64 = 1e3 / 2.96 * 1.602_176_634e-19 * 1e12;
 
+/// Pulser events per bias of synthetic data.
+pub const DEFAULT_PULSER_PULSES: usize = 200;
+/// Samples of synthetic data averaged into one (1: none).
+pub const DEFAULT_DECIMATE: usize = 1;
+
 /// Settings of the generator, with the defaults used for the shipped data ("the paper's noise
 /// level": about 1 keV pulser-amplitude spread and 3.7 keV white noise per 4 ns sample).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct SynthSettings {
-    /// Pulser events per bias (default 200).
+    /// Pulser events per bias (default [`DEFAULT_PULSER_PULSES`]).
     pub pulser_pulses: usize,
     /// Gamma events per pulser event at full depletion (default 0.5).
     pub gammas_per_pulser: f64,
@@ -46,7 +51,7 @@ pub struct SynthSettings {
     pub trace_ns: f64,
     /// Time of the pulser edge / gamma interaction in the trace, ns (default 4000).
     pub edge_ns: f64,
-    /// Average blocks of this many samples (default 1: none).
+    /// Average blocks of this many samples (default [`DEFAULT_DECIMATE`]: none).
     pub decimate: usize,
     /// Preamplifier rise time constant, ns (default 20).
     pub rise_ns: f64,
@@ -69,12 +74,12 @@ pub struct SynthSettings {
 impl Default for SynthSettings {
     fn default() -> Self {
         Self {
-            pulser_pulses: 200,
+            pulser_pulses: DEFAULT_PULSER_PULSES,
             gammas_per_pulser: 0.5,
             sampling_period_ns: 4.0,
             trace_ns: 20_000.0,
             edge_ns: 4000.0,
-            decimate: 1,
+            decimate: DEFAULT_DECIMATE,
             rise_ns: 20.0,
             gamma_rise_ns: 100.0,
             noise_pc: 2e-4,

@@ -18,6 +18,9 @@
 //!   C-V curves, depletion and pinch-off voltages.
 //! - [`drift`]: the electric field of a solved point, charge drift and pulses.
 //! - [`gpu`]: the wgpu backend's adapter and precision.
+//! - [`options`]: the options of the commands that load a detector and solve fields
+//!   ([`options::DetectorInput`], [`options::SolverOptions`], [`GridOverrides`]), declared once
+//!   for the command line.
 //! - [`expr`]: named parameters ([`Parameters`]) and the expressions detector files may use.
 //! - [`material`], [`constants`]: material properties and physical constants.
 //!
@@ -57,6 +60,7 @@ pub mod gpu;
 pub mod grid;
 pub mod impurity;
 pub mod material;
+pub mod options;
 pub mod scan;
 
 pub use detector::Detector;

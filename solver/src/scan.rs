@@ -15,6 +15,85 @@ use crate::error::{Error, Result};
 use crate::field::{FieldSettings, solve_point};
 use crate::impurity::ImpuritySpec;
 
+/// The bias of the paper's scan (section 5, Fig. 13), V.
+pub const SCAN_VOLTAGE_V: f64 = 25.0;
+/// The densities of the scan when none are given, as `--zeta-range` writes them: 18 values from
+/// 1e7 to 2e11 cm^-3, evenly in log (around the paper's sensitive range 1e8 .. 1e11 cm^-3).
+pub const DEFAULT_ZETA_RANGE: &str = "1e7:2e11:18";
+
+/// The densities of a scan (cm^-3), as parsed from `MIN:MAX:N` ([`parse_zeta_range`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ZetaRange(pub Vec<f64>);
+
+/// Parses `MIN:MAX:N`: N densities (cm^-3, 2 <= N <= 1000) spaced evenly in log between MIN and
+/// MAX (0 < MIN < MAX).
+///
+/// # Errors
+/// [`Error::Syntax`] saying what was expected (the command line shows it beside the option).
+pub fn parse_zeta_range(s: &str) -> Result<ZetaRange> {
+    let bad = |message: String| Error::Syntax {
+        text: s.into(),
+        message,
+    };
+    let parts: Vec<&str> = s.split(':').map(str::trim).collect();
+    let [a, b, n] = parts.as_slice() else {
+        return Err(bad(format!("`{s}`: expected MIN:MAX:N, e.g. 1e7:2e11:17")));
+    };
+    let num = |t: &str| {
+        t.parse::<f64>()
+            .map_err(|e| bad(format!("`{t}` in `{s}`: {e}")))
+    };
+    let (lo, hi) = (num(a)?, num(b)?);
+    let n: usize = n.parse().map_err(|e| {
+        bad(format!(
+            "`{n}` in `{s}`: the count must be a whole number ({e})"
+        ))
+    })?;
+    if !(lo.is_finite() && hi.is_finite() && lo > 0.0 && hi > lo) {
+        return Err(bad(format!(
+            "`{s}`: need 0 < MIN < MAX (densities in cm^-3)"
+        )));
+    }
+    if !(2..=1000).contains(&n) {
+        return Err(bad(format!(
+            "`{s}`: the count N must lie in 2..=1000, got {n}"
+        )));
+    }
+    log_spaced(lo, hi, n)
+        .map(ZetaRange)
+        .map_err(|e| bad(format!("`{s}`: {e}")))
+}
+
+/// The scan's own options (the detector and the solver's are
+/// [`crate::options::DetectorInput`] and [`crate::options::SolverOptions`]). The command line
+/// flattens this struct (feature `clap`), so every option and default is declared here once.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "clap", derive(clap::Args))]
+pub struct ScanOptions {
+    /// Bias voltage in V.
+    #[cfg_attr(
+        feature = "clap",
+        arg(
+            long,
+            value_name = "U",
+            default_value_t = SCAN_VOLTAGE_V,
+            allow_hyphen_values = true
+        )
+    )]
+    pub voltage: f64,
+    /// Densities MIN:MAX:N in cm^-3, N values spaced evenly in log.
+    #[cfg_attr(
+        feature = "clap",
+        arg(
+            long = "zeta-range",
+            value_name = "MIN:MAX:N",
+            default_value = DEFAULT_ZETA_RANGE,
+            value_parser = parse_zeta_range
+        )
+    )]
+    pub zeta_range: ZetaRange,
+}
+
 /// Name of the constant impurity model in messages.
 const SCAN_MODEL_NAME: &str = "(sensitivity scan: constant model)";
 
@@ -102,6 +181,21 @@ pub fn log_spaced(lo: f64, hi: f64, n: usize) -> Result<Vec<f64>> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn zeta_ranges() {
+        assert_eq!(parse_zeta_range(DEFAULT_ZETA_RANGE).unwrap().0.len(), 18);
+        let r = parse_zeta_range("1e7:1e11:5").unwrap().0;
+        assert_eq!(r.len(), 5);
+        for (a, b) in r.iter().zip([1e7, 1e8, 1e9, 1e10, 1e11]) {
+            assert!((a / b - 1.0).abs() < 1e-12);
+        }
+        let message = |text: &str| parse_zeta_range(text).unwrap_err().to_string();
+        assert!(parse_zeta_range("1e7:1e11").is_err());
+        assert!(message("0:1e11:5").contains("0 < MIN < MAX"));
+        assert!(message("1e7:1e11:1").contains("2..=1000"));
+        assert!(parse_zeta_range("1e7:x:5").is_err());
+    }
 
     #[test]
     fn log_spaced_decades() {

@@ -93,54 +93,8 @@ pub fn parse_r_range(text: &str) -> Result<RadiusRange, String> {
     ))
 }
 
-/// Parses a voltage list: "START:STOP:STEP" (inclusive of STOP when it falls on the step) or
-/// "V1,V2,...". Values are checked (finite, positive) and sorted by the caller.
-pub fn parse_voltages(text: &str) -> Result<VoltageList, String> {
-    parse_voltage_values(text).map(VoltageList)
-}
-
-/// A parsed `--voltages` list (V).
-#[derive(Debug, Clone, PartialEq)]
-pub struct VoltageList(pub Vec<f64>);
-
-fn parse_voltage_values(text: &str) -> Result<Vec<f64>, String> {
-    let num = |s: &str| -> Result<f64, String> {
-        let v: f64 = s
-            .trim()
-            .parse()
-            .map_err(|_| format!("`{}` in `{text}` is not a number", s.trim()))?;
-        if v.is_finite() {
-            Ok(v)
-        } else {
-            Err(format!("`{}` in `{text}` must be finite", s.trim()))
-        }
-    };
-    if text.contains(':') {
-        let parts: Vec<&str> = text.split(':').collect();
-        if parts.len() != 3 {
-            return Err(format!("expected START:STOP:STEP, got `{text}`"));
-        }
-        let (a, b, s) = (num(parts[0])?, num(parts[1])?, num(parts[2])?);
-        if s <= 0.0 {
-            return Err(format!("the step in `{text}` must be positive"));
-        }
-        if b < a {
-            return Err(format!("STOP must not be below START in `{text}`"));
-        }
-        let n = ((b - a) / s + 1e-9).floor() as usize;
-        if n > 100_000 {
-            return Err(format!("`{text}` gives more than 100000 voltages"));
-        }
-        Ok((0..=n).map(|k| a + s * k as f64).collect())
-    } else {
-        text.split(',').map(num).collect()
-    }
-}
-
-/// Parses "NAME=VALUE" as given to `--param`.
-pub fn parse_param(text: &str) -> Result<(String, f64), String> {
-    Parameters::parse_assignment(text).map_err(|e| e.to_string())
-}
+/// Bias-voltage lists (`--voltages`): declared once, in the solver library.
+pub use hpge_solver::options::{VoltageList, parse_voltages};
 
 /// Grid and accuracy options: declared once, in the solver library.
 pub use hpge_solver::GridOverrides as GridArgs;
@@ -162,24 +116,6 @@ pub fn load_detector(input: &DetectorInput) -> Result<Detector> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn voltages() {
-        assert_eq!(
-            parse_voltages("25:125:50").unwrap().0,
-            vec![25.0, 75.0, 125.0]
-        );
-        assert_eq!(parse_voltages("25:2975:50").unwrap().0.len(), 60);
-        assert_eq!(
-            parse_voltages("25, 75,125").unwrap().0,
-            vec![25.0, 75.0, 125.0]
-        );
-        assert!(parse_voltages("25:10:5").is_err());
-        assert!(parse_voltages("25:100:0").is_err());
-        assert!(parse_voltages("25:100").is_err());
-        assert!(parse_voltages("25,x").is_err());
-        assert!(parse_voltages("nan").is_err());
-    }
 
     #[test]
     fn points() {

@@ -7,8 +7,9 @@ use hpge_reports::plot;
 use hpge_solver::field::convergence_study;
 use serde_json::json;
 
+use super::DetectorInput;
 use super::args::load_detector;
-use super::{DetectorInput, SolverArgs, WeightingArg};
+use hpge_solver::options::{SolverOptions, WeightingOptions};
 
 /// Arguments of `convergence`.
 #[derive(Debug, clap::Args)]
@@ -22,7 +23,7 @@ pub struct ConvergenceArgs {
     #[arg(long, value_name = "N", default_value_t = 4)]
     pub levels: usize,
     #[command(flatten)]
-    pub solver: SolverArgs,
+    pub solver: SolverOptions,
     /// Print exactly one JSON object on stdout.
     #[arg(long)]
     pub json: bool,
@@ -46,10 +47,11 @@ pub fn run(a: &ConvergenceArgs) -> Result<()> {
         plot::check_output(p, "--plot")?;
     }
     let det = load_detector(&a.input)?;
-    let settings = a
-        .solver
-        .grid
-        .apply(&a.solver.settings(WeightingArg::Conductor), &det)?;
+    let settings = a.solver.grid.apply(
+        &a.solver
+            .field_settings(WeightingOptions::default().weighting),
+        &det,
+    )?;
     super::simulate::backend_json(&settings)?;
     let rows = convergence_study(&det, a.voltage, &settings, a.levels)?;
     let finest = rows

@@ -2,82 +2,31 @@
 //! start model, locate where it disagrees with the data and what region of the detector that
 //! probes, score the catalogue of extensions, fit the best, and show the gap shrink.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::Arc;
 
 use anyhow::{Context, Result};
+use hpge_inference::discover::DiscoverOptions;
 use hpge_inference::discover::catalogue;
-use hpge_inference::{
-    CvModel, DiscoverInputs, DiscoverSettings, Discovery, FitSettings, PriorSpec, Progress,
-    SampleSettings, SamplerKind, Status, discover,
-};
+use hpge_inference::posterior::NoiseKind;
+use hpge_inference::{CvModel, DiscoverInputs, Discovery, PriorSpec, Progress, Status, discover};
 use indicatif::ProgressBar;
 
 use hpge_inference::fit::noise_settings;
 
 use super::fit::{progress_printer, setup};
 
-/// `hpge-cv discover` arguments.
+/// `hpge-cv discover` arguments: the library's options, and what to print.
 #[derive(Debug, clap::Args)]
 pub struct DiscoverArgs {
-    /// The measured C-V curve (CSV with voltage_V, c12_pF, sigma_pF).
-    #[arg(
-        long,
-        value_name = "FILE",
-        default_value = hpge_inference::fit::DEFAULT_DATA
-    )]
-    pub data: PathBuf,
-    /// The detector the data were measured with (checked against the model's; the exact solver
-    /// runs on it for the extensions outside the surrogate's space and for the probed regions).
-    #[arg(
-        long,
-        value_name = "FILE",
-        default_value = hpge_inference::fit::DEFAULT_DETECTOR
-    )]
-    pub detector: PathBuf,
-    /// The start model: a prior file, or the name of one in priors/ (b-z: the paper's B_Z).
-    #[arg(long, value_name = "NAME|FILE", default_value = "b-z")]
-    pub start_model: String,
-    /// The surrogate model (.safetensors); its space must contain the start model.
-    #[arg(
-        long,
-        value_name = "FILE",
-        default_value = hpge_inference::fit::DEFAULT_MODEL
-    )]
-    pub model: PathBuf,
-    /// Output folder [default: discoveries/<start model>].
-    #[arg(long, value_name = "DIR")]
-    pub out: Option<PathBuf>,
+    #[command(flatten)]
+    pub options: DiscoverOptions,
     /// Print the summary as one JSON object on stdout (progress stays on stderr).
     #[arg(long)]
     pub json: bool,
-    /// Seed of every random step (sampling, predictive replicates).
-    #[arg(long, default_value_t = 0)]
-    pub seed: u64,
-    /// Catalogue entries to try, comma-separated (default: all; see --list).
-    #[arg(long, value_delimiter = ',')]
-    pub only: Vec<String>,
     /// List the catalogue and exit.
     #[arg(long)]
     pub list: bool,
-    /// Smallest Laplace ln Bayes factor for an extension to be added.
-    #[arg(long, default_value_t = 3.0)]
-    pub min_ln_bayes: f64,
-    /// Target bulk and tail ESS of the MCMC fits.
-    #[arg(long, default_value_t = 1000.0)]
-    pub ess: f64,
-    /// Stop each MCMC fit after this many seconds even if its targets are not reached.
-    #[arg(long, default_value_t = 300.0)]
-    pub max_seconds: f64,
-    /// Write no figures.
-    #[arg(long)]
-    pub no_plots: bool,
-    /// Fit and score on the surrogate wherever it can (MCMC, fast) instead of the exact solver
-    /// (Laplace; the default, because the surrogate is up to 27% off on z-only profiles).
-    #[arg(long)]
-    pub surrogate_only: bool,
-    #[command(flatten)]
-    pub grid: super::args::GridArgs,
 }
 
 /// Stage lines and the sampler's progress on stderr.
@@ -103,22 +52,6 @@ impl<F: Fn(&Status) + Sync> Progress for Printer<F> {
     }
 }
 
-/// The prior file of `--start-model`: a path, or priors/<name>.toml.
-fn start_prior(name: &str) -> Result<PathBuf> {
-    let p = PathBuf::from(name);
-    if p.is_file() {
-        return Ok(p);
-    }
-    let named = Path::new("priors").join(format!("{name}.toml"));
-    if named.is_file() {
-        return Ok(named);
-    }
-    anyhow::bail!(
-        "--start-model {name}: neither a prior file nor a name in priors/ ({} does not exist)",
-        named.display()
-    )
-}
-
 /// Runs `discover`.
 pub fn run(a: &DiscoverArgs) -> Result<()> {
     if a.list {
@@ -133,48 +66,20 @@ pub fn run(a: &DiscoverArgs) -> Result<()> {
         }
         return Ok(());
     }
-    let names: Vec<&str> = catalogue().iter().map(|e| e.name()).collect();
-    for o in &a.only {
-        if !names.contains(&o.as_str()) {
-            anyhow::bail!(
-                "--only {o}: no such catalogue entry; the entries are {}",
-                names.join(", ")
-            );
-        }
-    }
-    let prior_file = start_prior(&a.start_model)?;
-    let noise = noise_settings("paper")?;
-    let s = setup(&a.data, &a.model, &prior_file, &a.detector, noise, &a.grid)?;
+    let o = &a.options;
+    let w = &o.workflow;
+    w.check_only()?;
+    let prior_file = o.start_prior()?;
+    let noise = noise_settings(NoiseKind::Paper.as_str())?;
+    let s = setup(&w.data, &w.model, &prior_file, &w.detector, noise, &w.grid)?;
     let spec = PriorSpec::from_file(&prior_file)?;
-    let out = a.out.clone().unwrap_or_else(|| {
-        PathBuf::from("discoveries").join(
-            prior_file
-                .file_stem()
-                .map_or("discovery".into(), |s| s.to_string_lossy().to_string()),
-        )
-    });
+    let out = o.out_dir(&prior_file);
     std::fs::create_dir_all(&out)
         .with_context(|| format!("--out {}: cannot create the folder", out.display()))?;
-    let mut sample = SampleSettings::for_sampler(SamplerKind::Metropolis);
-    sample.seed = a.seed;
-    sample.ess_min = a.ess;
-    sample.max_seconds = a.max_seconds;
-    sample.validate()?;
-    let settings = DiscoverSettings {
-        fit: FitSettings {
-            sample,
-            noise,
-            ..FitSettings::default()
-        },
-        min_ln_bayes: a.min_ln_bayes,
-        exact: !a.surrogate_only,
-        only: a.only.clone(),
-        seed: a.seed,
-        ..DiscoverSettings::default()
-    };
+    let settings = o.settings(noise)?;
     eprintln!(
         "discover: {} ({} voltages), start model {} ({} parameters), {}",
-        a.data.display(),
+        w.data.display(),
         s.data.voltage_v.len(),
         prior_file.display(),
         s.prior.dim(),
@@ -197,7 +102,7 @@ pub fn run(a: &DiscoverArgs) -> Result<()> {
         &printer,
     )?;
     bar.finish_and_clear();
-    hpge_reports::discover::write_outputs(&out, &d, &s.exact, a.no_plots)?;
+    hpge_reports::discover::write_outputs(&out, &d, &s.exact, w.no_plots)?;
     if a.json {
         println!("{}", serde_json::to_string_pretty(&d.summary)?);
     } else {

@@ -10,9 +10,10 @@ use hpge_solver::drift::ElectricField;
 use hpge_solver::drift::field_line;
 use serde_json::json;
 
+use super::DetectorInput;
 use super::args::{RadiusRange, load_detector, parse_r_range};
 use super::simulate::backend_json;
-use super::{DetectorInput, SolverArgs, WeightingArg};
+use hpge_solver::options::{SolverOptions, WeightingOptions};
 
 /// V/m per V/cm.
 const V_PER_M_PER_V_PER_CM: f64 = 100.0;
@@ -35,7 +36,7 @@ pub struct FieldArgs {
     #[arg(long = "r-range", value_name = "LO:HI:N", value_parser = parse_r_range)]
     r_range: Option<RadiusRange>,
     #[command(flatten)]
-    solver: SolverArgs,
+    solver: SolverOptions,
     /// Print exactly one JSON object on stdout (|E| null where there is no field).
     #[arg(long)]
     json: bool,
@@ -79,10 +80,11 @@ pub fn run(a: &FieldArgs) -> Result<()> {
             .map(|k| b.r_min_mm + (b.r_max_mm - b.r_min_mm) * k as f64 / 200.0)
             .collect(),
     };
-    let settings = a
-        .solver
-        .grid
-        .apply(&a.solver.settings(WeightingArg::Conductor), &det)?;
+    let settings = a.solver.grid.apply(
+        &a.solver
+            .field_settings(WeightingOptions::default().weighting),
+        &det,
+    )?;
     backend_json(&settings)?;
     let point = hpge_solver::solve_point(&det, a.voltage, &settings, None)?;
     let field = ElectricField::new(&det, &point);

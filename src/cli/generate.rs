@@ -5,31 +5,24 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Result;
 use hpge_solver::{Detector, FieldSettings, Parameters};
-use hpge_surrogate::{Generator, ParameterSpace, SequenceKind, Shard, merge, run};
+use hpge_surrogate::job::GenerateOptions;
+use hpge_surrogate::{Generator, ParameterSpace, merge, run};
 use indicatif::{ProgressBar, ProgressStyle};
 
-/// Options of `generate`.
-pub struct GenerateOptions<'a> {
-    pub space: &'a Path,
-    pub detector: &'a Path,
-    pub n: u64,
-    pub out: &'a Path,
-    pub shard: Shard,
-    pub offset: u64,
-    pub threads: Option<usize>,
-    pub seed: u64,
-    pub sequence: SequenceKind,
-    pub curve_points: u64,
-    pub grid: &'a super::args::GridArgs,
-}
-
 /// Runs or resumes a generation.
-pub fn generate(o: &GenerateOptions<'_>) -> Result<()> {
-    let space = ParameterSpace::from_file(o.space)?;
-    let det = Detector::from_file(o.detector, &Parameters::new())?;
+pub fn generate(o: &GenerateOptions) -> Result<()> {
+    let space = ParameterSpace::from_file(&o.space)?;
+    let det = Detector::from_file(&o.detector, &Parameters::new())?;
     let settings = o.grid.apply(&FieldSettings::default(), &det)?;
     let g = Generator::new(
-        space, o.detector, settings, o.sequence, o.seed, o.offset, o.n, o.shard,
+        space,
+        &o.detector,
+        settings,
+        o.sequence,
+        o.seed,
+        o.offset,
+        o.n,
+        o.shard,
     )?
     .with_curve_points(o.curve_points)?;
     let bar = ProgressBar::new(0);
@@ -40,7 +33,7 @@ pub fn generate(o: &GenerateOptions<'_>) -> Result<()> {
         .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     let start = std::time::Instant::now();
-    let report = run(&g, o.out, o.threads, |done, total| {
+    let report = run(&g, &o.out, o.threads, |done, total| {
         bar.set_length(total as u64);
         bar.set_position(done as u64);
     });

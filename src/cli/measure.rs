@@ -6,45 +6,24 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result, bail};
 use hpge_measurement::synth::voltage_seed;
 use hpge_measurement::{
-    MeasureSettings, Measurement, PulseSet, RawProblem, SynthSettings, depletion_voltage, measure,
+    MeasureOptions, Measurement, PulseSet, RawProblem, SynthOptions, depletion_voltage, measure,
     read_raw_dir, synthesize_voltage, write_curve_with_comments, write_pulses,
 };
 use hpge_reports::plot;
 use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::json;
 
-/// Options of `measure`.
-pub struct MeasureOptions<'a> {
-    pub raw: &'a Path,
-    pub out: &'a Path,
-    pub plot: Option<&'a PathBuf>,
-    pub settings: Option<&'a PathBuf>,
-    pub json: bool,
-}
-
-/// The settings: `--settings FILE`, else `<raw>/measurement.toml` if present, else defaults.
-fn settings_for(raw: &Path, explicit: Option<&PathBuf>) -> Result<(MeasureSettings, String)> {
-    let path = match explicit {
-        Some(p) => Some(p.clone()),
-        None => Some(raw.join("measurement.toml")).filter(|p| p.is_file()),
-    };
-    Ok(match path {
-        Some(p) => (MeasureSettings::from_file(&p)?, p.display().to_string()),
-        None => (MeasureSettings::default(), "defaults".to_string()),
-    })
-}
-
 /// Runs the measurement pipeline and writes the curve, its covariance, a JSON report and the
 /// figures.
-pub fn run(o: &MeasureOptions<'_>) -> Result<()> {
-    if let Some(dir) = o.plot
+pub fn run(o: &MeasureOptions, plot: Option<&PathBuf>, json: bool) -> Result<()> {
+    if let Some(dir) = plot
         && !dir.is_dir()
     {
         std::fs::create_dir_all(dir)
             .with_context(|| format!("--plot {}: cannot create the folder", dir.display()))?;
     }
-    let (settings, settings_source) = settings_for(o.raw, o.settings)?;
-    let run = read_raw_dir(o.raw, settings.voltages_v.as_deref())?;
+    let (settings, settings_source) = o.measure_settings()?;
+    let run = read_raw_dir(&o.raw, settings.voltages_v.as_deref())?;
     for p in &run.problems {
         eprintln!(
             "problem: {}{}: {}",
@@ -60,7 +39,7 @@ pub fn run(o: &MeasureOptions<'_>) -> Result<()> {
     );
     bar.set_message(format!("{} pulse files", run.sets.len()));
     bar.enable_steady_tick(std::time::Duration::from_millis(200));
-    let m = measure(&run.sets, &settings, o.raw);
+    let m = measure(&run.sets, &settings, &o.raw);
     bar.finish_and_clear();
     let m = m?;
     for p in &m.problems {
@@ -83,15 +62,15 @@ pub fn run(o: &MeasureOptions<'_>) -> Result<()> {
             settings.uncertainties
         ),
     ];
-    write_curve_with_comments(o.out, &m.curve, &comments)?;
-    let report = report_json(&m, o.raw, &settings_source, &run.problems);
+    write_curve_with_comments(&o.out, &m.curve, &comments)?;
+    let report = report_json(&m, &o.raw, &settings_source, &run.problems);
     let report_path = o.out.with_extension("measure.json");
     std::fs::write(&report_path, format!("{report:#}\n"))
         .with_context(|| format!("{}: cannot write the report", report_path.display()))?;
-    if let Some(dir) = o.plot {
+    if let Some(dir) = plot {
         plot::measurement(&m, &run.sets, dir)?;
     }
-    if o.json {
+    if json {
         println!("{report}");
     } else {
         println!(
@@ -165,15 +144,6 @@ fn report_json(
     })
 }
 
-/// Options of `synthesize`.
-pub struct SynthOptions<'a> {
-    pub curve: &'a Path,
-    pub out: &'a Path,
-    pub seed: u64,
-    pub depletion_v: Option<f64>,
-    pub settings: SynthSettings,
-}
-
 /// Reads a curve CSV with columns `voltage_V` and `c12_pF` (the output of `simulate --out` or a
 /// measured curve).
 fn read_truth(path: &Path) -> Result<(Vec<f64>, Vec<f64>)> {
@@ -220,12 +190,13 @@ fn read_truth(path: &Path) -> Result<(Vec<f64>, Vec<f64>)> {
 
 /// Writes one pulse file per bias (`U<bias>V.npy` + sidecar), `measurement.toml` listing the
 /// biases, and `truth.json` with the curve, seed and settings.
-pub fn synthesize(o: &SynthOptions<'_>) -> Result<()> {
-    o.settings
+pub fn synthesize(o: &SynthOptions) -> Result<()> {
+    let settings = o.settings();
+    settings
         .validate()
         .map_err(|m| anyhow::anyhow!("synthesis settings: {m}"))?;
-    let (volts, c12) = read_truth(o.curve)?;
-    let ufd = match o.depletion_v {
+    let (volts, c12) = read_truth(&o.curve)?;
+    let ufd = match o.depletion_voltage {
         Some(v) if v.is_finite() && v > 0.0 => v,
         Some(v) => bail!("--depletion-voltage {v}: must be a positive number of volts"),
         None => depletion_voltage(&volts, &c12, 1e-3).with_context(|| {
@@ -235,7 +206,7 @@ pub fn synthesize(o: &SynthOptions<'_>) -> Result<()> {
             )
         })?,
     };
-    std::fs::create_dir_all(o.out)
+    std::fs::create_dir_all(&o.out)
         .with_context(|| format!("--out {}: cannot create the folder", o.out.display()))?;
     let bar = ProgressBar::new(volts.len() as u64);
     bar.set_style(
@@ -243,7 +214,7 @@ pub fn synthesize(o: &SynthOptions<'_>) -> Result<()> {
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     for (k, (&u, &c)) in volts.iter().zip(&c12).enumerate() {
-        let v = synthesize_voltage(u, c, ufd, &o.settings, voltage_seed(o.seed, k))?;
+        let v = synthesize_voltage(u, c, ufd, &settings, voltage_seed(o.seed, k))?;
         let name = o.out.join(format!("U{:04}V.npy", u.round() as i64));
         let set = PulseSet {
             source: name.clone(),
@@ -274,7 +245,7 @@ pub fn synthesize(o: &SynthOptions<'_>) -> Result<()> {
         "c12_pF": c12,
         "depletion_voltage_V": ufd,
         "seed": o.seed,
-        "settings": o.settings,
+        "settings": settings,
         "version": env!("CARGO_PKG_VERSION"),
     });
     let truth_path = o.out.join("truth.json");

@@ -18,9 +18,10 @@ use hpge_solver::drift::rise_time_10_90_ns;
 use hpge_solver::{Detector, Pulse};
 use serde_json::json;
 
+use super::DetectorInput;
 use super::args::{load_detector, parse_cylindrical};
 use super::simulate::backend_json;
-use super::{DetectorInput, SolverArgs, WeightingArg};
+use hpge_solver::options::{SolverOptions, WeightingOptions};
 
 #[derive(Debug, clap::Args)]
 pub struct PulseArgs {
@@ -33,7 +34,7 @@ pub struct PulseArgs {
     #[arg(long, value_name = "R,PHI,Z", allow_hyphen_values = true, value_parser = parse_cylindrical)]
     at: (f64, f64, f64),
     #[command(flatten)]
-    solver: SolverArgs,
+    solver: SolverOptions,
     /// ADL drift-model parameters (TOML with the keys of the published defaults: e100, e111,
     /// h100, h111 tables of mu0_cm2_per_vs, beta, e0_v_per_cm, mun_cm2_per_vs; ml_over_me,
     /// mt_over_me, phi110_deg); missing keys keep the published 78 K values.
@@ -101,10 +102,11 @@ pub fn run(a: &PulseArgs) -> Result<()> {
         };
         return Err(anyhow::Error::new(e).context(flag));
     }
-    let settings = a
-        .solver
-        .grid
-        .apply(&a.solver.settings(WeightingArg::Conductor), &det)?;
+    let settings = a.solver.grid.apply(
+        &a.solver
+            .field_settings(WeightingOptions::default().weighting),
+        &det,
+    )?;
     backend_json(&settings)?;
     let point = hpge_solver::solve_point(&det, a.voltage, &settings, None)?;
     let field = ElectricField::new(&det, &point);

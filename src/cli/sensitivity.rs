@@ -8,32 +8,12 @@ use std::path::PathBuf;
 use anyhow::{Context, Result, bail};
 use hpge_reports::plot;
 use hpge_solver::FieldSettings;
-use hpge_solver::scan::{log_spaced, sensitivity_scan};
+use hpge_solver::scan::sensitivity_scan;
 use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::json;
 
 use super::DetectorInput;
 use super::args::load_detector;
-
-/// Parses `MIN:MAX:N`: N densities (cm^-3) spaced evenly in log between MIN and MAX (> 0).
-pub fn parse_range(s: &str) -> Result<Vec<f64>, String> {
-    let parts: Vec<&str> = s.split(':').map(str::trim).collect();
-    let [a, b, n] = parts.as_slice() else {
-        return Err(format!("`{s}`: expected MIN:MAX:N, e.g. 1e7:2e11:17"));
-    };
-    let num = |t: &str| t.parse::<f64>().map_err(|e| format!("`{t}` in `{s}`: {e}"));
-    let (lo, hi) = (num(a)?, num(b)?);
-    let n: usize = n
-        .parse()
-        .map_err(|e| format!("`{n}` in `{s}`: the count must be a whole number ({e})"))?;
-    if !(lo.is_finite() && hi.is_finite() && lo > 0.0 && hi > lo) {
-        return Err(format!("`{s}`: need 0 < MIN < MAX (densities in cm^-3)"));
-    }
-    if !(2..=1000).contains(&n) {
-        return Err(format!("`{s}`: the count N must lie in 2..=1000, got {n}"));
-    }
-    log_spaced(lo, hi, n).map_err(|e| format!("`{s}`: {e}"))
-}
 
 /// Options of `sensitivity`.
 pub struct SensitivityOptions<'a> {
@@ -120,26 +100,4 @@ pub fn run(o: &SensitivityOptions<'_>) -> Result<()> {
         );
     }
     Ok(())
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn ranges() {
-        let r = parse_range("1e7:1e11:5").unwrap();
-        assert_eq!(r.len(), 5);
-        for (a, b) in r.iter().zip([1e7, 1e8, 1e9, 1e10, 1e11]) {
-            assert!((a / b - 1.0).abs() < 1e-12);
-        }
-        assert!(parse_range("1e7:1e11").is_err());
-        assert!(
-            parse_range("0:1e11:5")
-                .unwrap_err()
-                .contains("0 < MIN < MAX")
-        );
-        assert!(parse_range("1e7:1e11:1").unwrap_err().contains("2..=1000"));
-        assert!(parse_range("1e7:x:5").is_err());
-    }
 }

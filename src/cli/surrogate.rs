@@ -5,23 +5,12 @@ use std::path::Path;
 
 use anyhow::{Context, Result};
 use hpge_surrogate::Surrogate;
-use hpge_surrogate::job::{Evaluation, TrainEvent, TrainJob, parse_params, read_for_model};
+use hpge_surrogate::job::{
+    EvaluateOptions, Evaluation, PredictOptions, TrainEvent, TrainJob, parse_params, read_for_model,
+};
 use hpge_surrogate::model::EpochRecord;
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
-
-/// Options of `train`.
-pub struct TrainOptions<'a> {
-    pub data: &'a Path,
-    pub test: &'a Path,
-    pub space: &'a Path,
-    pub recipe: &'a str,
-    pub out: &'a Path,
-    pub seed: u64,
-    pub plot: Option<&'a Path>,
-    pub quiet: bool,
-    pub detector: Option<&'a Path>,
-}
 
 /// The progress bar of network training (hidden when quiet) and, when stderr is not a terminal,
 /// one log line per epoch.
@@ -111,29 +100,20 @@ impl TrainProgress<'_> {
 }
 
 /// Trains, evaluates on the test set and writes the model file and its learning curves.
-pub fn train(o: &TrainOptions) -> Result<()> {
-    let job = TrainJob {
-        data: o.data.into(),
-        test: o.test.into(),
-        space: o.space.into(),
-        recipe: o.recipe.into(),
-        seed: o.seed,
-        detector: o.detector.map(Into::into),
-        out: o.out.into(),
-    };
+pub fn train(job: &TrainJob, plot: Option<&Path>, quiet: bool) -> Result<()> {
     job.check_out().map_err(|e| anyhow::anyhow!("--out {e}"))?;
-    if let Some(dir) = o.plot {
+    if let Some(dir) = plot {
         std::fs::create_dir_all(dir)
             .with_context(|| format!("--plot {}: cannot create the folder", dir.display()))?;
     }
     let mut progress = TrainProgress {
-        recipe: o.recipe,
-        quiet: o.quiet,
+        recipe: &job.recipe,
+        quiet,
         bar: None,
     };
     let outcome = job.run(&mut |e| progress.event(e))?;
     let model = &outcome.model;
-    if let Some(dir) = o.plot {
+    if let Some(dir) = plot {
         if !outcome.curves.is_empty() {
             hpge_reports::plot::learning_curves(&outcome.curves, &model.info, dir)?;
         }
@@ -146,7 +126,7 @@ pub fn train(o: &TrainOptions) -> Result<()> {
         )?;
     }
     let f = &model.info.test_figures;
-    if !o.quiet {
+    if !quiet {
         eprintln!(
             "trained in {:.1} s; test set: sigma {:.3}%, mean {:+.3}%, |rel| q50 {:.3}% q90 \
              {:.3}% q99 {:.3}% max {:.2}%",
@@ -158,7 +138,7 @@ pub fn train(o: &TrainOptions) -> Result<()> {
             100.0 * f.abs_rel_q99,
             100.0 * f.abs_rel_max
         );
-        eprintln!("wrote {}", o.out.display());
+        eprintln!("wrote {}", job.out.display());
         if let Some(file) = &outcome.curves_file {
             eprintln!("wrote {}", file.display());
         }
@@ -166,25 +146,16 @@ pub fn train(o: &TrainOptions) -> Result<()> {
     Ok(())
 }
 
-/// Options of `evaluate`.
-pub struct EvaluateOptions<'a> {
-    pub model: &'a Path,
-    pub data: &'a Path,
-    pub json: bool,
-    pub plot: Option<&'a Path>,
-    pub worst: usize,
-}
-
 /// Accuracy of a model on a data set of its space.
-pub fn evaluate(o: &EvaluateOptions) -> Result<()> {
-    let model = Surrogate::load(o.model)?;
-    if let Some(dir) = o.plot {
+pub fn evaluate(o: &EvaluateOptions, json: bool, plot: Option<&Path>) -> Result<()> {
+    let model = Surrogate::load(&o.model)?;
+    if let Some(dir) = plot {
         std::fs::create_dir_all(dir)
             .with_context(|| format!("--plot {}: cannot create the folder", dir.display()))?;
     }
-    let data = read_for_model(&model, o.model, o.data)?;
+    let data = read_for_model(&model, &o.model, &o.data)?;
     let ev = Evaluation::new(&model, &data, o.worst);
-    if let Some(dir) = o.plot {
+    if let Some(dir) = plot {
         hpge_reports::plot::surrogate_errors(
             &ev.predictions,
             &data.c12_pf,
@@ -193,8 +164,8 @@ pub fn evaluate(o: &EvaluateOptions) -> Result<()> {
             dir,
         )?;
     }
-    if o.json {
-        println!("{}", serde_json::to_string(&ev.json(o.model, o.data))?);
+    if json {
+        println!("{}", serde_json::to_string(&ev.json(&o.model, &o.data))?);
         return Ok(());
     }
     let f = &ev.figures;
@@ -244,15 +215,6 @@ pub fn evaluate(o: &EvaluateOptions) -> Result<()> {
     Ok(())
 }
 
-/// Options of `predict`.
-pub struct PredictOptions<'a> {
-    pub model: &'a Path,
-    pub params: &'a [String],
-    pub voltages: &'a [f64],
-    pub json: bool,
-    pub jacobian: bool,
-}
-
 #[derive(Debug, Serialize)]
 struct PredictJson<'a> {
     model: String,
@@ -268,11 +230,12 @@ struct PredictJson<'a> {
 }
 
 /// c12 along a curve from a model file.
-pub fn predict(o: &PredictOptions) -> Result<()> {
-    let model = Surrogate::load(o.model)?;
-    let params = parse_params(&model, o.params).map_err(|e| anyhow::anyhow!("--params: {e}"))?;
-    let u = model.voltages(o.voltages)?;
-    let n = o.voltages.len();
+pub fn predict(o: &PredictOptions, json: bool) -> Result<()> {
+    let model = Surrogate::load(&o.model)?;
+    let params = parse_params(&model, &o.params).map_err(|e| anyhow::anyhow!("--params: {e}"))?;
+    let voltages = &o.voltages.0;
+    let u = model.voltages(voltages)?;
+    let n = voltages.len();
     let mut c = vec![0.0; n];
     let mut spread = vec![0.0; n];
     model.curve_into(&params, &u, &mut c, Some(&mut spread))?;
@@ -287,7 +250,7 @@ pub fn predict(o: &PredictOptions) -> Result<()> {
     };
     let sigma: Vec<f64> = c.iter().map(|c| model.sigma_p() * c).collect();
     let ensemble = model.members() > 1;
-    if o.json {
+    if json {
         let j = PredictJson {
             model: o.model.display().to_string(),
             recipe: &model.info.recipe_name,
@@ -297,7 +260,7 @@ pub fn predict(o: &PredictOptions) -> Result<()> {
                 .map(|s| s.to_string())
                 .zip(params.iter().copied())
                 .collect(),
-            voltages_v: o.voltages,
+            voltages_v: voltages,
             c12_pf: c,
             sigma_pf: sigma,
             ensemble_spread_pf: ensemble.then_some(spread),
@@ -325,7 +288,7 @@ pub fn predict(o: &PredictOptions) -> Result<()> {
     }
     println!("{header}");
     for k in 0..n {
-        let mut line = format!("{},{:.6},{:.6}", o.voltages[k], c[k], sigma[k]);
+        let mut line = format!("{},{:.6},{:.6}", voltages[k], c[k], sigma[k]);
         if ensemble {
             line += &format!(",{:.6}", spread[k]);
         }

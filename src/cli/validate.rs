@@ -1,73 +1,30 @@
 //! `hpge-cv validate coverage`: simulation-based calibration of the fit.
 
 use std::io::Write as _;
-use std::path::Path;
 
-use anyhow::{Context, Result, bail};
-use hpge_inference::{CvModel, ExactModel, FitSettings, SampleSettings};
-use hpge_validation::{CoverageSettings, coverage as run_coverage};
+use anyhow::{Context, Result};
+use hpge_inference::{CvModel, ExactModel};
+use hpge_validation::{CoverageOptions, coverage as run_coverage};
 use indicatif::{ProgressBar, ProgressStyle};
-
-use hpge_inference::fit::{noise_settings, sampler_kind};
 
 use super::fit::setup;
 
-/// Options of `validate coverage`.
-pub struct CoverageOptions<'a> {
-    pub truths: usize,
-    pub json: bool,
-    pub prior: &'a Path,
-    pub model: &'a Path,
-    pub data: &'a Path,
-    pub detector: &'a Path,
-    pub exact: bool,
-    pub likelihood: &'a str,
-    pub sampler: &'a str,
-    pub seed: u64,
-    pub ess: f64,
-    pub ranks: usize,
-    pub mode_starts: usize,
-    pub out: &'a Path,
-}
-
 /// Runs the study, writes coverage.json, ranks.csv and figures; exit code 1 if it fails.
-pub fn coverage(o: &CoverageOptions) -> Result<()> {
-    if o.truths < 2 {
-        bail!("--truths {}: need at least 2 truths", o.truths);
-    }
-    if o.ranks < 9 {
-        bail!("--ranks {}: need at least 9 draws to rank among", o.ranks);
-    }
-    let kind = sampler_kind(o.sampler)?;
-    let noise = noise_settings(o.likelihood)?;
+pub fn coverage(o: &CoverageOptions, as_json: bool) -> Result<()> {
+    let settings = o.settings()?;
+    let kind = settings.fit.sample.sampler;
     let s = setup(
-        o.data,
-        o.model,
-        o.prior,
-        o.detector,
-        noise,
+        &o.data,
+        &o.model,
+        &o.prior,
+        &o.detector,
+        settings.fit.noise,
         &super::args::GridArgs::default(),
     )?;
-    let mut sample = SampleSettings::for_sampler(kind);
-    sample.ess_min = o.ess;
-    // A study needs many fits: a fit that has not reached its ESS after 20 000 kept draws per
-    // chain (or a minute) stops there and is counted as unconverged.
-    sample.max_seconds = 60.0;
-    sample.max_draws = 20_000;
-    sample.mode_starts = o.mode_starts;
-    sample.validate()?;
-    let settings = CoverageSettings {
-        n_truths: o.truths,
-        seed: o.seed,
-        fit: FitSettings {
-            sample,
-            noise,
-            ..FitSettings::default()
-        },
-        ranks: o.ranks,
-    };
-    std::fs::create_dir_all(o.out)
-        .with_context(|| format!("--out {}: cannot create the folder", o.out.display()))?;
+    let out = o.out_dir();
+    let out = out.as_path();
+    std::fs::create_dir_all(out)
+        .with_context(|| format!("--out {}: cannot create the folder", out.display()))?;
     let exact;
     let (data_model, data_sigma): (&dyn CvModel, f64) = if o.exact {
         exact = ExactModel::new(s.exact.clone(), &s.data.voltage_v)?;
@@ -120,10 +77,10 @@ pub fn coverage(o: &CoverageOptions) -> Result<()> {
         );
         obj.insert("settings".into(), serde_json::to_value(settings)?);
     }
-    let path = o.out.join("coverage.json");
+    let path = out.join("coverage.json");
     std::fs::write(&path, serde_json::to_string_pretty(&json)? + "\n")
         .with_context(|| format!("cannot write {}", path.display()))?;
-    let path = o.out.join("ranks.csv");
+    let path = out.join("ranks.csv");
     let mut w = std::io::BufWriter::new(
         std::fs::File::create(&path)
             .with_context(|| format!("cannot create {}", path.display()))?,
@@ -150,11 +107,11 @@ pub fn coverage(o: &CoverageOptions) -> Result<()> {
     }
     w.flush()?;
     hpge_reports::plot::coverage_figures(
-        &o.out.join("figures"),
+        &out.join("figures"),
         &report,
         &format!("{} coverage", o.prior.display()),
     )?;
-    if o.json {
+    if as_json {
         // The fields first: n_truths, parameters (name, ks_p, coverage_683,
         // coverage_955), pass; the full record is in coverage.json.
         let brief = serde_json::json!({
@@ -195,7 +152,7 @@ pub fn coverage(o: &CoverageOptions) -> Result<()> {
                 p.expected_955[1]
             );
         }
-        println!("outputs in {}", o.out.display());
+        println!("outputs in {}", out.display());
     }
     if !report.pass {
         std::process::exit(1);

@@ -8,7 +8,7 @@
 //!   [`problems::coax`]) and the high-precision radial 1D reference ([`problems::radial1d`]).
 //! - [`studies`]: c12 accuracy against a 4x finer grid ([`studies::accuracy`]), simulation-based
 //!   calibration of the fit ([`studies::coverage`]) and hidden-effect tests of model discovery
-//!   ([`studies::hidden`]).
+//!   ([`studies::hidden`]), with the options a user gives them ([`studies::options`]).
 //!
 //! The names most users need first are re-exported here; the rest live at their module paths
 //! (e.g. [`studies::coverage::ks_uniform`], [`problems::radial1d::DEFAULT_NODES`]).
@@ -42,3 +42,4 @@ pub use repo::repo_path;
 pub use studies::accuracy::{AccuracyCase, AccuracyRow, accuracy_cases, accuracy_row};
 pub use studies::coverage::{CoverageReport, CoverageSettings, coverage};
 pub use studies::hidden::{HiddenEffect, HiddenOutcome, hidden_effects, run_hidden};
+pub use studies::options::{CoverageOptions, HiddenOptions};

@@ -9,6 +9,7 @@ mod checks;
 mod elpd_linear;
 mod fits;
 mod laplace;
+mod options;
 mod region;
 mod run;
 mod settings;
@@ -23,7 +24,10 @@ pub use checks::{
     Elpd, PredictiveDraws, ResidualCheck, Window, delta_elpd, leave_window_out, residual_check,
 };
 pub use laplace::{LaplaceFit, LaplaceSettings, laplace_fit};
+pub use options::{DEFAULT_START_MODEL, DiscoverOptions, WorkflowOptions};
 pub use region::{ProbedRegion, probed_region};
 pub use run::discover;
-pub use settings::{DiscoverInputs, DiscoverSettings, Discovery, ModelFit, Progress};
+pub use settings::{
+    DEFAULT_MIN_LN_BAYES, DiscoverInputs, DiscoverSettings, Discovery, ModelFit, Progress,
+};
 pub use summary::{CandidateScore, Disagreement, DiscoverySummary, Gap, NotApplicable};

@@ -16,6 +16,10 @@ use crate::prior::PriorSpec;
 use crate::sampler::Status;
 use crate::{Error, Result};
 
+/// Smallest Laplace ln Bayes factor for an extension to be chosen: 3 is "strong" evidence on
+/// Kass & Raftery's (1995) scale (2 ln B > 6).
+pub const DEFAULT_MIN_LN_BAYES: f64 = 3.0;
+
 /// Settings of the workflow.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct DiscoverSettings {
@@ -54,7 +58,7 @@ impl Default for DiscoverSettings {
             laplace: LaplaceSettings::default(),
             min_run: 3,
             window_p: 0.01,
-            min_ln_bayes: 3.0,
+            min_ln_bayes: DEFAULT_MIN_LN_BAYES,
             elpd_blocks: 10,
             draws: 1000,
             exact: true,

@@ -9,7 +9,10 @@ use hpge_solver::GridOverrides;
 use super::job::FitFiles;
 use super::run::FitSettings;
 use crate::posterior::{NoiseKind, NoiseSettings};
-use crate::sampler::{SampleSettings, SamplerKind};
+use crate::sampler::{
+    DEFAULT_CHAINS, DEFAULT_ESS_MIN, DEFAULT_MODE_STARTS, DEFAULT_RHAT_MAX, DEFAULT_SEED,
+    SampleSettings, SamplerKind,
+};
 use crate::{Error, Result};
 
 /// The shipped Super-Siegfried curve (a stand-in made by this program; data/super-siegfried-k1/).
@@ -20,6 +23,13 @@ pub const DEFAULT_MODEL: &str = "models/super-siegfried-rz-split.safetensors";
 pub const DEFAULT_PRIOR: &str = "priors/b-rz.toml";
 /// The detector of the shipped data.
 pub const DEFAULT_DETECTOR: &str = "detectors/super-siegfried-k1.toml";
+/// Posterior draws a fit re-weights with the exact solver.
+pub const DEFAULT_EXACT_DRAWS: usize = 100;
+/// Sampling budget (s) of a fit on the command line (`fit`, and each MCMC fit of `discover`):
+/// five minutes, so that a fit that cannot reach its targets returns (unconverged, exit code 3)
+/// while a user waits; the shipped fit converges in about 30 s. Half the library's budget
+/// ([`crate::sampler::DEFAULT_MAX_SECONDS`]), which is meant for unattended runs.
+pub const FIT_MAX_SECONDS: f64 = 300.0;
 
 /// Everything a user chooses about a fit.
 #[derive(Debug, Clone, PartialEq)]
@@ -46,33 +56,33 @@ pub struct FitOptions {
     #[cfg_attr(feature = "clap", arg(long, value_name = "DIR"))]
     pub out: Option<PathBuf>,
     /// Sampler: metropolis (adaptive, like BAT.jl's default) or nuts.
-    #[cfg_attr(feature = "clap", arg(long, default_value = "metropolis"))]
+    #[cfg_attr(feature = "clap", arg(long, default_value = SamplerKind::default().as_str()))]
     pub sampler: String,
     /// Seed of the sampler (starting points, proposals).
-    #[cfg_attr(feature = "clap", arg(long, default_value_t = 0))]
+    #[cfg_attr(feature = "clap", arg(long, default_value_t = DEFAULT_SEED))]
     pub seed: u64,
     /// Skip the exact-solver re-weighting check.
     #[cfg_attr(feature = "clap", arg(long))]
     pub no_exact_check: bool,
     /// Posterior draws re-weighted with the exact solver (about 1 s of solver time each on 2
     /// cores... 0.6 s per curve per core).
-    #[cfg_attr(feature = "clap", arg(long, default_value_t = 100))]
+    #[cfg_attr(feature = "clap", arg(long, default_value_t = DEFAULT_EXACT_DRAWS))]
     pub exact_draws: usize,
     /// Likelihood: paper (independent, 3% measurement term) or covariance (the measured
     /// covariance instead of the 3% term).
-    #[cfg_attr(feature = "clap", arg(long, default_value = "paper"))]
+    #[cfg_attr(feature = "clap", arg(long, default_value = NoiseKind::default().as_str()))]
     pub likelihood: String,
     /// Chains (run in parallel).
-    #[cfg_attr(feature = "clap", arg(long, default_value_t = 4))]
+    #[cfg_attr(feature = "clap", arg(long, default_value_t = DEFAULT_CHAINS))]
     pub chains: usize,
     /// Target bulk and tail ESS of every parameter.
-    #[cfg_attr(feature = "clap", arg(long, default_value_t = 1000.0))]
+    #[cfg_attr(feature = "clap", arg(long, default_value_t = DEFAULT_ESS_MIN))]
     pub ess: f64,
     /// Target R-hat (rank-normalised, split).
-    #[cfg_attr(feature = "clap", arg(long, default_value_t = 1.01))]
+    #[cfg_attr(feature = "clap", arg(long, default_value_t = DEFAULT_RHAT_MAX))]
     pub rhat: f64,
     /// Stop sampling after this many seconds even if the targets are not reached.
-    #[cfg_attr(feature = "clap", arg(long, default_value_t = 300.0))]
+    #[cfg_attr(feature = "clap", arg(long, default_value_t = FIT_MAX_SECONDS))]
     pub max_seconds: f64,
     /// Known parameter values (TOML NAME = VALUE) to mark on the figures and check against the
     /// smallest intervals, e.g. data/super-siegfried-k1/truth-b-rz.toml.
@@ -82,7 +92,7 @@ pub struct FitOptions {
     #[cfg_attr(feature = "clap", arg(long))]
     pub no_plots: bool,
     /// Nelder-Mead starts of the mode search before sampling (0: none).
-    #[cfg_attr(feature = "clap", arg(long, default_value_t = 24))]
+    #[cfg_attr(feature = "clap", arg(long, default_value_t = DEFAULT_MODE_STARTS))]
     pub mode_starts: usize,
     /// The exact solver's grid and accuracy.
     #[cfg_attr(feature = "clap", command(flatten))]
@@ -98,18 +108,18 @@ impl Default for FitOptions {
             prior: DEFAULT_PRIOR.into(),
             detector: DEFAULT_DETECTOR.into(),
             out: None,
-            sampler: "metropolis".into(),
-            seed: 0,
+            sampler: SamplerKind::default().as_str().into(),
+            seed: DEFAULT_SEED,
             no_exact_check: false,
-            exact_draws: 100,
-            likelihood: "paper".into(),
-            chains: 4,
-            ess: 1000.0,
-            rhat: 1.01,
-            max_seconds: 300.0,
+            exact_draws: DEFAULT_EXACT_DRAWS,
+            likelihood: NoiseKind::default().as_str().into(),
+            chains: DEFAULT_CHAINS,
+            ess: DEFAULT_ESS_MIN,
+            rhat: DEFAULT_RHAT_MAX,
+            max_seconds: FIT_MAX_SECONDS,
             truth: None,
             no_plots: false,
-            mode_starts: 24,
+            mode_starts: DEFAULT_MODE_STARTS,
             grid: GridOverrides::default(),
         }
     }

@@ -36,6 +36,22 @@ impl SamplerKind {
     }
 }
 
+/// Chains of a run: 4, as in the paper's BAT.jl fits (at least 2 are needed for R-hat).
+pub const DEFAULT_CHAINS: usize = 4;
+/// Seed of a run that is not given one.
+pub const DEFAULT_SEED: u64 = 0;
+/// Target R-hat (rank-normalised, split) of a whole run: 1.01, Vehtari et al. (2021).
+pub const DEFAULT_RHAT_MAX: f64 = 1.01;
+/// Target bulk and tail ESS of every parameter: 1000, Vehtari et al. (2021).
+pub const DEFAULT_ESS_MIN: f64 = 1000.0;
+/// Nelder-Mead starts of the mode search before tuning (0: no search).
+pub const DEFAULT_MODE_STARTS: usize = 24;
+/// Sampling budget (s) of a run that nobody limits otherwise (library callers such as the
+/// benches): 10 minutes, generous, since a run normally stops at its R-hat and ESS targets first.
+/// The command line's fits stop earlier ([`crate::fit::FIT_MAX_SECONDS`]), and so do the many
+/// fits of the validation studies (their own budgets).
+pub const DEFAULT_MAX_SECONDS: f64 = 600.0;
+
 /// Sampling settings. Defaults: 4 chains (the paper's BAT.jl run), BAT.jl's acceptance window
 /// [0.15, 0.35] and burn-in criterion R-hat <= 1.1, then sampling on to the stricter R-hat <= 1.01
 /// and ESS >= 1000 of Vehtari et al. (2021).
@@ -90,21 +106,21 @@ impl SampleSettings {
         let metropolis = sampler == SamplerKind::Metropolis;
         Self {
             sampler,
-            chains: 4,
-            seed: 0,
-            rhat_max: 1.01,
-            ess_min: 1000.0,
+            chains: DEFAULT_CHAINS,
+            seed: DEFAULT_SEED,
+            rhat_max: DEFAULT_RHAT_MAX,
+            ess_min: DEFAULT_ESS_MIN,
             cycle_draws: 1000,
             max_cycles: 40,
             acceptance: [0.15, 0.35],
             burnin_rhat: 1.1,
-            mode_starts: 24,
+            mode_starts: DEFAULT_MODE_STARTS,
             nuts_tune: 600,
             nuts_max_depth: 8,
             batch_draws: if metropolis { 2000 } else { 200 },
             thin: if metropolis { 4 } else { 1 },
             max_draws: 100_000,
-            max_seconds: 600.0,
+            max_seconds: DEFAULT_MAX_SECONDS,
         }
     }
 

@@ -16,13 +16,15 @@
 //! - [`section9`]: Fig. 29, the field along r and the n+ pulses at the fits' modes (computed by
 //!   [`section9_compute`]).
 //!
-//! [`run_paper`] runs the steps in order; [`Ctx`] carries a run's state between them.
+//! [`run_paper`] runs the steps in order; [`Ctx`] carries a run's state between them;
+//! [`PaperOptions`] are the options a user gives it.
 
 pub mod ctx;
 pub mod cv;
 pub mod density;
 pub mod fits;
 pub mod models;
+mod options;
 pub mod readme;
 mod run;
 pub mod samples;
@@ -33,4 +35,5 @@ pub mod surrogate;
 
 pub use ctx::{Ctx, Inputs, Row, verdict};
 pub use models::{ModeDetectors, NamedModel};
+pub use options::{PAPER_OUT, PaperOptions, SECTION9_OUT, Section9Options};
 pub use run::{PaperRun, run_paper};

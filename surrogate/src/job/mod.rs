@@ -1,10 +1,13 @@
 //! The surrogate's application layer, as the `train`, `evaluate` and `predict` commands use it
 //! (and tests and other programs can, without the command line): a training run with its
 //! resumable checkpoints and learning curves ([`TrainJob`]), a model's accuracy on a data set
-//! ([`Evaluation`]) and parameter lists as a user writes them ([`parse_params`]).
+//! ([`Evaluation`]) and parameter lists as a user writes them ([`parse_params`]); the commands'
+//! options are declared here once ([`GenerateOptions`], [`TrainJob`], [`EvaluateOptions`],
+//! [`PredictOptions`]).
 
 mod checkpoint;
 mod evaluate;
+mod options;
 mod params;
 mod train;
 
@@ -13,5 +16,9 @@ mod tests;
 
 pub use checkpoint::{curves_path, partial_dir, resume_members, save_member, write_curves};
 pub use evaluate::{Evaluation, EvaluationJson, Worst, read_for_model};
+pub use options::{DEFAULT_SHARD, DEFAULT_WORST, EvaluateOptions, GenerateOptions, PredictOptions};
 pub use params::parse_params;
-pub use train::{POLYNOMIAL_RECIPE, TrainEvent, TrainJob, TrainOutcome, detector_info};
+pub use train::{
+    DEFAULT_RECIPE, DEFAULT_SEED, DEFAULT_SPACE, POLYNOMIAL_RECIPE, TrainEvent, TrainJob,
+    TrainOutcome, detector_info,
+};

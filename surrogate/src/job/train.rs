@@ -25,25 +25,43 @@ pub const POLYNOMIAL_RECIPE: &str = "poly3";
 const INPUT_MAP: &str = "u = (x - lo)/(hi - lo) per the space's distribution, clamped to \
                          [1e-6, 1 - 1e-6]; z = Phi^-1(u) (standard-normal coordinates)";
 
-/// One training run: its inputs and the model file it writes.
+/// The parameter space `train` assumes when none is given: the paper's B_RZ space of the
+/// shipped models.
+pub const DEFAULT_SPACE: &str = "spaces/super-siegfried-rz.toml";
+/// The recipe `train` uses when none is given: the paper's network (section 6).
+pub const DEFAULT_RECIPE: &str = "paper";
+/// Seed of a training run that is not given one.
+pub const DEFAULT_SEED: u64 = 0;
+
+/// One training run: its inputs and the model file it writes. The command line flattens this
+/// struct (feature `clap`), so every option of `train` and its default is declared here once.
 #[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "clap", derive(clap::Args))]
 pub struct TrainJob {
-    /// Training rows (a `generate` rows file or a subset).
+    /// Training rows (the CSV of `generate`, or a split of it, e.g. data/training/train.csv).
+    #[cfg_attr(feature = "clap", arg(long, value_name = "FILE"))]
     pub data: PathBuf,
     /// Test rows (learning curves, the model's test figures and sigma_p).
+    #[cfg_attr(feature = "clap", arg(long, value_name = "FILE"))]
     pub test: PathBuf,
-    /// The parameter space file both data sets were generated in.
+    /// The parameter space the rows were generated from.
+    #[cfg_attr(feature = "clap", arg(long, value_name = "FILE", default_value = DEFAULT_SPACE))]
     pub space: PathBuf,
-    /// Recipe name: one of [`crate::RECIPES`] or [`POLYNOMIAL_RECIPE`].
+    /// Recipe: paper, paper-log, split, split-ensemble, tiny (networks) or poly3 (the
+    /// polynomial baseline).
+    #[cfg_attr(feature = "clap", arg(long, default_value = DEFAULT_RECIPE))]
     pub recipe: String,
-    /// Seed of initialisation and batch order (member m uses seed + m).
-    pub seed: u64,
-    /// The detector the rows were simulated for: recorded (file and hash) in the model's
-    /// metadata, checked against the space on the way.
-    pub detector: Option<PathBuf>,
-    /// The model file to write (`NAME.safetensors`; the curves go to `NAME.curves.csv`, the
-    /// checkpoints of finished members to `NAME.partial/`).
+    /// The model file (.safetensors); learning curves go to <stem>.curves.csv beside it, the
+    /// checkpoints of finished members to <stem>.partial/.
+    #[cfg_attr(feature = "clap", arg(long, value_name = "FILE"))]
     pub out: PathBuf,
+    /// Seed of the initial weights and the batch order (member m uses seed + m).
+    #[cfg_attr(feature = "clap", arg(long, default_value_t = DEFAULT_SEED))]
+    pub seed: u64,
+    /// The detector the rows were generated for (recorded with its hash; `fit` refuses the
+    /// model for another detector; checked against the space on the way).
+    #[cfg_attr(feature = "clap", arg(long, value_name = "FILE"))]
+    pub detector: Option<PathBuf>,
 }
 
 /// What a training run reports while it works, in this order.

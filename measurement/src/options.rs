@@ -1,0 +1,100 @@
+//! The options of `measure` and `synthesize` as a user states them. The command line flattens
+//! these structs (feature `clap`), so every option and default is declared here once.
+
+use std::path::{Path, PathBuf};
+
+use crate::Result;
+use crate::measure::MeasureSettings;
+use crate::synth::{DEFAULT_DECIMATE, DEFAULT_PULSER_PULSES, SynthSettings};
+
+/// Everything a user chooses about a measurement (the pipeline's settings are a TOML file).
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "clap", derive(clap::Args))]
+pub struct MeasureOptions {
+    /// Directory of pulse files: <stem>.npy [pulses, samples] in pC with a <stem>.toml sidecar
+    /// (bias_V, sampling_period_ns, charge_unit); optional measurement.toml (voltages_V,
+    /// circuit, uncertainties, tail fit).
+    #[cfg_attr(feature = "clap", arg(long, value_name = "DIR"))]
+    pub raw: PathBuf,
+    /// The C-V curve (voltage_V,c12_pF,sigma_pF); the covariance goes to <stem>.covariance.csv
+    /// and a report to <stem>.measure.json.
+    #[cfg_attr(feature = "clap", arg(long, value_name = "FILE"))]
+    pub out: PathBuf,
+    /// Measurement settings (TOML) instead of <raw>/measurement.toml.
+    #[cfg_attr(feature = "clap", arg(long, value_name = "FILE"))]
+    pub settings: Option<PathBuf>,
+}
+
+impl MeasureOptions {
+    /// The settings and where they came from: `settings`, else `<raw>/measurement.toml` if
+    /// present, else the defaults (source `defaults`).
+    ///
+    /// # Errors
+    /// A settings file that cannot be read or is refused.
+    pub fn measure_settings(&self) -> Result<(MeasureSettings, String)> {
+        let path = match &self.settings {
+            Some(p) => Some(p.clone()),
+            None => Some(self.raw.join("measurement.toml")).filter(|p| p.is_file()),
+        };
+        Ok(match path {
+            Some(p) => (MeasureSettings::from_file(&p)?, p.display().to_string()),
+            None => (MeasureSettings::default(), "defaults".to_string()),
+        })
+    }
+}
+
+/// Seed of `synthesize` when not given one.
+pub const DEFAULT_SYNTH_SEED: u64 = 1;
+
+/// Everything a user chooses about synthetic raw data (the rest is [`SynthSettings::default`]).
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "clap", derive(clap::Args))]
+pub struct SynthOptions {
+    /// The true curve: a CSV with columns voltage_V and c12_pF (e.g. from `simulate --out`).
+    #[cfg_attr(feature = "clap", arg(long, value_name = "FILE"))]
+    pub curve: PathBuf,
+    /// Output directory for the pulse files, measurement.toml and truth.json.
+    #[cfg_attr(feature = "clap", arg(long, value_name = "DIR"))]
+    pub out: PathBuf,
+    /// Seed of the random generator.
+    #[cfg_attr(feature = "clap", arg(long, default_value_t = DEFAULT_SYNTH_SEED))]
+    pub seed: u64,
+    /// Full-depletion voltage of the truth (V) [default: where its -dc12/dU_B falls to 1e-3 pF/V].
+    #[cfg_attr(feature = "clap", arg(long = "depletion-voltage", value_name = "V"))]
+    pub depletion_voltage: Option<f64>,
+    /// Pulser pulses per bias.
+    #[cfg_attr(
+        feature = "clap",
+        arg(long, value_name = "N", default_value_t = DEFAULT_PULSER_PULSES)
+    )]
+    pub pulses: usize,
+    /// Average blocks of K samples (4 ns each) to keep files small.
+    #[cfg_attr(
+        feature = "clap",
+        arg(long, value_name = "K", default_value_t = DEFAULT_DECIMATE)
+    )]
+    pub decimate: usize,
+}
+
+impl SynthOptions {
+    /// The defaults for `curve` into `out` (the same as the command line's).
+    pub fn new(curve: &Path, out: &Path) -> Self {
+        Self {
+            curve: curve.into(),
+            out: out.into(),
+            seed: DEFAULT_SYNTH_SEED,
+            depletion_voltage: None,
+            pulses: DEFAULT_PULSER_PULSES,
+            decimate: DEFAULT_DECIMATE,
+        }
+    }
+
+    /// The synthesis settings: the defaults with these pulses and decimation.
+    pub fn settings(&self) -> SynthSettings {
+        SynthSettings {
+            pulser_pulses: self.pulses,
+            decimate: self.decimate,
+            ..SynthSettings::default()
+        }
+    }
+}

@@ -1,0 +1,243 @@
+//! The options of the validation studies as a user states them: simulation-based calibration
+//! ([`CoverageOptions`], `validate coverage`) and the hidden-effect tests of model discovery
+//! ([`HiddenOptions`], `validate discovery`). The command line flattens these structs (feature
+//! `clap`), so every option and default is declared here once.
+
+use std::path::PathBuf;
+
+use hpge_inference::discover::WorkflowOptions;
+use hpge_inference::fit::{
+    DEFAULT_DATA, DEFAULT_DETECTOR, DEFAULT_MODEL, DEFAULT_PRIOR, noise_settings, sampler_kind,
+};
+use hpge_inference::posterior::{NoiseKind, NoiseSettings};
+use hpge_inference::sampler::{DEFAULT_MODE_STARTS, DEFAULT_SEED};
+use hpge_inference::{DiscoverSettings, FitSettings, SampleSettings, SamplerKind};
+
+use super::coverage::CoverageSettings;
+use crate::error::Result;
+
+/// Target bulk and tail ESS of each fit of a coverage study: ranks among L draws need about L
+/// independent draws (L = [`COVERAGE_RANKS`]), far fewer than a real fit's 1000.
+pub const COVERAGE_ESS: f64 = 300.0;
+/// L: posterior draws each truth is ranked among (ranks 0..=99, 100 bins).
+pub const COVERAGE_RANKS: usize = 99;
+/// Sampling budget (s) of each fit of a coverage study. A study needs many fits: a fit that has
+/// not reached its ESS after [`COVERAGE_FIT_MAX_DRAWS`] kept draws per chain (or a minute) stops
+/// there and is counted as unconverged.
+pub const COVERAGE_FIT_MAX_SECONDS: f64 = 60.0;
+/// Most kept draws per chain of each fit of a coverage study (see [`COVERAGE_FIT_MAX_SECONDS`]).
+pub const COVERAGE_FIT_MAX_DRAWS: usize = 20_000;
+
+/// Everything a user chooses about a coverage study.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "clap", derive(clap::Args))]
+pub struct CoverageOptions {
+    /// Number of truths.
+    #[cfg_attr(feature = "clap", arg(long))]
+    pub truths: usize,
+    /// The prior (truths are drawn from it).
+    #[cfg_attr(feature = "clap", arg(long, value_name = "FILE", default_value = DEFAULT_PRIOR))]
+    pub prior: PathBuf,
+    /// The surrogate that is fitted.
+    #[cfg_attr(feature = "clap", arg(long, value_name = "FILE", default_value = DEFAULT_MODEL))]
+    pub model: PathBuf,
+    /// A measured curve: its voltages (and covariance, for --likelihood covariance) are used.
+    #[cfg_attr(feature = "clap", arg(long, value_name = "FILE", default_value = DEFAULT_DATA))]
+    pub data: PathBuf,
+    /// The detector (for --exact and the model check).
+    #[cfg_attr(
+        feature = "clap",
+        arg(long, value_name = "FILE", default_value = DEFAULT_DETECTOR)
+    )]
+    pub detector: PathBuf,
+    /// Simulate the data with the exact field solver instead of the surrogate (what surrogate
+    /// error does to coverage; about 2 CPU-seconds per truth more).
+    #[cfg_attr(feature = "clap", arg(long))]
+    pub exact: bool,
+    /// Likelihood: paper or covariance.
+    #[cfg_attr(feature = "clap", arg(long, default_value = NoiseKind::default().as_str()))]
+    pub likelihood: String,
+    /// Sampler: metropolis or nuts.
+    #[cfg_attr(feature = "clap", arg(long, default_value = SamplerKind::default().as_str()))]
+    pub sampler: String,
+    /// Seed of the truths, the noise and the fits.
+    #[cfg_attr(feature = "clap", arg(long, default_value_t = DEFAULT_SEED))]
+    pub seed: u64,
+    /// Target bulk and tail ESS of each fit.
+    #[cfg_attr(feature = "clap", arg(long, default_value_t = COVERAGE_ESS))]
+    pub ess: f64,
+    /// Posterior draws each truth is ranked among.
+    #[cfg_attr(feature = "clap", arg(long, default_value_t = COVERAGE_RANKS))]
+    pub ranks: usize,
+    /// Nelder-Mead starts of each fit's mode search.
+    #[cfg_attr(feature = "clap", arg(long, default_value_t = DEFAULT_MODE_STARTS))]
+    pub mode_starts: usize,
+    /// Output folder for coverage.json, ranks.csv and the figures
+    /// [default: reports/coverage/<prior>[-exact]].
+    #[cfg_attr(feature = "clap", arg(long, value_name = "DIR"))]
+    pub out: Option<PathBuf>,
+}
+
+impl CoverageOptions {
+    /// The shipped defaults with `truths` truths (the same as the command line's).
+    pub fn new(truths: usize) -> Self {
+        Self {
+            truths,
+            prior: DEFAULT_PRIOR.into(),
+            model: DEFAULT_MODEL.into(),
+            data: DEFAULT_DATA.into(),
+            detector: DEFAULT_DETECTOR.into(),
+            exact: false,
+            likelihood: NoiseKind::default().as_str().into(),
+            sampler: SamplerKind::default().as_str().into(),
+            seed: DEFAULT_SEED,
+            ess: COVERAGE_ESS,
+            ranks: COVERAGE_RANKS,
+            mode_starts: DEFAULT_MODE_STARTS,
+            out: None,
+        }
+    }
+
+    /// The output folder: `out`, else `reports/coverage/<prior file stem>` (with `-exact` for
+    /// exact-solver data).
+    pub fn out_dir(&self) -> PathBuf {
+        self.out.clone().unwrap_or_else(|| {
+            let stem = self
+                .prior
+                .file_stem()
+                .map_or("coverage".into(), |s| s.to_string_lossy().to_string());
+            PathBuf::from("reports/coverage").join(if self.exact {
+                format!("{stem}-exact")
+            } else {
+                stem
+            })
+        })
+    }
+
+    /// Checks the counts.
+    ///
+    /// # Errors
+    /// [`hpge_inference::Error::BadOption`] naming `--truths` (fewer than 2) or `--ranks`
+    /// (fewer than 9).
+    pub fn validate(&self) -> Result<()> {
+        let bad = |option: String, message: &str| -> Result<()> {
+            Err(hpge_inference::Error::BadOption {
+                option,
+                message: message.into(),
+            }
+            .into())
+        };
+        if self.truths < 2 {
+            return bad(
+                format!("--truths {}", self.truths),
+                "need at least 2 truths",
+            );
+        }
+        if self.ranks < 9 {
+            return bad(
+                format!("--ranks {}", self.ranks),
+                "need at least 9 draws to rank among",
+            );
+        }
+        Ok(())
+    }
+
+    /// The noise model named by `likelihood`.
+    ///
+    /// # Errors
+    /// An unknown likelihood.
+    pub fn noise(&self) -> Result<NoiseSettings> {
+        Ok(noise_settings(&self.likelihood)?)
+    }
+
+    /// The study's settings: the counts checked, each fit with the sampler, targets and budgets
+    /// of a study.
+    ///
+    /// # Errors
+    /// What [`Self::validate`] refuses, an unknown sampler or likelihood, or targets
+    /// [`SampleSettings::validate`] refuses.
+    pub fn settings(&self) -> Result<CoverageSettings> {
+        self.validate()?;
+        let mut sample = SampleSettings::for_sampler(sampler_kind(&self.sampler)?);
+        let noise = self.noise()?;
+        sample.ess_min = self.ess;
+        sample.max_seconds = COVERAGE_FIT_MAX_SECONDS;
+        sample.max_draws = COVERAGE_FIT_MAX_DRAWS;
+        sample.mode_starts = self.mode_starts;
+        sample.validate()?;
+        Ok(CoverageSettings {
+            n_truths: self.truths,
+            seed: self.seed,
+            fit: FitSettings {
+                sample,
+                noise,
+                ..FitSettings::default()
+            },
+            ranks: self.ranks,
+        })
+    }
+}
+
+/// Seed of the hidden-effect study (data set i uses seed + i; the workflow runs with it too).
+pub const HIDDEN_SEED: u64 = 7;
+/// Output folder of the hidden-effect study.
+pub const HIDDEN_OUT: &str = "reports/discovery/hidden";
+/// The start model of the hidden-effect study: the paper's B_Z, which the base truth fits
+/// exactly.
+pub const HIDDEN_START_MODEL: &str = "priors/b-z.toml";
+/// Sampling budget (s) of each MCMC fit of the hidden-effect study: the study runs the workflow
+/// on six data sets, so each fit gets less than a command-line fit's five minutes
+/// ([`hpge_inference::fit::FIT_MAX_SECONDS`]).
+pub const HIDDEN_FIT_MAX_SECONDS: f64 = 120.0;
+
+/// Everything a user chooses about the hidden-effect study.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "clap", derive(clap::Args))]
+pub struct HiddenOptions {
+    /// Seed of the noise (data set i uses seed + i) and of the workflow.
+    #[cfg_attr(feature = "clap", arg(long, default_value_t = HIDDEN_SEED))]
+    pub seed: u64,
+    /// Output folder: one sub-folder per data set (cv.csv, truth.json, the workflow's outputs),
+    /// and summary.json / summary.md.
+    #[cfg_attr(feature = "clap", arg(long, value_name = "DIR", default_value = HIDDEN_OUT))]
+    pub out: PathBuf,
+    /// Hidden effects to run, comma-separated (default: all: none, radial, stray-capacitance,
+    /// calibration-scale, quadratic-z, li-slope).
+    #[cfg_attr(feature = "clap", arg(long, value_delimiter = ','))]
+    pub effects: Vec<String>,
+    /// The start model's prior.
+    #[cfg_attr(
+        feature = "clap",
+        arg(long, value_name = "FILE", default_value = HIDDEN_START_MODEL)
+    )]
+    pub start_model: PathBuf,
+    /// The workflow's inputs, catalogue entries, targets and grid.
+    #[cfg_attr(feature = "clap", command(flatten))]
+    pub workflow: WorkflowOptions,
+}
+
+impl Default for HiddenOptions {
+    /// The shipped defaults (the same as the command line's).
+    fn default() -> Self {
+        Self {
+            seed: HIDDEN_SEED,
+            out: HIDDEN_OUT.into(),
+            effects: Vec::new(),
+            start_model: HIDDEN_START_MODEL.into(),
+            workflow: WorkflowOptions::default(),
+        }
+    }
+}
+
+impl HiddenOptions {
+    /// The workflow's settings with `noise` and the study's budget per fit, checked (each data
+    /// set then runs with its own seed).
+    ///
+    /// # Errors
+    /// Targets [`SampleSettings::validate`] refuses.
+    pub fn settings(&self, noise: NoiseSettings) -> Result<DiscoverSettings> {
+        Ok(self
+            .workflow
+            .settings(noise, self.seed, HIDDEN_FIT_MAX_SECONDS)?)
+    }
+}
