@@ -5,7 +5,7 @@ use hpge_inference::fit::{LEVELS, Predictive};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::layout::{Key, LEVEL_COLORS, key_strip, padded, ticks};
+use super::layout::{Axes, Key, LEVEL_COLORS, draw_axes, key_strip, padded};
 use crate::error::Result;
 use crate::plot::style::PALETTE;
 use crate::plot::style::err;
@@ -69,17 +69,15 @@ pub(super) fn predictive<DB: DrawingBackend>(
         .y_label_area_size(80)
         .build_cartesian_2d(x0..x1, y0..y1)
         .map_err(err)?;
-    chart
-        .configure_mesh()
-        .x_desc("U_B [V]")
-        .y_desc("c_p - c_m [pF]")
-        .x_label_formatter(&ticks(x1 - x0))
-        .y_label_formatter(&ticks(y1 - y0))
-        .label_style(("sans-serif", 16))
-        .axis_desc_style(("sans-serif", 18))
-        .light_line_style(WHITE)
-        .draw()
-        .map_err(err)?;
+    draw_axes(
+        &mut chart,
+        Axes {
+            desc: ("U_B [V]", "c_p - c_m [pF]"),
+            span: (x1 - x0, y1 - y0),
+            labels: None,
+            font: (16, 18),
+        },
+    )?;
     // Widest band first, so that the narrower ones lie on top.
     for l in (0..LEVELS.len()).rev() {
         let have: Vec<(f64, [f64; 2])> = order
@@ -164,17 +162,15 @@ pub(super) fn zeta<DB: DrawingBackend>(
         .y_label_area_size(80)
         .build_cartesian_2d(x0..x1, y0..y1)
         .map_err(err)?;
-    chart
-        .configure_mesh()
-        .x_desc(format!("{axis} [mm]"))
-        .y_desc("zeta [1e10 cm^-3]")
-        .x_label_formatter(&ticks(x1 - x0))
-        .y_label_formatter(&ticks(y1 - y0))
-        .light_line_style(WHITE)
-        .label_style(("sans-serif", 16))
-        .axis_desc_style(("sans-serif", 18))
-        .draw()
-        .map_err(err)?;
+    draw_axes(
+        &mut chart,
+        Axes {
+            desc: (&format!("{axis} [mm]"), "zeta [1e10 cm^-3]"),
+            span: (x1 - x0, y1 - y0),
+            labels: None,
+            font: (16, 18),
+        },
+    )?;
     chart
         .draw_series(LineSeries::new(
             [(x0, 0.0), (x1, 0.0)],
