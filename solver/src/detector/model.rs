@@ -6,10 +6,10 @@ use std::sync::Arc;
 use serde::{Deserialize, Serialize};
 
 use crate::expr::Parameters;
-use crate::{Error, Result};
 use crate::geometry::{BOUNDARY_TOL_MM, BoundingBox, Solid};
 use crate::impurity::{ImpurityContext, ImpurityModel, ImpuritySpec};
 use crate::material::Material;
+use crate::{Error, Result};
 
 /// Boundary condition on one side of the world box.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]

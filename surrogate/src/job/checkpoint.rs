@@ -59,7 +59,10 @@ fn read_curves(path: &Path, m: usize) -> Result<Vec<EpochRecord>> {
             file: path.into(),
             message: format!("malformed line `{line}`"),
         })?;
-        records.push(EpochRecord { member: m, ..record });
+        records.push(EpochRecord {
+            member: m,
+            ..record
+        });
     }
     Ok(records)
 }

@@ -6,8 +6,8 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::layout::{
-    Axes, Key, LEVEL_COLORS, OUTSIDE, PRIOR, TRUTH, axis_label, draw_axes, grid, key_strip,
-    padded, ticks, view_range,
+    Axes, Key, LEVEL_COLORS, OUTSIDE, PRIOR, TRUTH, axis_label, draw_axes, grid, key_strip, padded,
+    ticks, view_range,
 };
 use crate::error::Result;
 use crate::plot::colormap::t_color;
