@@ -143,7 +143,12 @@ pub(super) fn zeta<DB: DrawingBackend>(
         .iter()
         .flat_map(|p| p.zeta_cm3.iter().map(|z| z / 1e10));
     let (y0, y1) = padded(ys.chain([0.0]), 0.06);
-    let mut chart = curve_chart(&body, (x0, x1), (y0, y1), (&format!("{axis} [mm]"), "zeta [1e10 cm^-3]"))?;
+    let mut chart = curve_chart(
+        &body,
+        (x0, x1),
+        (y0, y1),
+        (&format!("{axis} [mm]"), "zeta [1e10 cm^-3]"),
+    )?;
     chart
         .draw_series(LineSeries::new(
             [(x0, 0.0), (x1, 0.0)],
