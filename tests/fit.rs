@@ -1,7 +1,7 @@
 //! The fit as a user runs it (issue: Bayesian inference): the B_Z fit on the shipped data with
 //! both samplers (outputs, JSON fields, figures), the exit code of an unconverged fit, the
-//! exact-solver check on a few draws, and bad input: a prior outside the model's domain, a curve
-//! with fewer voltages than parameters, a model trained for another detector.
+//! exact-solver check on a few draws, and bad flags and files (exit code 2 naming them; the
+//! inputs the library refuses, one by one: `inference/tests/fit_job.rs`).
 
 mod common;
 
@@ -160,44 +160,9 @@ fn bad_input_is_refused_clearly() {
     let d = temp("fit-bad");
     let out = d.join("o");
     let o = out.to_str().unwrap();
-    // A prior reaching outside the model's domain.
-    let prior = d.join("wide.toml");
-    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/priors/b-z.toml"))
-        .unwrap()
-        .replace("lo = 0.2, hi = 5.0", "lo = 0.1, hi = 6.0");
-    std::fs::write(&prior, text).unwrap();
-    bad(
-        &run(&["fit", "--prior", prior.to_str().unwrap(), "--out", o]),
-        &["wide.toml", "d_li_mm", "outside the model's domain"],
-    );
-    // Fewer voltages than parameters.
-    let data = d.join("short.csv");
-    std::fs::write(&data, "voltage_V,c12_pF,sigma_pF\n500,130,4\n2000,43,1.3\n").unwrap();
-    bad(
-        &run(&[
-            "fit",
-            "--prior",
-            "priors/b-z.toml",
-            "--data",
-            data.to_str().unwrap(),
-            "--out",
-            o,
-        ]),
-        &["2 voltages", "3 parameters"],
-    );
-    // A model trained for another detector (any change of the file changes its hash).
-    let det = d.join("other-detector.toml");
-    let text = std::fs::read_to_string(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/detectors/super-siegfried-k1.toml"
-    ))
-    .unwrap();
-    std::fs::write(&det, text + "\n# another detector\n").unwrap();
-    bad(
-        &run(&["fit", "--detector", det.to_str().unwrap(), "--out", o]),
-        &["trained for the detector", "other-detector.toml"],
-    );
-    // Unknown sampler and likelihood, a missing data file.
+    // Unknown sampler and likelihood, a missing data file. The library's refusals (a prior
+    // outside the model's domain, fewer voltages than parameters, a model trained for another
+    // detector) are inference/tests/fit_job.rs.
     bad(&run(&["fit", "--sampler", "gibbs", "--out", o]), &["gibbs"]);
     bad(
         &run(&["fit", "--likelihood", "student", "--out", o]),

@@ -1,7 +1,7 @@
 //! The surrogate as a user runs it (issue: neural-network surrogate): a tiny network trained on a
 //! tiny generated set (the loss falls, the model file reloads to identical predictions, evaluate
-//! and predict agree), and bad input (a data set of another space, a model file of another
-//! version, NaN and out-of-range inputs) gives exit code 2 with a clear message.
+//! and predict agree), and bad input (NaN inputs, a data set of another space, a missing model
+//! file) gives exit code 2 with a clear message.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -168,7 +168,9 @@ fn tiny_network_on_a_tiny_generated_set() {
     bad(&train("4", &[]), &["member-0.safetensors", "another run"]);
     std::fs::remove_dir_all(&partial).unwrap();
 
-    // Bad input.
+    // Bad input: exit code 2 naming the flag or the file. The library's refusals one by one
+    // (inputs outside the domain, U_B outside, a model file of another format version, a training
+    // set of another space, an unknown recipe): surrogate/src/model/tests.rs and job/tests.rs.
     let nan: Vec<&str> = vec!["nan"; 9];
     bad(
         &run(&[
@@ -182,32 +184,6 @@ fn tiny_network_on_a_tiny_generated_set() {
         ]),
         &["d_li_mm", "finite"],
     );
-    let mut outside = params.clone();
-    outside[0] = "d_li_mm=7".into();
-    bad(
-        &run(&[
-            "predict",
-            "--model",
-            &s(&model),
-            "--params",
-            &outside.join(","),
-            "--voltages",
-            "100",
-        ]),
-        &["d_li_mm", "outside"],
-    );
-    bad(
-        &run(&[
-            "predict",
-            "--model",
-            &s(&model),
-            "--params",
-            &params.join(","),
-            "--voltages",
-            "5000",
-        ]),
-        &["U_B", "outside"],
-    );
     // A data set of another space: the header renamed.
     let text = std::fs::read_to_string(te.join("rows.csv"))
         .unwrap()
@@ -218,26 +194,6 @@ fn tiny_network_on_a_tiny_generated_set() {
         &run(&["evaluate", "--model", &s(&model), "--data", &s(&other)]),
         &["other.csv", "another space"],
     );
-    // A model file of another format version (same length, so the header stays valid).
-    let mut bytes = std::fs::read(&model).unwrap();
-    let needle = b"\\\"format_version\\\":1";
-    let at = bytes
-        .windows(needle.len())
-        .position(|w| w == needle)
-        .expect("version in the header");
-    *bytes.get_mut(at + needle.len() - 1).unwrap() = b'7';
-    let future = d.join("future.safetensors");
-    std::fs::write(&future, bytes).unwrap();
-    bad(
-        &run(&[
-            "evaluate",
-            "--model",
-            &s(&future),
-            "--data",
-            &s(&te.join("rows.csv")),
-        ]),
-        &["future.safetensors", "format_version", "retrain"],
-    );
     bad(
         &run(&[
             "evaluate",
@@ -247,32 +203,6 @@ fn tiny_network_on_a_tiny_generated_set() {
             &s(&other),
         ]),
         &["missing.safetensors"],
-    );
-    bad(
-        &run(&[
-            "train",
-            "--data",
-            &s(&other),
-            "--test",
-            &s(&te.join("rows.csv")),
-            "--out",
-            &s(&d.join("x.safetensors")),
-        ]),
-        &["other.csv", "another space"],
-    );
-    bad(
-        &run(&[
-            "train",
-            "--data",
-            &s(&tr.join("rows.csv")),
-            "--test",
-            &s(&te.join("rows.csv")),
-            "--recipe",
-            "huge",
-            "--out",
-            &s(&d.join("x.safetensors")),
-        ]),
-        &["unknown recipe", "paper"],
     );
     let _ = std::fs::remove_dir_all(&d);
 }

@@ -7,6 +7,7 @@ mod generate;
 mod gpu;
 mod impurity;
 mod inference;
+mod problems;
 mod solver;
 mod surrogate;
 
@@ -14,6 +15,7 @@ criterion_group!(
     benches,
     impurity::bench,
     solver::bench,
+    problems::bench,
     gpu::bench,
     generate::bench,
     surrogate::bench,

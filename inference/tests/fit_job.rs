@@ -123,3 +123,24 @@ fn truth_files_map_to_the_prior_order() {
     std::fs::write(&t, "y_top = \"high\"\n").unwrap();
     assert!(read_truth(&t, &job.prior).is_err());
 }
+
+#[test]
+fn a_prior_outside_the_models_domain_is_refused() {
+    let d = temp("wide");
+    let prior = d.join("wide.toml");
+    let text = std::fs::read_to_string(repo("priors/b-z.toml"))
+        .unwrap()
+        .replace("lo = 0.2, hi = 5.0", "lo = 0.1, hi = 6.0");
+    std::fs::write(&prior, text).unwrap();
+    let o = FitOptions {
+        prior,
+        ..shipped("priors/b-z.toml")
+    };
+    let e = FitJob::from_files(&o.files(), o.noise().unwrap(), &o.grid)
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
+    for needle in ["wide.toml", "d_li_mm", "outside the model's domain"] {
+        assert!(e.contains(needle), "`{needle}` not in: {e}");
+    }
+}

@@ -141,6 +141,15 @@ pub enum Error {
         #[source]
         source: Box<Error>,
     },
+    /// No contact of the detector is held at the bias, so a bias voltage acts on nothing.
+    #[error(
+        "{}: no contact has potential = \"bias\", so the bias voltage acts on nothing",
+        file.display()
+    )]
+    NoBiasContact {
+        /// The detector file.
+        file: PathBuf,
+    },
     /// An interaction point (the start of a drift) lies inside a contact.
     #[error(
         "(r, z) = ({r_mm}, {z_mm}) mm is inside the contact `{contact}`; an interaction must be in the depleted crystal"
@@ -237,6 +246,7 @@ impl Error {
             | Error::Argument { .. }
             | Error::GridOption { .. }
             | Error::Syntax { .. }
+            | Error::NoBiasContact { .. }
             | Error::InteractionInContact { .. }
             | Error::InteractionUndepleted { .. }
             | Error::InteractionOutside { .. }

@@ -85,12 +85,7 @@ pub fn run(a: &PulseArgs) -> Result<()> {
     let model =
         AdlModel::new(adl.clone()).map_err(|m| anyhow::anyhow!("--drift-parameters: {m}"))?;
     let det = load_detector(&a.input)?;
-    if det.bias_contacts().is_empty() {
-        bail!(
-            "{}: no contact has potential = \"bias\", so the bias voltage acts on nothing",
-            det.file.display()
-        );
-    }
+    det.check_bias_contact()?;
     let (r_mm, phi_deg, z_mm) = a.at;
     let flag = format!("--at {r_mm},{phi_deg},{z_mm}");
     // Cheap geometric checks before the field solve.

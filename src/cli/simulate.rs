@@ -65,12 +65,7 @@ pub fn run(o: &SimulateOptions<'_>) -> Result<()> {
         input.params.push(("d_li_mm".to_string(), d));
     }
     let det = load_detector(&input)?;
-    if det.bias_contacts().is_empty() {
-        bail!(
-            "{}: no contact has potential = \"bias\", so the bias voltage acts on nothing",
-            det.file.display()
-        );
-    }
+    det.check_bias_contact()?;
     let settings = o.grid.apply(&o.settings, &det)?;
     let device = backend_json(&settings)?;
     let bar = ProgressBar::new(volts.len() as u64);

@@ -3,6 +3,8 @@
 
 use std::path::{Path, PathBuf};
 
+use hpge_measurement::{CvData, Data, load_data};
+
 use crate::error::{Error, Result};
 
 /// The shipped inputs the report reads (paths relative to the repository root).
@@ -45,6 +47,17 @@ impl Default for Inputs {
 }
 
 impl Inputs {
+    /// The measured C-V curve (`data`); raw pulser data there is an error naming the file.
+    pub fn data_curve(&self) -> Result<CvData> {
+        match load_data(&self.data)? {
+            Data::Curve(c) => Ok(c),
+            Data::Raw(_) => Err(Error::Content {
+                file: self.data.clone(),
+                message: "expected a C-V curve".into(),
+            }),
+        }
+    }
+
     /// Every input file, in the order the README lists them.
     pub fn all(&self) -> Vec<&Path> {
         vec![

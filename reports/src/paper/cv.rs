@@ -4,7 +4,6 @@
 
 use std::path::Path;
 
-use hpge_measurement::{Data, load_data};
 use hpge_solver::{CvCurve, Detector, FieldSettings, Parameters, cv_curve};
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -26,15 +25,7 @@ const FD_SLOPE: f64 = 1e-3;
 
 /// Draws the figure and adds its README row.
 pub fn run(ctx: &mut Ctx) -> Result<()> {
-    let data = match load_data(&ctx.inputs.data)? {
-        Data::Curve(c) => c,
-        Data::Raw(_) => {
-            return Err(Error::Content {
-                file: ctx.inputs.data.clone(),
-                message: "expected a C-V curve".into(),
-            });
-        }
-    };
+    let data = ctx.inputs.data_curve()?;
     let mut p = Parameters::new();
     p.set("d_li_mm".to_string(), D_LI_MM);
     let det = Detector::from_file(&ctx.inputs.detector, &p)?;

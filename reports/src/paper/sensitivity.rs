@@ -1,7 +1,6 @@
 //! The paper's Fig. 13 (section 6): c12 at 25 V with d_Li = 1 mm for constant impurity
 //! densities, which sets the sensitive range zeta_l = 1e8 .. zeta_u = 1e11 cm^-3.
 
-use hpge_measurement::{Data, load_data};
 use hpge_solver::scan::sensitivity_scan;
 use hpge_solver::{Detector, FieldSettings, Parameters};
 use serde_json::json;
@@ -36,15 +35,7 @@ pub fn run(ctx: &mut Ctx) -> Result<()> {
             .ok_or_else(|| Error::invalid("a density of the scan is missing"))
     };
     let (p7, p8, p11) = (at(1e7)?, at(1e8)?, at(1e11)?);
-    let data = match load_data(&ctx.inputs.data)? {
-        Data::Curve(c) => c,
-        Data::Raw(_) => {
-            return Err(Error::Content {
-                file: ctx.inputs.data.clone(),
-                message: "expected a C-V curve".into(),
-            });
-        }
-    };
+    let data = ctx.inputs.data_curve()?;
     let c_m = data
         .voltage_v
         .iter()

@@ -27,23 +27,12 @@ fn read_curves(path: &Path) -> Result<Vec<EpochRecord>> {
         .lines()
         .filter(|l| !l.starts_with('#') && !l.starts_with("member") && !l.trim().is_empty())
     {
-        let v: Vec<f64> = line.split(',').filter_map(|x| x.parse().ok()).collect();
-        if v.len() != 8 {
-            return Err(Error::Content {
+        out.push(
+            EpochRecord::from_csv_line(line).ok_or_else(|| Error::Content {
                 file: path.to_path_buf(),
                 message: format!("malformed line `{line}`"),
-            });
-        }
-        out.push(EpochRecord {
-            member: v[0] as usize,
-            epoch: v[1] as usize,
-            cycle: v[2] as usize,
-            lr: v[3],
-            train_loss: v[4],
-            test_loss: v[5],
-            test_rel_rms: v[6],
-            seconds: v[7],
-        });
+            })?,
+        );
     }
     if out.is_empty() {
         return Err(Error::Content {

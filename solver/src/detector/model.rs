@@ -9,6 +9,7 @@ use crate::expr::Parameters;
 use crate::geometry::{BOUNDARY_TOL_MM, BoundingBox, Solid};
 use crate::impurity::{ImpurityContext, ImpurityModel, ImpuritySpec};
 use crate::material::Material;
+use crate::{Error, Result};
 
 /// Boundary condition on one side of the world box.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -304,5 +305,16 @@ impl Detector {
         (0..self.contacts.len())
             .filter(|&i| self.contacts[i].potential == ContactPotential::Bias)
             .collect()
+    }
+
+    /// Checks that some contact is held at the bias (else a bias voltage acts on nothing):
+    /// [`Error::NoBiasContact`] names the file.
+    pub fn check_bias_contact(&self) -> Result<()> {
+        if self.bias_contacts().is_empty() {
+            return Err(Error::NoBiasContact {
+                file: self.file.clone(),
+            });
+        }
+        Ok(())
     }
 }

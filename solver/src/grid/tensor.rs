@@ -109,18 +109,38 @@ impl Grid {
         s: &GridSettings,
     ) -> Option<Grid> {
         let width = max_width_mm.max(s.min_tick_distance_mm);
+        self.with_ticks_added(split_r, split_z, s, |a, b, out| {
+            let h = b - a;
+            if h > width * (1.0 + 1e-9) {
+                // Straight to the target width: one pass instead of repeated halving.
+                let parts = (h / width - 1e-9).ceil() as usize;
+                for p in 1..parts {
+                    out.push(a + h * p as f64 / parts as f64);
+                }
+                true
+            } else {
+                false
+            }
+        })
+    }
+
+    /// The grid with the ticks `insert(a, b, out)` adds (after `a`, before `b`) in every r
+    /// interval [a, b] with `split_r[i]` and z interval with `split_z[j]`; `insert` says whether
+    /// it added any. The ratio limit is restored on an axis that gained ticks. `None` when no
+    /// interval gained any.
+    fn with_ticks_added(
+        &self,
+        split_r: &[bool],
+        split_z: &[bool],
+        s: &GridSettings,
+        insert: impl Fn(f64, f64, &mut Vec<f64>) -> bool,
+    ) -> Option<Grid> {
         let go = |t: &[f64], split: &[bool]| -> (Vec<f64>, bool) {
             let mut out = Vec::with_capacity(t.len() * 2);
             let mut any = false;
             for k in 0..t.len() - 1 {
                 out.push(t[k]);
-                let h = t[k + 1] - t[k];
-                if split[k] && h > width * (1.0 + 1e-9) {
-                    // Straight to the target width: one pass instead of repeated halving.
-                    let parts = (h / width - 1e-9).ceil() as usize;
-                    for p in 1..parts {
-                        out.push(t[k] + h * p as f64 / parts as f64);
-                    }
+                if split[k] && insert(t[k], t[k + 1], &mut out) {
                     any = true;
                 }
             }
@@ -172,25 +192,14 @@ impl Grid {
     /// Halves every r interval with `split_r[i]` and z interval with `split_z[j]` (never below
     /// `min_tick_distance_mm`), then restores the ratio limit. `None` when nothing was split.
     pub fn halved(&self, split_r: &[bool], split_z: &[bool], s: &GridSettings) -> Option<Grid> {
-        let go = |t: &[f64], split: &[bool]| -> (Vec<f64>, bool) {
-            let mut out = Vec::with_capacity(t.len() * 2);
-            let mut any = false;
-            for k in 0..t.len() - 1 {
-                out.push(t[k]);
-                if split[k] && (t[k + 1] - t[k]) / 2.0 >= s.min_tick_distance_mm {
-                    out.push(0.5 * (t[k] + t[k + 1]));
-                    any = true;
-                }
+        self.with_ticks_added(split_r, split_z, s, |a, b, out| {
+            if (b - a) / 2.0 >= s.min_tick_distance_mm {
+                out.push(0.5 * (a + b));
+                true
+            } else {
+                false
             }
-            out.push(t[t.len() - 1]);
-            if any {
-                limit_ratio(&mut out, s.min_tick_distance_mm, s.max_distance_ratio);
-            }
-            (out, any)
-        };
-        let (r, ar) = go(&self.r_mm, split_r);
-        let (z, az) = go(&self.z_mm, split_z);
-        (ar || az).then_some(Grid { r_mm: r, z_mm: z })
+        })
     }
 
     /// Every interval divided into `parts` equal ones (spacings / `parts`, nodes ~ `parts`^2 x):

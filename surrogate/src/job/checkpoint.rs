@@ -55,22 +55,13 @@ fn read_curves(path: &Path, m: usize) -> Result<Vec<EpochRecord>> {
         .lines()
         .filter(|l| !l.starts_with('#') && !l.starts_with("member"))
     {
-        let v: Vec<f64> = line.split(',').filter_map(|x| x.parse().ok()).collect();
-        if v.len() != 8 {
-            return Err(Error::Parse {
-                file: path.into(),
-                message: format!("malformed line `{line}`"),
-            });
-        }
+        let record = EpochRecord::from_csv_line(line).ok_or_else(|| Error::Parse {
+            file: path.into(),
+            message: format!("malformed line `{line}`"),
+        })?;
         records.push(EpochRecord {
             member: m,
-            epoch: v[1] as usize,
-            cycle: v[2] as usize,
-            lr: v[3],
-            train_loss: v[4],
-            test_loss: v[5],
-            test_rel_rms: v[6],
-            seconds: v[7],
+            ..record
         });
     }
     Ok(records)

@@ -243,19 +243,7 @@ fn model_curves(file: &Path) -> Vec<EpochRecord> {
     let text = std::fs::read_to_string(file).unwrap();
     text.lines()
         .filter(|l| !l.starts_with('#') && !l.starts_with("member"))
-        .map(|l| {
-            let v: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
-            EpochRecord {
-                member: v[0] as usize,
-                epoch: v[1] as usize,
-                cycle: v[2] as usize,
-                lr: v[3],
-                train_loss: v[4],
-                test_loss: v[5],
-                test_rel_rms: v[6],
-                seconds: v[7],
-            }
-        })
+        .map(|l| EpochRecord::from_csv_line(l).expect("eight numbers"))
         .collect()
 }
 

@@ -36,6 +36,28 @@ pub struct EpochRecord {
     pub seconds: f64,
 }
 
+impl EpochRecord {
+    /// One data line of a learning-curve CSV (`member,epoch,cycle,lr,train_loss,test_loss,
+    /// test_rel_rms,seconds`, as `job::write_curves` writes it), or `None` where the line does not
+    /// hold eight numbers.
+    pub fn from_csv_line(line: &str) -> Option<Self> {
+        let v: Vec<f64> = line.split(',').filter_map(|x| x.parse().ok()).collect();
+        if v.len() != 8 {
+            return None;
+        }
+        Some(EpochRecord {
+            member: v[0] as usize,
+            epoch: v[1] as usize,
+            cycle: v[2] as usize,
+            lr: v[3],
+            train_loss: v[4],
+            test_loss: v[5],
+            test_rel_rms: v[6],
+            seconds: v[7],
+        })
+    }
+}
+
 /// The result of [`train`].
 #[derive(Debug, Clone)]
 pub struct Trained {

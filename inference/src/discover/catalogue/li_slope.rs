@@ -3,15 +3,11 @@
 //! is not uniform along a crystal; the start model has one d_Li. Outside the surrogate's space:
 //! computed with the exact solver, by re-shaping the bias contact's tube.
 
-use std::sync::Arc;
-
 use hpge_solver::Detector;
 use hpge_solver::detector::ContactPotential;
 use hpge_solver::geometry::{Primitive, Solid};
 
-use super::quadratic_z::base_inputs;
-use super::{Baseline, Candidate, ExactVariant, Extension, ExtensionPredictor, one_more};
-use crate::prior::PriorDistribution;
+use super::{Baseline, Candidate, ExactParameter, Extension, one_more_exact};
 use crate::{Error, Result};
 
 /// Domain of s, mm.
@@ -121,34 +117,19 @@ impl Extension for LiSlope {
     }
 
     fn build(&self, base: &Baseline) -> Result<Candidate> {
-        let volts = base.model.voltages();
-        let model = ExactVariant::new(
-            base.exact,
-            volts,
-            &[("d_li_slope_mm", SLOPE_RANGE_MM)],
-            set_slope,
-            LABEL,
-        )?;
-        let mut x = base_inputs(base)?;
-        x.push(0.1);
-        model.detector(&x)?;
-        Ok(one_more(
+        one_more_exact(
             self,
             base,
-            ExtensionPredictor::Exact,
-            Arc::new(model),
-            (
-                "d_li_slope_mm",
-                "mm",
-                "Li thickness at the top minus at the bottom of the n+ layer",
-                PriorDistribution::TruncatedNormal {
-                    mean: 0.0,
-                    sd: SLOPE_PRIOR_SD_MM,
-                    lo: None,
-                    hi: None,
-                },
-            ),
-            0.0,
-        ))
+            ExactParameter {
+                name: "d_li_slope_mm",
+                unit: "mm",
+                description: "Li thickness at the top minus at the bottom of the n+ layer",
+                range: SLOPE_RANGE_MM,
+                prior_sd: SLOPE_PRIOR_SD_MM,
+                dry_run: 0.1,
+            },
+            set_slope,
+            LABEL,
+        )
     }
 }

@@ -31,7 +31,7 @@ pub use stray::StrayCapacitance;
 
 use crate::Result;
 use crate::model::CvModel;
-use crate::prior::{ParameterSpec, PriorDistribution, PriorSpec};
+use crate::prior::{ParameterSpec, Prior, PriorDistribution, PriorSpec};
 
 /// What computes a candidate's curves.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -156,6 +156,75 @@ pub(crate) fn one_more(
         start,
         added: vec![name.into()],
     }
+}
+
+/// One parameter of an effect outside the surrogate's space (computed with the exact solver):
+/// its name, unit and description, its domain, and its prior, a normal of sd `prior_sd` around
+/// zero.
+pub(crate) struct ExactParameter {
+    /// The parameter's (and the model input's) name.
+    pub name: &'static str,
+    /// Its unit.
+    pub unit: &'static str,
+    /// What it is, in words.
+    pub description: &'static str,
+    /// Its domain, [lo, hi].
+    pub range: [f64; 2],
+    /// The sd of its prior (a normal around zero, unbounded).
+    pub prior_sd: f64,
+    /// The value the modifier is tried at once before the candidate is returned (so an entry
+    /// that cannot apply to this detector says so now).
+    pub dry_run: f64,
+}
+
+/// A candidate that adds one exact-solver parameter (null value zero) to the start model: the
+/// exact model with `modify` applying it ([`ExactVariant`]), checked once at the start mode with
+/// the parameter at `dry_run`.
+pub(crate) fn one_more_exact(
+    ext: &dyn Extension,
+    base: &Baseline,
+    parameter: ExactParameter,
+    modify: Modifier,
+    label: &str,
+) -> Result<Candidate> {
+    let volts = base.model.voltages();
+    let model = ExactVariant::new(
+        base.exact,
+        volts,
+        &[(parameter.name, parameter.range)],
+        modify,
+        label,
+    )?;
+    let mut x = base_inputs(base)?;
+    x.push(parameter.dry_run);
+    model.detector(&x)?;
+    Ok(one_more(
+        ext,
+        base,
+        ExtensionPredictor::Exact,
+        Arc::new(model),
+        (
+            parameter.name,
+            parameter.unit,
+            parameter.description,
+            PriorDistribution::TruncatedNormal {
+                mean: 0.0,
+                sd: parameter.prior_sd,
+                lo: None,
+                hi: None,
+            },
+        ),
+        0.0,
+    ))
+}
+
+/// The start mode as model inputs of the surrogate's space (for a dry run of a modifier).
+fn base_inputs(base: &Baseline) -> Result<Vec<f64>> {
+    let names = base.model.inputs();
+    let prior = Prior::bind(base.spec, &names, &base.model.domain())?;
+    let mut x = vec![0.0; names.len()];
+    prior.expand(base.mode, &mut x);
+    Ok(x)
 }
 
 #[cfg(test)]

@@ -4,12 +4,10 @@
 //! surrogate's space: computed with the exact solver.
 
 use std::path::Path;
-use std::sync::Arc;
 
 use hpge_solver::Detector;
 
-use super::{Baseline, Candidate, ExactVariant, Extension, ExtensionPredictor, one_more};
-use crate::prior::{Prior, PriorDistribution};
+use super::{Baseline, Candidate, ExactParameter, Extension, one_more_exact};
 use crate::{Error, Result};
 
 /// Domain of y_quad.
@@ -55,43 +53,19 @@ impl Extension for QuadraticZ {
     }
 
     fn build(&self, base: &Baseline) -> Result<Candidate> {
-        let volts = base.model.voltages();
-        let model = ExactVariant::new(
-            base.exact,
-            volts,
-            &[("y_quad", QUAD_RANGE)],
-            set_quadratic,
-            LABEL,
-        )?;
-        let mut x = base_inputs(base)?;
-        x.push(0.0);
-        model.detector(&x)?;
-        Ok(one_more(
+        one_more_exact(
             self,
             base,
-            ExtensionPredictor::Exact,
-            Arc::new(model),
-            (
-                "y_quad",
-                "1",
-                "quadratic z term of y (its value at mid-height)",
-                PriorDistribution::TruncatedNormal {
-                    mean: 0.0,
-                    sd: QUAD_PRIOR_SD,
-                    lo: None,
-                    hi: None,
-                },
-            ),
-            0.0,
-        ))
+            ExactParameter {
+                name: "y_quad",
+                unit: "1",
+                description: "quadratic z term of y (its value at mid-height)",
+                range: QUAD_RANGE,
+                prior_sd: QUAD_PRIOR_SD,
+                dry_run: 0.0,
+            },
+            set_quadratic,
+            LABEL,
+        )
     }
-}
-
-/// The start mode as model inputs of the surrogate's space (for a dry run of a modifier).
-pub(super) fn base_inputs(base: &Baseline) -> Result<Vec<f64>> {
-    let names = base.model.inputs();
-    let prior = Prior::bind(base.spec, &names, &base.model.domain())?;
-    let mut x = vec![0.0; names.len()];
-    prior.expand(base.mode, &mut x);
-    Ok(x)
 }

@@ -3,9 +3,10 @@
 
 use hpge_inference::fit::{LEVELS, Predictive};
 use plotters::coord::Shift;
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 
-use super::layout::{Key, LEVEL_COLORS, key_strip, padded, ticks};
+use super::layout::{Axes, Key, LEVEL_COLORS, draw_axes, key_strip, padded};
 use crate::error::Result;
 use crate::plot::style::PALETTE;
 use crate::plot::style::err;
@@ -63,23 +64,7 @@ pub(super) fn predictive<DB: DrawingBackend>(
     });
     let (y0, y1) = padded(ys.chain([0.0]), 0.08);
     let (x0, x1) = padded(pred.voltage_v.iter().copied(), 0.03);
-    let mut chart = ChartBuilder::on(&body)
-        .margin(20)
-        .x_label_area_size(52)
-        .y_label_area_size(80)
-        .build_cartesian_2d(x0..x1, y0..y1)
-        .map_err(err)?;
-    chart
-        .configure_mesh()
-        .x_desc("U_B [V]")
-        .y_desc("c_p - c_m [pF]")
-        .x_label_formatter(&ticks(x1 - x0))
-        .y_label_formatter(&ticks(y1 - y0))
-        .label_style(("sans-serif", 16))
-        .axis_desc_style(("sans-serif", 18))
-        .light_line_style(WHITE)
-        .draw()
-        .map_err(err)?;
+    let mut chart = curve_chart(&body, (x0, x1), (y0, y1), ("U_B [V]", "c_p - c_m [pF]"))?;
     // Widest band first, so that the narrower ones lie on top.
     for l in (0..LEVELS.len()).rev() {
         let have: Vec<(f64, [f64; 2])> = order
@@ -158,23 +143,12 @@ pub(super) fn zeta<DB: DrawingBackend>(
         .iter()
         .flat_map(|p| p.zeta_cm3.iter().map(|z| z / 1e10));
     let (y0, y1) = padded(ys.chain([0.0]), 0.06);
-    let mut chart = ChartBuilder::on(&body)
-        .margin(20)
-        .x_label_area_size(52)
-        .y_label_area_size(80)
-        .build_cartesian_2d(x0..x1, y0..y1)
-        .map_err(err)?;
-    chart
-        .configure_mesh()
-        .x_desc(format!("{axis} [mm]"))
-        .y_desc("zeta [1e10 cm^-3]")
-        .x_label_formatter(&ticks(x1 - x0))
-        .y_label_formatter(&ticks(y1 - y0))
-        .light_line_style(WHITE)
-        .label_style(("sans-serif", 16))
-        .axis_desc_style(("sans-serif", 18))
-        .draw()
-        .map_err(err)?;
+    let mut chart = curve_chart(
+        &body,
+        (x0, x1),
+        (y0, y1),
+        (&format!("{axis} [mm]"), "zeta [1e10 cm^-3]"),
+    )?;
     chart
         .draw_series(LineSeries::new(
             [(x0, 0.0), (x1, 0.0)],
@@ -191,4 +165,29 @@ pub(super) fn zeta<DB: DrawingBackend>(
             .map_err(err)?;
     }
     Ok(())
+}
+
+/// A whole-figure chart of the fit's curves on [x0, x1] x [y0, y1], with its axes drawn.
+fn curve_chart<'a, DB: DrawingBackend>(
+    body: &'a DrawingArea<DB, Shift>,
+    (x0, x1): (f64, f64),
+    (y0, y1): (f64, f64),
+    desc: (&str, &str),
+) -> Result<ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>> {
+    let mut chart = ChartBuilder::on(body)
+        .margin(20)
+        .x_label_area_size(52)
+        .y_label_area_size(80)
+        .build_cartesian_2d(x0..x1, y0..y1)
+        .map_err(err)?;
+    draw_axes(
+        &mut chart,
+        Axes {
+            desc,
+            span: (x1 - x0, y1 - y0),
+            labels: None,
+            font: (16, 18),
+        },
+    )?;
+    Ok(chart)
 }

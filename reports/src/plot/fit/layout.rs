@@ -3,6 +3,7 @@
 
 use hpge_inference::fit::ParameterSummary;
 use plotters::coord::Shift;
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
@@ -82,6 +83,41 @@ pub(super) fn padded(values: impl Iterator<Item = f64>, frac: f64) -> (f64, f64)
         0.1 * lo.abs().max(1e-12)
     };
     (lo - pad, hi + pad)
+}
+
+/// The axes of a fit figure's panel: what each axis shows, the spans the tick labels are
+/// formatted for, how many labels (plotters' default where `None`), and the font sizes of the
+/// labels and of the axis descriptions.
+pub(super) struct Axes<'a> {
+    /// What the x and the y axis show.
+    pub desc: (&'a str, &'a str),
+    /// The x and y spans, for [`ticks`].
+    pub span: (f64, f64),
+    /// How many labels on x and on y.
+    pub labels: Option<(usize, usize)>,
+    /// Font sizes of the tick labels and of the axis descriptions.
+    pub font: (u32, u32),
+}
+
+/// Draws a panel's axes in the fit figures' style (no light grid lines).
+pub(super) fn draw_axes<DB: DrawingBackend>(
+    chart: &mut ChartContext<'_, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+    axes: Axes,
+) -> Result<()> {
+    let (x_ticks, y_ticks) = (ticks(axes.span.0), ticks(axes.span.1));
+    let mut mesh = chart.configure_mesh();
+    mesh.x_desc(axes.desc.0)
+        .y_desc(axes.desc.1)
+        .x_label_formatter(&x_ticks)
+        .y_label_formatter(&y_ticks)
+        .label_style(("sans-serif", axes.font.0))
+        .axis_desc_style(("sans-serif", axes.font.1))
+        .light_line_style(WHITE);
+    if let Some((x, y)) = axes.labels {
+        mesh.x_labels(x).y_labels(y);
+    }
+    mesh.draw().map_err(err)?;
+    Ok(())
 }
 
 /// A tick-label formatter for an axis spanning `span`: as many decimals as a step of about

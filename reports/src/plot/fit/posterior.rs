@@ -6,8 +6,8 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::layout::{
-    Key, LEVEL_COLORS, OUTSIDE, PRIOR, TRUTH, axis_label, grid, key_strip, padded, ticks,
-    view_range,
+    Axes, Key, LEVEL_COLORS, OUTSIDE, PRIOR, TRUTH, axis_label, draw_axes, grid, key_strip, padded,
+    ticks, view_range,
 };
 use crate::error::Result;
 use crate::plot::colormap::t_color;
@@ -122,19 +122,15 @@ fn marginal<DB: DrawingBackend>(
         .y_label_area_size(62)
         .build_cartesian_2d(lo..hi, 0.0..top)
         .map_err(err)?;
-    chart
-        .configure_mesh()
-        .x_desc(axis_label(p))
-        .y_desc("posterior density")
-        .x_labels(6)
-        .y_labels(6)
-        .x_label_formatter(&ticks(hi - lo))
-        .y_label_formatter(&ticks(top))
-        .label_style(("sans-serif", 15))
-        .axis_desc_style(("sans-serif", 17))
-        .light_line_style(WHITE)
-        .draw()
-        .map_err(err)?;
+    draw_axes(
+        &mut chart,
+        Axes {
+            desc: (&axis_label(p), "posterior density"),
+            span: (hi - lo, top),
+            labels: Some((6, 6)),
+            font: (15, 17),
+        },
+    )?;
     chart
         .draw_series(
             h.iter()
@@ -229,17 +225,15 @@ pub(super) fn pair<DB: DrawingBackend>(
         .y_label_area_size(72)
         .build_cartesian_2d(x0..x1, y0..y1)
         .map_err(err)?;
-    chart
-        .configure_mesh()
-        .x_desc(axis_label(pa))
-        .y_desc(axis_label(pb))
-        .x_label_formatter(&ticks(x1 - x0))
-        .y_label_formatter(&ticks(y1 - y0))
-        .label_style(("sans-serif", 16))
-        .axis_desc_style(("sans-serif", 18))
-        .light_line_style(WHITE)
-        .draw()
-        .map_err(err)?;
+    draw_axes(
+        &mut chart,
+        Axes {
+            desc: (&axis_label(pa), &axis_label(pb)),
+            span: (x1 - x0, y1 - y0),
+            labels: None,
+            font: (16, 18),
+        },
+    )?;
     chart
         .draw_series(
             h.iter()
@@ -340,19 +334,15 @@ pub(super) fn traces<DB: DrawingBackend>(
             .y_label_area_size(70)
             .build_cartesian_2d(0.0..(len - 1) as f64, lo..hi)
             .map_err(err)?;
-        chart
-            .configure_mesh()
-            .x_desc("draw")
-            .y_desc(axis_label(p))
-            .x_label_formatter(&ticks(len as f64))
-            .y_label_formatter(&ticks(hi - lo))
-            .x_labels(6)
-            .y_labels(5)
-            .label_style(("sans-serif", 14))
-            .axis_desc_style(("sans-serif", 16))
-            .light_line_style(WHITE)
-            .draw()
-            .map_err(err)?;
+        draw_axes(
+            &mut chart,
+            Axes {
+                desc: ("draw", &axis_label(p)),
+                span: (len as f64, hi - lo),
+                labels: Some((6, 5)),
+                font: (14, 16),
+            },
+        )?;
         for (c, chain) in chains.iter().enumerate() {
             let color = PALETTE[c % PALETTE.len()].mix(0.75);
             let pts = chain
