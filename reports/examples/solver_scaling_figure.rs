@@ -18,7 +18,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut rows: Vec<(String, f64, f64)> = Vec::new();
     for (k, line) in text.lines().enumerate().skip(1) {
         let f: Vec<&str> = line.split(',').collect();
-        let bad = || format!("{} line {}: expected method,h_mm,nodes,iterations,potential_s,point_s,c12_pF", csv.display(), k + 1);
+        let bad = || {
+            format!(
+                "{} line {}: expected method,h_mm,nodes,iterations,potential_s,point_s,c12_pF",
+                csv.display(),
+                k + 1
+            )
+        };
         if f.len() != 7 {
             return Err(bad().into());
         }

@@ -25,14 +25,20 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         &Parameters::new(),
     )?;
     println!("method,h_mm,nodes,iterations,potential_s,point_s,c12_pF");
-    for h in [2.0, 1.4, 1.0, 0.7, 0.5, 0.35, 0.25, 0.18, 0.125, 0.09, 0.0625] {
+    for h in [
+        2.0, 1.4, 1.0, 0.7, 0.5, 0.35, 0.25, 0.18, 0.125, 0.09, 0.0625,
+    ] {
         let mut s = FieldSettings::default();
         s.grid.max_spacing_semiconductor_mm = h;
         s.grid.max_spacing_mm = (4.0 * h).min(s.grid.max_spacing_mm);
         let grid = Grid::initial(&det, &s.grid);
         let nodes = grid.len();
         for method in [Method::Fast, Method::Sor] {
-            let max = if method == Method::Sor { sor_max } else { fast_max };
+            let max = if method == Method::Sor {
+                sor_max
+            } else {
+                fast_max
+            };
             if nodes > max {
                 continue;
             }

@@ -127,8 +127,14 @@ fn untied_seed_gives_the_same_solution_with_less_work() {
     let u = find_pocket_bias(&det, &coarse);
     let c = solve_fast(&coarse, &det, u, None).unwrap();
     assert!(!c.pockets.is_empty());
-    let untied = c.untied_phi_v.as_ref().expect("a pocket round changed the answer");
-    assert!(max_diff(untied, &c.phi_v) > 1e-3, "untied and tied fields coincide");
+    let untied = c
+        .untied_phi_v
+        .as_ref()
+        .expect("a pocket round changed the answer");
+    assert!(
+        max_diff(untied, &c.phi_v) > 1e-3,
+        "untied and tied fields coincide"
+    );
     let gs = GridSettings {
         max_spacing_semiconductor_mm: 1.0,
         max_spacing_mm: 2.5,
