@@ -113,6 +113,33 @@ pub fn load_detector(input: &DetectorInput) -> Result<Detector> {
     Ok(det)
 }
 
+/// Adds what every single-detector JSON record carries (the detector and impurity files, the
+/// parameters and the program version) to the object `v`. serde_json's maps are sorted, so the
+/// record prints the same wherever the keys were inserted.
+pub fn with_detector_provenance(mut v: serde_json::Value, det: &Detector) -> serde_json::Value {
+    if let Some(o) = v.as_object_mut() {
+        o.insert("detector".into(), det.file.display().to_string().into());
+        o.insert(
+            "impurity_file".into(),
+            det.semiconductor
+                .impurity_file()
+                .display()
+                .to_string()
+                .into(),
+        );
+        o.insert(
+            "parameters".into(),
+            serde_json::json!(
+                det.parameters
+                    .iter()
+                    .collect::<std::collections::BTreeMap<_, _>>()
+            ),
+        );
+        o.insert("version".into(), env!("CARGO_PKG_VERSION").into());
+    }
+    v
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

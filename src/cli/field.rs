@@ -146,20 +146,19 @@ pub fn run(a: &FieldArgs) -> Result<()> {
         plot::line_figure(&fig, path)?;
     }
     if a.json {
-        let v = json!({
-            "r_mm": line.r_mm,
-            "e_V_per_m": line.e_v_per_m,
-            "e_V_per_cm": v_cm,
-            "status": line.status.iter().map(|s| s.as_str()).collect::<Vec<_>>(),
-            "phi_deg": a.phi,
-            "z_mm": a.z,
-            "voltage_V": a.voltage,
-            "fully_depleted": point.fully_depleted(),
-            "detector": det.file.display().to_string(),
-            "impurity_file": det.semiconductor.impurity_file().display().to_string(),
-            "parameters": det.parameters.iter().collect::<std::collections::BTreeMap<_, _>>(),
-            "version": env!("CARGO_PKG_VERSION"),
-        });
+        let v = super::args::with_detector_provenance(
+            json!({
+                "r_mm": line.r_mm,
+                "e_V_per_m": line.e_v_per_m,
+                "e_V_per_cm": v_cm,
+                "status": line.status.iter().map(|s| s.as_str()).collect::<Vec<_>>(),
+                "phi_deg": a.phi,
+                "z_mm": a.z,
+                "voltage_V": a.voltage,
+                "fully_depleted": point.fully_depleted(),
+            }),
+            &det,
+        );
         println!("{v}");
     } else {
         println!(

@@ -135,26 +135,25 @@ pub fn run(a: &PulseArgs) -> Result<()> {
     }
     let rise = rise_time_10_90_ns(&p.t_ns, &p.signals[k_ref].charge);
     if a.json {
-        let v = json!({
-            "t_ns": p.t_ns,
-            "contacts": p.signals.iter().map(|s| json!({"name": s.name, "signal": s.charge})).collect::<Vec<_>>(),
-            "collection_time_ns": p.collection_time_ns,
-            "electron": p.electron.outcome(&det),
-            "hole": p.hole.outcome(&det),
-            "normalised": a.normalise,
-            "normalised_by": divisor,
-            "reference_contact": det.contacts[k_ref].name,
-            "rise_time_10_90_ns": rise,
-            "at": {"r_mm": r_mm, "phi_deg": phi_deg, "z_mm": z_mm},
-            "voltage_V": a.voltage,
-            "fully_depleted": point.fully_depleted(),
-            "detector": det.file.display().to_string(),
-            "impurity_file": det.semiconductor.impurity_file().display().to_string(),
-            "parameters": det.parameters.iter().collect::<std::collections::BTreeMap<_, _>>(),
-            "drift_model": {"name": "ADL", "file": a.drift_parameters.as_ref().map(|f| f.display().to_string()), "parameters": adl},
-            "drift_settings": drift,
-            "version": env!("CARGO_PKG_VERSION"),
-        });
+        let v = super::args::with_detector_provenance(
+            json!({
+                "t_ns": p.t_ns,
+                "contacts": p.signals.iter().map(|s| json!({"name": s.name, "signal": s.charge})).collect::<Vec<_>>(),
+                "collection_time_ns": p.collection_time_ns,
+                "electron": p.electron.outcome(&det),
+                "hole": p.hole.outcome(&det),
+                "normalised": a.normalise,
+                "normalised_by": divisor,
+                "reference_contact": det.contacts[k_ref].name,
+                "rise_time_10_90_ns": rise,
+                "at": {"r_mm": r_mm, "phi_deg": phi_deg, "z_mm": z_mm},
+                "voltage_V": a.voltage,
+                "fully_depleted": point.fully_depleted(),
+                "drift_model": {"name": "ADL", "file": a.drift_parameters.as_ref().map(|f| f.display().to_string()), "parameters": adl},
+                "drift_settings": drift,
+            }),
+            &det,
+        );
         println!("{v}");
     } else {
         print_summary(&det, &p, &provenance, rise, divisor);

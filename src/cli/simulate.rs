@@ -152,37 +152,36 @@ pub fn run(o: &SimulateOptions<'_>) -> Result<()> {
     let pinch_off_v = curve_pinch_off_voltage(&det, &curve, &settings)?;
     let last = curve.points.last().map_or((0, 0), |p| p.grid);
     if o.json {
-        let v = json!({
-            "voltage_V": curve.points.iter().map(|p| p.voltage_v).collect::<Vec<_>>(),
-            "c12_pF": curve.points.iter().map(|p| p.c12_pf).collect::<Vec<_>>(),
-            "c12_err_pF": curve.points.iter().map(|p| p.c12_err_pf).collect::<Vec<_>>(),
-            "tolerance_reached": curve.points.iter().map(|p| p.tolerance_reached).collect::<Vec<_>>(),
-            "tolerance": settings.grid.tolerance,
-            "adaptive": settings.grid.adaptive,
-            "fully_depleted": curve.points.iter().map(|p| p.fully_depleted).collect::<Vec<_>>(),
-            "depletion_voltage_V": curve.depletion_voltage_v,
-            "pinch_off_voltage_V": pinch_off_v,
-            "pockets": curve.points.iter().map(|p| p.pockets.iter().map(|k| json!({
-                "carrier": k.carrier,
-                "level_V": k.level_v,
-                "volume_cm3": k.volume_cm3,
-                "nodes": k.nodes,
-                "centroid_mm": [k.centroid_mm.0, k.centroid_mm.1],
-                "r_range_mm": [k.r_range_mm.0, k.r_range_mm.1],
-                "z_range_mm": [k.z_range_mm.0, k.z_range_mm.1],
-            })).collect::<Vec<_>>()).collect::<Vec<_>>(),
-            "grid": {"nr": last.0, "nz": last.1},
-            "grid_per_point": curve.points.iter().map(|p| json!({"nr": p.grid.0, "nz": p.grid.1})).collect::<Vec<_>>(),
-            "method": settings.method.as_str(),
-            "weighting": settings.weighting.as_str(),
-            "backend": settings.backend.as_str(),
-            "device": device,
-            "seconds": seconds,
-            "detector": det.file.display().to_string(),
-            "impurity_file": det.semiconductor.impurity_file().display().to_string(),
-            "parameters": det.parameters.iter().collect::<std::collections::BTreeMap<_, _>>(),
-            "version": env!("CARGO_PKG_VERSION"),
-        });
+        let v = super::args::with_detector_provenance(
+            json!({
+                "voltage_V": curve.points.iter().map(|p| p.voltage_v).collect::<Vec<_>>(),
+                "c12_pF": curve.points.iter().map(|p| p.c12_pf).collect::<Vec<_>>(),
+                "c12_err_pF": curve.points.iter().map(|p| p.c12_err_pf).collect::<Vec<_>>(),
+                "tolerance_reached": curve.points.iter().map(|p| p.tolerance_reached).collect::<Vec<_>>(),
+                "tolerance": settings.grid.tolerance,
+                "adaptive": settings.grid.adaptive,
+                "fully_depleted": curve.points.iter().map(|p| p.fully_depleted).collect::<Vec<_>>(),
+                "depletion_voltage_V": curve.depletion_voltage_v,
+                "pinch_off_voltage_V": pinch_off_v,
+                "pockets": curve.points.iter().map(|p| p.pockets.iter().map(|k| json!({
+                    "carrier": k.carrier,
+                    "level_V": k.level_v,
+                    "volume_cm3": k.volume_cm3,
+                    "nodes": k.nodes,
+                    "centroid_mm": [k.centroid_mm.0, k.centroid_mm.1],
+                    "r_range_mm": [k.r_range_mm.0, k.r_range_mm.1],
+                    "z_range_mm": [k.z_range_mm.0, k.z_range_mm.1],
+                })).collect::<Vec<_>>()).collect::<Vec<_>>(),
+                "grid": {"nr": last.0, "nz": last.1},
+                "grid_per_point": curve.points.iter().map(|p| json!({"nr": p.grid.0, "nz": p.grid.1})).collect::<Vec<_>>(),
+                "method": settings.method.as_str(),
+                "weighting": settings.weighting.as_str(),
+                "backend": settings.backend.as_str(),
+                "device": device,
+                "seconds": seconds,
+            }),
+            &det,
+        );
         println!("{v}");
     } else {
         println!(
