@@ -190,20 +190,8 @@ pub(crate) fn solve_point_with(
                 .iter()
                 .all(|c| !c.at_contact)
     };
-    let finish = |mesh: Mesh, pot: PotentialSolution, w: Weighed, reports, accuracy| {
-        let undepleted_nodes = undepleted_nodes(&mesh, &pot);
-        PointResult {
-            bias_v,
-            mesh,
-            potential: pot,
-            weighting: w.weighting,
-            capacitance: w.capacitance,
-            c12_pf: w.c12_pf,
-            undepleted_nodes,
-            contact_layers: w.contact_layers,
-            reports,
-            accuracy,
-        }
+    let finish = |mesh, pot, w, reports, accuracy| {
+        PointResult::assemble(bias_v, mesh, pot, w, reports, accuracy)
     };
     // A fully depleted point restarts from the detector's initial grid (or the grid another
     // depleted bias ended on): its c12 then does not depend on the bias or on the neighbouring
@@ -298,23 +286,41 @@ pub fn solve_point_on_grid(
     let mesh = Mesh::new(det, grid);
     let pot = potential_on(det, bias_v, settings, &mesh, seed.as_ref())?;
     let w = weigh(det, settings, &mesh, &pot, bias_v, pair)?;
-    let undepleted_nodes = undepleted_nodes(&mesh, &pot);
-    Ok(PointResult {
-        bias_v,
-        reports: vec![pot.report.clone()],
-        mesh,
-        potential: pot,
-        weighting: w.weighting,
-        capacitance: w.capacitance,
-        c12_pf: w.c12_pf,
-        undepleted_nodes,
-        contact_layers: w.contact_layers,
-        accuracy: Accuracy {
-            c12_err_pf: f64::NAN,
-            passes: 1,
-            reached: true,
-        },
-    })
+    let reports = vec![pot.report.clone()];
+    let accuracy = Accuracy {
+        c12_err_pf: f64::NAN,
+        passes: 1,
+        reached: true,
+    };
+    Ok(PointResult::assemble(
+        bias_v, mesh, pot, w, reports, accuracy,
+    ))
+}
+
+impl PointResult {
+    /// A point from its final mesh, potential and weighting stage.
+    fn assemble(
+        bias_v: f64,
+        mesh: Mesh,
+        pot: PotentialSolution,
+        w: Weighed,
+        reports: Vec<SolveReport>,
+        accuracy: Accuracy,
+    ) -> Self {
+        let undepleted_nodes = undepleted_nodes(&mesh, &pot);
+        Self {
+            bias_v,
+            mesh,
+            potential: pot,
+            weighting: w.weighting,
+            capacitance: w.capacitance,
+            c12_pf: w.c12_pf,
+            undepleted_nodes,
+            contact_layers: w.contact_layers,
+            reports,
+            accuracy,
+        }
+    }
 }
 
 /// A starting point for a potential solve: node fields on the new grid.
