@@ -21,8 +21,10 @@ fn temp(name: &str) -> PathBuf {
     d
 }
 
-fn generate(out: &Path, n: &str, extra: &[&str]) -> Output {
-    let mut args = vec![
+/// `generate` of `n` rows of the paper's space into `out`.
+fn generate_command(out: &Path, n: &str) -> Command {
+    let mut c = bin();
+    c.args([
         "generate",
         "--space",
         "spaces/super-siegfried-rz.toml",
@@ -37,9 +39,23 @@ fn generate(out: &Path, n: &str, extra: &[&str]) -> Output {
         // paper_space_no_shorts.rs).
         "--grid",
         "adaptive=false",
-    ];
-    args.extend_from_slice(extra);
-    run(&args)
+    ]);
+    c
+}
+
+fn generate(out: &Path, n: &str, extra: &[&str]) -> Output {
+    generate_command(out, n).args(extra).output().unwrap()
+}
+
+/// A one-thread `generate` in the background, output discarded (for the tests that kill it or
+/// run a second process beside it).
+fn spawn_generate(out: &Path, n: &str) -> std::process::Child {
+    generate_command(out, n)
+        .args(["--threads", "1"])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap()
 }
 
 /// Rows sorted by index without the `seconds` column (wall time differs between runs).
@@ -113,26 +129,7 @@ fn a_second_process_on_the_same_folder_is_refused() {
     // not leave the folder locked.
     let d = temp("lock");
     let out = d.join("busy");
-    let mut first = bin()
-        .args([
-            "generate",
-            "--space",
-            "spaces/super-siegfried-rz.toml",
-            "--detector",
-            "detectors/super-siegfried-k1.toml",
-            "--n",
-            "5000",
-            "--out",
-            out.to_str().unwrap(),
-            "--threads",
-            "1",
-            "--grid",
-            "adaptive=false",
-        ])
-        .stdout(std::process::Stdio::null())
-        .stderr(std::process::Stdio::null())
-        .spawn()
-        .unwrap();
+    let mut first = spawn_generate(&out, "5000");
     // Wait until the first run holds the lock (it writes its pid into the lock file).
     let lock = out.join("generate.lock");
     let t0 = std::time::Instant::now();
@@ -164,26 +161,7 @@ fn kill_and_resume_loses_and_duplicates_nothing() {
     );
     let out = d.join("killed");
     for delay_ms in [300, 700] {
-        let mut child = bin()
-            .args([
-                "generate",
-                "--space",
-                "spaces/super-siegfried-rz.toml",
-                "--detector",
-                "detectors/super-siegfried-k1.toml",
-                "--n",
-                "24",
-                "--out",
-                out.to_str().unwrap(),
-                "--threads",
-                "1",
-                "--grid",
-                "adaptive=false",
-            ])
-            .stdout(std::process::Stdio::null())
-            .stderr(std::process::Stdio::null())
-            .spawn()
-            .unwrap();
+        let mut child = spawn_generate(&out, "24");
         std::thread::sleep(std::time::Duration::from_millis(delay_ms));
         let _ = child.kill(); // SIGKILL
         let _ = child.wait();
