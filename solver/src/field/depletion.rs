@@ -11,6 +11,7 @@
 
 use std::time::Instant;
 
+use super::band;
 use super::cholesky::{Factor, Symbolic};
 use super::mesh::{Mesh, NodeKind};
 use super::pockets::{self, Pocket, Ties, depression_depths_v, find_pockets};
@@ -101,7 +102,11 @@ pub(crate) const POCKET_CYCLE_TOL: f64 = 1e-3;
 /// Inside a round the semismooth Newton iteration (Hintermueller, Ito, Kunisch 2003) runs with
 /// the pocket levels as extra unknowns: with the active set fixed, the potential is affine in the
 /// levels l_k (x = x_0 + sum_k l_k y_k, one triangular solve per pocket with the same
-/// factorisation) and l_k = x(s_k) at each pour point s_k closes the system.
+/// factorisation) and l_k = x(s_k) at each pour point s_k closes the system. Its first
+/// iterations take the active set that a projected relaxation in a band around the front
+/// proposes (`field::band`), so the front crosses many grid layers per factorisation; a seeded
+/// solve moves its guess's front that way before the first factorisation. The answer is the
+/// plain method's: a round ends only when a plain step leaves the active set unchanged.
 pub fn solve_fast(
     mesh: &Mesh,
     det: &Detector,
@@ -125,6 +130,19 @@ pub fn solve_fast_with(
     bias_v: f64,
     guess_v: Option<&[f64]>,
     untied_guess_v: Option<&[f64]>,
+) -> Result<PotentialSolution> {
+    solve_with_band_steps(mesh, det, bias_v, guess_v, untied_guess_v, BAND_STEPS)
+}
+
+/// [`solve_fast_with`] with `band_steps` band-relaxation steps per round (0: the plain
+/// active-set method, which reaches the same solution in more iterations; `band.rs`).
+pub(crate) fn solve_with_band_steps(
+    mesh: &Mesh,
+    det: &Detector,
+    bias_v: f64,
+    guess_v: Option<&[f64]>,
+    untied_guess_v: Option<&[f64]>,
+    band_steps: usize,
 ) -> Result<PotentialSolution> {
     let guess_v = untied_guess_v.or(guess_v);
     let start = Instant::now();
@@ -157,6 +175,20 @@ pub fn solve_fast_with(
             }
         }
     }
+    // A seeded start: the guess's front moved by the band relaxation before the first
+    // factorisation (the guess is an interpolated or rescaled field, off by a few cells there).
+    if let Some(g) = guess_v
+        && g.len() == mesh.kind.len()
+        && band_steps > 0
+    {
+        let mut x = vec![0.0; n];
+        for (k, &v) in g.iter().enumerate() {
+            if let Some(u) = sys.node_unknown[k] {
+                x[u] = v;
+            }
+        }
+        state = band_state(&sys, &bounded, |_| (lo, hi), &x, &state);
+    }
     let sym = sys.symbolic()?;
     // One factor's storage for every active-set iteration of every round.
     let mut factor: Option<Factor> = None;
@@ -176,6 +208,7 @@ pub fn solve_fast_with(
             bounded: &bounded,
             bounds: (lo, hi),
             ties: pocket_ties(&sys, &ties, prev_phi.as_deref()),
+            band_steps,
         };
         let (x, fell_back) = ctx.solve(&sym, &mut factor, &mut state, &mut iterations)?;
         let phi = sys.to_nodes(&x);
@@ -343,6 +376,8 @@ struct Round<'a> {
     bounded: &'a [bool],
     bounds: (f64, f64),
     ties: UnknownTies,
+    /// Iterations (from the first) whose next active set the band relaxation proposes.
+    band_steps: usize,
 }
 
 impl Round<'_> {
@@ -497,7 +532,7 @@ impl Round<'_> {
                 }
             }
             let ax = sys.matvec(&sys.val, &x);
-            let mut changed = false;
+            let mut next = state.to_vec();
             for u in 0..n {
                 if !self.bounded[u] {
                     continue;
@@ -508,23 +543,95 @@ impl Round<'_> {
                     _ => sys.rhs[u] - ax[u],
                 };
                 let c = sys.val[sys.diag_pos[u]];
-                let next = if lambda + c * (x[u] - bu) > 0.0 {
+                next[u] = if lambda + c * (x[u] - bu) > 0.0 {
                     Bound::Upper
                 } else if lambda + c * (x[u] - bl) < 0.0 {
                     Bound::Lower
                 } else {
                     Bound::Free
                 };
-                if next != state[u] {
-                    changed = true;
-                    state[u] = next;
-                }
             }
-            if !changed {
+            if next == state {
                 return Ok((x, fell_back));
             }
+            // Early on, let the front move as far as the band's local solve says (`band.rs`;
+            // tied unknowns bounded by the present levels); later, plain steps.
+            if local <= self.band_steps {
+                let proposed = self.band_step(&x, &next, &levels);
+                if proposed != state {
+                    next = proposed;
+                }
+            }
+            state.copy_from_slice(&next);
         }
     }
+}
+
+/// Active-set iterations of a round (from its first) whose next active set comes from the
+/// band relaxation (`band.rs`) rather than the plain step; a seeded solve also moves its
+/// guess's front once before the first factorisation.
+const BAND_STEPS: usize = 6;
+
+/// Graph distance (edges) from the front that the band relaxation covers.
+const BAND_DEPTH: usize = 8;
+
+/// Largest number of sweeps of one band relaxation.
+const BAND_SWEEPS: usize = 64;
+
+impl Round<'_> {
+    /// [`band_state`] for this round, each tied unknown bounded by its pocket's present level.
+    fn band_step(&self, x: &[f64], next: &[Bound], levels: &[f64]) -> Vec<Bound> {
+        band_state(
+            self.sys,
+            self.bounded,
+            |u| self.bounds_of(u, levels),
+            x,
+            next,
+        )
+    }
+}
+
+/// The active set proposed by a projected relaxation around the front of `next` (an active
+/// set), starting from the potential `x` (unknown space, V; `band.rs`); `bounds(u)` gives each
+/// bounded unknown's [l, u] (V).
+fn band_state(
+    sys: &System,
+    bounded: &[bool],
+    bounds: impl Fn(usize) -> (f64, f64),
+    x: &[f64],
+    next: &[Bound],
+) -> Vec<Bound> {
+    // Front: bounded unknowns with a bounded neighbour in another state.
+    let seeds: Vec<usize> = (0..sys.n)
+        .filter(|&u| {
+            bounded[u]
+                && (sys.col_ptr[u]..sys.col_ptr[u + 1]).any(|e| {
+                    let v = sys.row_idx[e];
+                    bounded[v] && next[v] != next[u]
+                })
+        })
+        .collect();
+    let members = band::band(sys, &seeds, bounded, BAND_DEPTH);
+    let mut xt: Vec<f64> = x.to_vec();
+    let mut span: f64 = 1.0;
+    for &u in &members {
+        let (l, h) = bounds(u);
+        span = span.max((h - l).abs());
+        xt[u] = xt[u].clamp(l, h);
+    }
+    band::relax(sys, &mut xt, &members, &bounds, 1e-6 * span, BAND_SWEEPS);
+    let mut out = next.to_vec();
+    for &u in &members {
+        let (l, h) = bounds(u);
+        out[u] = if xt[u] >= h {
+            Bound::Upper
+        } else if xt[u] <= l {
+            Bound::Lower
+        } else {
+            Bound::Free
+        };
+    }
+    out
 }
 
 /// Solves the small dense system a x = b (row-major m x m) by Gaussian elimination with partial

@@ -1,6 +1,7 @@
 //! Field solves: potential with depletion, weighting potentials, capacitance matrix.
 
 mod adaptive;
+mod band;
 mod capacitance;
 mod charge;
 mod cholesky;
