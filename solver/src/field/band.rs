@@ -109,7 +109,7 @@ mod tests {
 
     use crate::detector::Detector;
     use crate::expr::Parameters;
-    use crate::field::depletion::solve_with_band_steps;
+    use crate::field::depletion::{BAND_STEPS, solve_with_band_steps};
     use crate::field::mesh::Mesh;
     use crate::grid::{Grid, GridSettings};
 
@@ -150,7 +150,8 @@ mod tests {
             let guess = coarse.grid.interpolate_to(&c.phi_v, &fine.grid);
             for seed in [None, Some(guess.as_slice())] {
                 let plain = solve_with_band_steps(&fine, &det, bias_v, seed, None, 0).unwrap();
-                let band = solve_with_band_steps(&fine, &det, bias_v, seed, None, 6).unwrap();
+                let band =
+                    solve_with_band_steps(&fine, &det, bias_v, seed, None, BAND_STEPS).unwrap();
                 assert_eq!(plain.phi_v, band.phi_v, "{file} at {bias_v} V");
                 assert_eq!(plain.undepleted, band.undepleted, "{file} at {bias_v} V");
                 assert_eq!(plain.pockets.len(), band.pockets.len(), "{file}");
