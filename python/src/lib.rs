@@ -7,7 +7,7 @@
 //! Units at every interface: lengths mm, potentials V, densities cm^-3 (signed: positive is
 //! n-type), capacitances pF, times ns, fields V/cm.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use hpge_inference::fit::{FitJob, FitOptions, outputs};
 use hpge_measurement::{MeasureOptions, measure as measure_run, read_raw_dir};
@@ -748,18 +748,18 @@ fn legend_to_toml(
     .map_err(err)
 }
 
+/// r (mm), z (mm) and the surface of each segment.
+type Outline<'py> = (
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray1<f64>>,
+    Vec<&'static str>,
+);
+
 /// The crystal's r-z outline (mm) of a LEGEND diode record as hpge-cv converts it: a tuple of
 /// arrays (r_mm, z_mm), from the axis at the p+ face around to the axis (the closing segment
 /// runs along the axis), and the surface of each segment ("p+", "n+", "passive").
 #[pyfunction]
-fn legend_outline<'py>(
-    py: Python<'py>,
-    record: &Bound<'py, PyAny>,
-) -> PyResult<(
-    Bound<'py, PyArray1<f64>>,
-    Bound<'py, PyArray1<f64>>,
-    Vec<&'static str>,
-)> {
+fn legend_outline<'py>(py: Python<'py>, record: &Bound<'py, PyAny>) -> PyResult<Outline<'py>> {
     let (text, source) = legend::record_text(py, record)?;
     let d = hpge_solver::detector::legend::read_json(
         &text,
@@ -781,12 +781,6 @@ fn legend_outline<'py>(
         array(py, d.outline_mm.iter().map(|p| p[1]).collect()),
         surfaces,
     ))
-}
-
-/// The path's text for messages.
-#[allow(dead_code)]
-fn shown(p: &Path) -> String {
-    p.display().to_string()
 }
 
 /// hpge-cv from Python: detectors, C-V curves, capacitance, pulses and fields from the field
