@@ -17,7 +17,9 @@ for rec in "$TMP/V07646A.json" detectors/legend/B00002A.json detectors/legend/V0
   "$BIN" detector --from-legend "$rec" --out "$TMP/$name.toml" \
     --plot "$OUT/$name.png" --plot "$OUT/$name.svg" > /dev/null 2> "$TMP/$name.log"
   grep "characterization" "$TMP/$name.log" || true
-  "$BIN" simulate --detector "$TMP/$name.toml" --voltages 100:6000:100 --json \
+  [ "${PLOTS_ONLY:-0}" = 1 ] && continue
+  # U_fd to 100 V (the full-depletion voltage is located between the listed biases) at 1% c12.
+  "$BIN" simulate --detector "$TMP/$name.toml" --voltages 500:6000:500 --tolerance 0.01 --json \
     > "$TMP/$name.cv.json"
   python3 -c "import json,sys; d=json.load(open(sys.argv[1])); print(sys.argv[2], 'simulated U_fd', d['depletion_voltage_V'], 'V')" \
     "$TMP/$name.cv.json" "$name"
