@@ -221,3 +221,15 @@ def test_unknown_type_and_broken_json(cli, tmp_path):
         hpge_cv.legend_to_toml(broken)
     code, _, err = cli("detector", "--from-legend", broken)
     assert code == 2 and "broken.json" in err and "JSON" in err
+
+
+def test_converted_bege_depletes():
+    """The converted BEGe (tapered, n+ around the corners) depletes fully: no undepleted layer
+    in front of its contacts (a convex corner's n+ once left one)."""
+    from conftest import ROOT
+
+    det = hpge_cv.Detector.from_legend(ROOT / "detectors" / "legend" / "B00002A.json")
+    assert det.parameters["n_plus_mm"] == 0.8  # from characterization.manufacturer
+    sim = hpge_cv.simulate(det, [500.0, 1000.0], tolerance=0.01, progress=False)
+    assert all(sim["fully_depleted"])
+    assert 50.0 < sim["depletion_voltage_V"] < 500.0

@@ -704,8 +704,8 @@ fn offset(v: f64, k: f64, param: &str) -> String {
 }
 
 /// The layer under the surfaces of kind `s`: for every such segment the strip between it and
-/// its inward offset by `param` (mm), and at every joint of two such segments the quadrilateral
-/// that closes the gap between their strips.
+/// its inward offset by `param` (mm), and at every reflex joint of two such segments the
+/// quadrilateral that closes the gap between their strips.
 fn layer(d: &LegendDiode, s: Surface, param: &str) -> Vec<String> {
     let pts = &d.outline_mm;
     let mut polys = Vec::new();
@@ -732,8 +732,11 @@ fn layer(d: &LegendDiode, s: Surface, param: &str) -> Vec<String> {
         if k + 1 < d.surfaces.len()
             && let Some(m) = normals[k + 1]
         {
-            let cross = n[0] * m[1] - n[1] * m[0];
-            if cross.abs() > 1e-9 {
+            // Only where the outline turns away from the crystal (a reflex corner) do the two
+            // strips leave a gap; at a convex corner they overlap already.
+            let c = pts[k + 2];
+            let turn = (c[0] - b[0]) * n[0] + (c[1] - b[1]) * n[1];
+            if turn < -1e-12 {
                 let sum = [n[0] + m[0], n[1] + m[1]];
                 polys.push(format!(
                     "{{ polygon = {{ points_mm = [{}, {}, {}, {}] }} }}",
