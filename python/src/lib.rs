@@ -703,6 +703,124 @@ fn fit<'py>(
     Ok(r)
 }
 
+/// Model discovery, as `hpge-cv discover` (issue 9): fits the start model, finds windows of
+/// same-sign residuals, scores the catalogue of extensions by Laplace Bayes factors, fits the
+/// best.
+///
+/// Arguments (defaults: the command line's, relative to the working directory): `data`,
+/// `model`, `detector`, `start_model` (a prior file or a name in priors/, default "b-z"),
+/// `only` (catalogue entries, e.g. ["radial"]), `seed`, `ess`, `surrogate_only` (leave out the
+/// exact-solver extensions, which are slow), `out` (a folder: also write `discovery.json`,
+/// `residuals.csv`, `report.md` and the figures there), `progress`.
+///
+/// Returns the summary (`discovery.json`'s object) as a dict. The GIL is released while it runs.
+#[pyfunction]
+#[pyo3(signature = (
+    data=None, model=None, detector=None, start_model=None, only=None, seed=None, ess=None,
+    surrogate_only=false, out=None, progress=None
+))]
+#[allow(clippy::too_many_arguments)]
+fn discover<'py>(
+    py: Python<'py>,
+    data: Option<PathBuf>,
+    model: Option<PathBuf>,
+    detector: Option<PathBuf>,
+    start_model: Option<String>,
+    only: Option<Vec<String>>,
+    seed: Option<u64>,
+    ess: Option<f64>,
+    surrogate_only: bool,
+    out: Option<PathBuf>,
+    progress: Option<Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyAny>> {
+    use hpge_inference::discover::DiscoverOptions;
+    let mut o = DiscoverOptions::default();
+    if let Some(d) = data {
+        o.workflow.data = d;
+    }
+    if let Some(m) = model {
+        o.workflow.model = m;
+    }
+    if let Some(d) = detector {
+        o.workflow.detector = d;
+    }
+    if let Some(s) = start_model {
+        o.start_model = s;
+    }
+    if let Some(v) = only {
+        o.workflow.only = v;
+    }
+    if let Some(s) = seed {
+        o.seed = s;
+    }
+    if let Some(e) = ess {
+        o.workflow.ess = e;
+    }
+    o.surrogate_only = surrogate_only;
+    o.out = out.clone();
+    o.workflow.no_plots = out.is_none();
+    let progress = DiscoverProgress(progress_arg(progress, "discover")?);
+    let summary = py.detach(|| -> PyResult<serde_json::Value> {
+        let w = &o.workflow;
+        w.check_only().map_err(err)?;
+        let prior_file = o.start_prior().map_err(err)?;
+        let noise = hpge_inference::fit::noise_settings(
+            hpge_inference::posterior::NoiseKind::Paper.as_str(),
+        )
+        .map_err(err)?;
+        let files = hpge_inference::fit::FitFiles {
+            data: w.data.clone(),
+            model: w.model.clone(),
+            prior: prior_file.clone(),
+            detector: w.detector.clone(),
+        };
+        let s = FitJob::from_files(&files, noise, &w.grid).map_err(err)?;
+        let spec = hpge_inference::PriorSpec::from_file(&prior_file).map_err(err)?;
+        let settings = o.settings(noise).map_err(err)?;
+        let surrogate: std::sync::Arc<dyn hpge_inference::CvModel> =
+            std::sync::Arc::new(s.surrogate.clone());
+        let mut inputs = s.inputs.clone();
+        inputs.insert("start_model".into(), prior_file.display().to_string());
+        let d = hpge_inference::discover(
+            &hpge_inference::DiscoverInputs {
+                surrogate,
+                exact: &s.exact,
+                start: &spec,
+                likelihood: &s.likelihood,
+                inputs,
+            },
+            &settings,
+            &progress,
+        )
+        .map_err(err)?;
+        if out.is_some() {
+            let dir = o.out_dir(&prior_file);
+            std::fs::create_dir_all(&dir).map_err(|e| {
+                HpgeError::new_err(format!("{}: cannot create the folder: {e}", dir.display()))
+            })?;
+            hpge_reports::discover::write_outputs(&dir, &d, &s.exact, w.no_plots).map_err(err)?;
+        }
+        serde_json::to_value(&d.summary).map_err(err)
+    })?;
+    json_to_py(py, &summary)
+}
+
+/// Discovery's stages and sampling progress.
+struct DiscoverProgress(Progress);
+
+impl hpge_inference::Progress for DiscoverProgress {
+    fn stage(&self, message: &str) {
+        if let Progress::Stderr(_) = self.0 {
+            eprintln!("hpge_cv: discover: {message}");
+        }
+    }
+    fn sampling(&self, s: &hpge_inference::Status) {
+        if let Progress::Callback(_) = self.0 {
+            self.0.report(s.draws, 0);
+        }
+    }
+}
+
 /// A fit's progress for `run_fit` (lines on stderr or the callback).
 struct FitProgress(Progress);
 
@@ -798,6 +916,7 @@ fn hpge_cv(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(predict, m)?)?;
     m.add_function(wrap_pyfunction!(measure, m)?)?;
     m.add_function(wrap_pyfunction!(fit, m)?)?;
+    m.add_function(wrap_pyfunction!(discover, m)?)?;
     m.add_function(wrap_pyfunction!(legend_to_toml, m)?)?;
     m.add_function(wrap_pyfunction!(legend_outline, m)?)?;
     Ok(())

@@ -23,6 +23,7 @@ def test_module_surface():
     for f in ("simulate", "capacitance", "pulse", "field", "predict", "measure", "fit"):
         doc = getattr(hpge_cv, f).__doc__
         assert doc and ("V" in doc or "pF" in doc), f
+    assert "discovery.json" in hpge_cv.discover.__doc__
 
 
 def test_simulate_equals_the_command_line(cli_json):
@@ -101,6 +102,10 @@ def test_errors_are_hpge_errors_naming_the_input(tmp_path):
         hpge_cv.predict(MODEL, PARAMS, [1e6])
     with pytest.raises(hpge_cv.HpgeError, match="nothing-here"):
         hpge_cv.measure(tmp_path / "nothing-here")
+    with pytest.raises(hpge_cv.HpgeError, match="no-such-model"):
+        hpge_cv.discover(start_model="no-such-model", progress=False)
+    with pytest.raises(hpge_cv.HpgeError, match="not-an-effect"):
+        hpge_cv.discover(only=["not-an-effect"], progress=False)
     with pytest.raises(hpge_cv.HpgeError, match="no-prior.toml"):
         hpge_cv.fit(prior=tmp_path / "no-prior.toml", data=ROOT / "data/super-siegfried-k1/cv.csv",
                     model=MODEL, detector=ROOT / "detectors/super-siegfried-k1.toml")
