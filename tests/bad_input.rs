@@ -332,3 +332,38 @@ fn bad_grid_and_tolerance() {
     ]);
     assert!(msg.contains("--levels"), "{msg}");
 }
+
+/// `detector --from-legend`: a bad LEGEND diode record is exit code 2 with the file and the key.
+#[test]
+fn bad_legend_records() {
+    let cases: [(&str, &str, &[&str]); 4] = [
+        (
+            "legend-negative.json",
+            r#"{"name": "X", "type": "bege", "geometry": {"height_in_mm": 30, "radius_in_mm": -3}}"#,
+            &["`geometry.radius_in_mm`", "-3"],
+        ),
+        (
+            "legend-missing.json",
+            r#"{"name": "X", "type": "ppc", "geometry": {"radius_in_mm": 30}}"#,
+            &["`geometry.height_in_mm`", "missing"],
+        ),
+        (
+            "legend-type.json",
+            r#"{"name": "X", "type": "planar", "geometry": {"height_in_mm": 30, "radius_in_mm": 30}}"#,
+            &["`type`", "planar"],
+        ),
+        (
+            "legend-truncated.json",
+            r#"{"name": "X", "type": "#,
+            &["JSON"],
+        ),
+    ];
+    for (name, text, needles) in cases {
+        let path = write(name, text);
+        let msg = fails(&["detector", "--from-legend", path.to_str().unwrap()]);
+        assert!(msg.contains(name), "{msg}");
+        for n in needles {
+            assert!(msg.contains(n), "{name}: `{n}` not in {msg}");
+        }
+    }
+}

@@ -1,11 +1,12 @@
 //! `hpge-cv detector`: check a description, summarise it, draw its cross-section.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
-use anyhow::Result;
+use anyhow::{Context, Result};
 use hpge_reports::plot;
-use hpge_solver::Detector;
 use hpge_solver::detector::WorldSide;
+use hpge_solver::detector::legend::{self, LegendOptions};
+use hpge_solver::{Detector, Parameters};
 use serde_json::json;
 
 use super::DetectorInput;
@@ -17,14 +18,69 @@ pub fn run(input: &DetectorInput, plots: &[PathBuf], as_json: bool) -> Result<()
         plot::check_output(p, "--plot")?;
     }
     let det = load_detector(input)?;
+    show(&det, plots, as_json)
+}
+
+/// `detector --from-legend DIODE.json [--out D.toml]`: converts a LEGEND diode record
+/// ([`hpge_solver::detector::legend`]), writes (or prints) the description, then loads, checks,
+/// summarises and draws it as [`run`] does a detector file.
+pub fn from_legend(
+    record: &Path,
+    out: Option<&Path>,
+    options: &LegendOptions,
+    params: &[(String, f64)],
+    impurity: Option<&Path>,
+    plots: &[PathBuf],
+    as_json: bool,
+) -> Result<()> {
     for p in plots {
-        plot::cross_section(&det, p)?;
+        plot::check_output(p, "--plot")?;
+    }
+    let diode = legend::read_file(record, options)?;
+    let text = legend::to_toml(&diode, record, options);
+    let file = match out {
+        Some(path) => {
+            std::fs::write(path, &text)
+                .with_context(|| format!("--out {}: cannot write the file", path.display()))?;
+            eprintln!("wrote {}", path.display());
+            path.to_path_buf()
+        }
+        None => {
+            print!("{text}");
+            record.with_extension("toml")
+        }
+    };
+    for n in &diode.notes {
+        eprintln!("note: {n}");
+    }
+    match diode.depletion_voltage_v {
+        Some(u) => eprintln!("the record's characterization: depletion voltage {u} V"),
+        None => eprintln!("the record's characterization gives no depletion voltage"),
+    }
+    let mut overrides = Parameters::new();
+    for (k, v) in params {
+        overrides.set(k.clone(), *v);
+    }
+    let mut det = Detector::from_toml_str(&text, &file, &overrides)
+        .with_context(|| format!("the description converted from {}", record.display()))?;
+    if let Some(path) = impurity {
+        det.set_impurity_file(path)?;
+    }
+    if out.is_none() && plots.is_empty() && !as_json {
+        return Ok(());
+    }
+    show(&det, plots, as_json)
+}
+
+fn show(det: &Detector, plots: &[PathBuf], as_json: bool) -> Result<()> {
+    for p in plots {
+        plot::cross_section(det, p)?;
         eprintln!("wrote {}", p.display());
     }
     if as_json {
-        println!("{}", summary_json(&det));
+        println!("{}", summary_json(det));
     } else {
-        print_summary(&det);
+        print_summary(det);
     }
     Ok(())
 }

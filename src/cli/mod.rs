@@ -260,8 +260,35 @@ struct ImpurityArgs {
 
 #[derive(Debug, clap::Args)]
 struct DetectorArgs {
-    #[command(flatten)]
-    input: DetectorInput,
+    /// Detector description (TOML), e.g. detectors/super-siegfried-k1.toml.
+    #[arg(
+        long,
+        value_name = "FILE",
+        required_unless_present = "from_legend",
+        conflicts_with = "from_legend"
+    )]
+    detector: Option<PathBuf>,
+    /// Impurity model file (TOML) replacing the detector's default model.
+    #[arg(long, value_name = "FILE")]
+    impurity: Option<PathBuf>,
+    /// Override a parameter declared in the detector's [parameters], e.g. --param d_li_mm=3.
+    #[arg(long = "param", value_name = "NAME=VALUE", value_parser = hpge_solver::Parameters::parse_assignment)]
+    params: Vec<(String, f64)>,
+    /// Convert a LEGEND diode record (legend-metadata's diodes/NAME.json: geometry,
+    /// production.impcc, characterization) into a detector description (detectors/README.md),
+    /// then check and summarise it as a detector file.
+    #[arg(long, value_name = "DIODE.json")]
+    from_legend: Option<PathBuf>,
+    /// With --from-legend: write the detector description (TOML) here [default: print it].
+    #[arg(long, value_name = "FILE", requires = "from_legend")]
+    out: Option<PathBuf>,
+    /// With --from-legend: the n+ (Li) layer thickness in mm where the record's
+    /// characterization gives none.
+    #[arg(long, value_name = "MM", requires = "from_legend", default_value_t = hpge_solver::detector::legend::LegendOptions::default().n_plus_thickness_mm)]
+    n_plus_thickness: f64,
+    /// With --from-legend: the gap in mm between the crystal and the grounded can.
+    #[arg(long, value_name = "MM", requires = "from_legend", default_value_t = hpge_solver::detector::legend::LegendOptions::default().can_gap_mm)]
+    can_gap: f64,
     /// Write the r-z cross-section to this file (.svg or .png; repeatable).
     #[arg(long, value_name = "FILE")]
     plot: Vec<PathBuf>,
@@ -274,7 +301,34 @@ struct DetectorArgs {
 pub fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Impurity(a) => impurity::run(&a.input, &a.at, a.json),
-        Command::Detector(a) => detector::run(&a.input, &a.plot, a.json),
+        Command::Detector(a) => {
+            let legend = hpge_solver::detector::legend::LegendOptions {
+                n_plus_thickness_mm: a.n_plus_thickness,
+                can_gap_mm: a.can_gap,
+                ..Default::default()
+            };
+            match (&a.from_legend, &a.detector) {
+                (Some(record), _) => detector::from_legend(
+                    record,
+                    a.out.as_deref(),
+                    &legend,
+                    &a.params,
+                    a.impurity.as_deref(),
+                    &a.plot,
+                    a.json,
+                ),
+                (None, Some(d)) => detector::run(
+                    &DetectorInput {
+                        detector: d.clone(),
+                        impurity: a.impurity.clone(),
+                        params: a.params.clone(),
+                    },
+                    &a.plot,
+                    a.json,
+                ),
+                (None, None) => anyhow::bail!("give --detector FILE or --from-legend DIODE.json"),
+            }
+        }
         Command::Simulate(a) => {
             let Some(args::VoltageList(volts)) = a.voltages.clone() else {
                 anyhow::bail!("--voltages is required, e.g. --voltages 25:2975:50");

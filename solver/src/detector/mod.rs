@@ -2,6 +2,7 @@
 
 mod build;
 mod initial_grid;
+pub mod legend;
 mod model;
 mod spec;
 

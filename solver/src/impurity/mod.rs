@@ -15,7 +15,7 @@ mod spec;
 mod spline;
 mod transform;
 
-pub use model::{ConstantModel, ImpurityModel, LinearZModel, PointDensity};
+pub use model::{ConstantModel, ImpurityModel, LinearZModel, PointDensity, ZTableModel};
 pub use rz::RzModel;
 pub use spec::{ImpurityContext, ImpuritySpec, ModelKind};
 pub use spline::ClampedNaturalSpline;

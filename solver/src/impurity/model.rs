@@ -121,9 +121,51 @@ impl ImpurityModel for LinearZModel {
     }
 }
 
+/// A density along z, piecewise linear through a table, constant beyond its ends; the same at
+/// every radius.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ZTableModel {
+    /// Heights in mm, strictly increasing.
+    pub z_mm: Vec<f64>,
+    /// Signed densities (cm^-3) at `z_mm`.
+    pub values_cm3: Vec<f64>,
+}
+
+impl ImpurityModel for ZTableModel {
+    fn name(&self) -> &'static str {
+        "z-table"
+    }
+
+    fn density_cm3(&self, _r_mm: f64, z_mm: f64) -> f64 {
+        let (z, v) = (&self.z_mm, &self.values_cm3);
+        let n = z.len();
+        if z_mm <= z[0] {
+            return v[0];
+        }
+        if z_mm >= z[n - 1] {
+            return v[n - 1];
+        }
+        let k = z.partition_point(|&x| x <= z_mm).clamp(1, n - 1);
+        let t = (z_mm - z[k - 1]) / (z[k] - z[k - 1]);
+        v[k - 1] + t * (v[k] - v[k - 1])
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn z_table_interpolates_and_holds_its_ends() {
+        let m = ZTableModel {
+            z_mm: vec![0.0, 10.0, 30.0],
+            values_cm3: vec![-1e10, -2e10, 0.0],
+        };
+        assert_eq!(m.density_cm3(0.0, -5.0), -1e10);
+        assert!((m.density_cm3(3.0, 5.0) + 1.5e10).abs() < 1.0);
+        assert!((m.density_cm3(3.0, 20.0) + 1e10).abs() < 1.0);
+        assert_eq!(m.density_cm3(3.0, 40.0), 0.0);
+    }
 
     #[test]
     fn constant() {

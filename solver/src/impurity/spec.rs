@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use super::model::{ConstantModel, ImpurityModel, LinearZModel};
+use super::model::{ConstantModel, ImpurityModel, LinearZModel, ZTableModel};
 use super::rz::RzModel;
 use super::transform::LogTransform;
 use crate::error::{Error, Result};
@@ -18,6 +18,9 @@ pub enum ModelKind {
     /// `"rz"`: [`RzModel`], needs `y_bot` and `y_top` or `zeta_bot_cm3` and `zeta_top_cm3`;
     /// optional `knots_mm` and `transform`.
     Rz,
+    /// `"z-table"`: [`ZTableModel`], needs `z_mm` and `values_cm3` (piecewise linear in z,
+    /// constant beyond the ends; e.g. a LEGEND record's profile along the axis).
+    ZTable,
 }
 
 impl ModelKind {
@@ -27,6 +30,7 @@ impl ModelKind {
             ModelKind::Constant => "constant",
             ModelKind::LinearZ => "linear-z",
             ModelKind::Rz => "rz",
+            ModelKind::ZTable => "z-table",
         }
     }
 }
@@ -84,6 +88,12 @@ pub struct ImpuritySpec {
     /// height (zero at both faces; model discovery's `quadratic-z` extension). Default 0.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub y_quad: Option<f64>,
+    /// `z-table`: heights in mm (strictly increasing).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub z_mm: Option<Vec<f64>>,
+    /// `z-table`: the signed density (cm^-3) at each of `z_mm`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub values_cm3: Option<Vec<f64>>,
 }
 
 /// What a model needs from the detector: the crystal's z range and default knots.
@@ -183,12 +193,46 @@ impl ImpuritySpec {
                 Ok(Box::new(model))
             }
             ModelKind::Rz => Ok(Box::new(self.build_rz(ctx, keys)?)),
+            ModelKind::ZTable => {
+                let need = "model \"z-table\" needs `z_mm` and `values_cm3`";
+                let z = self.z_mm.as_ref().ok_or_else(|| keys.err("z_mm", need))?;
+                let v = self
+                    .values_cm3
+                    .as_ref()
+                    .ok_or_else(|| keys.err("values_cm3", need))?;
+                if z.len() != v.len() || z.is_empty() {
+                    return Err(keys.err(
+                        "values_cm3",
+                        format!(
+                            "has {} values for {} heights in `z_mm` (need the same number, at least one)",
+                            v.len(),
+                            z.len()
+                        ),
+                    ));
+                }
+                for (i, &x) in z.iter().enumerate() {
+                    keys.finite(&format!("z_mm[{i}]"), x)?;
+                    if i > 0 && x <= z[i - 1] {
+                        return Err(keys.err(
+                            &format!("z_mm[{i}]"),
+                            format!("heights must increase: {x} mm after {} mm", z[i - 1]),
+                        ));
+                    }
+                }
+                for (i, &x) in v.iter().enumerate() {
+                    keys.finite(&format!("values_cm3[{i}]"), x)?;
+                }
+                Ok(Box::new(ZTableModel {
+                    z_mm: z.clone(),
+                    values_cm3: v.clone(),
+                }))
+            }
         }
     }
 
     /// Rejects keys that belong to a model other than `self.model`.
     fn check_foreign_keys(&self, keys: Keys<'_>) -> Result<()> {
-        use ModelKind::{Constant, LinearZ, Rz};
+        use ModelKind::{Constant, LinearZ, Rz, ZTable};
         let present = [
             ("zeta_cm3", self.zeta_cm3.is_some(), Constant),
             ("bottom_cm3", self.bottom_cm3.is_some(), LinearZ),
@@ -200,6 +244,8 @@ impl ImpuritySpec {
             ("zeta_top_cm3", self.zeta_top_cm3.is_some(), Rz),
             ("transform", self.transform.is_some(), Rz),
             ("y_quad", self.y_quad.is_some(), Rz),
+            ("z_mm", self.z_mm.is_some(), ZTable),
+            ("values_cm3", self.values_cm3.is_some(), ZTable),
         ];
         for (name, is_some, owner) in present {
             if is_some && owner != self.model {

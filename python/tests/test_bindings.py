@@ -1,0 +1,149 @@
+"""The Python bindings against the command line (same library calls, same numbers) and their
+error handling."""
+
+import os
+
+import numpy as np
+import pytest
+
+import hpge_cv
+from conftest import ROOT
+
+COAX = ROOT / "detectors" / "coax-analytic.toml"
+MODEL = ROOT / "models" / "super-siegfried-rz-split.safetensors"
+PARAMS = {
+    "d_li_mm": 1.0,
+    "y1_bot": 0.65, "y2_bot": 0.64, "y3_bot": 0.6, "y4_bot": 0.3,
+    "y1_top": 0.55, "y2_top": 0.54, "y3_top": 0.5, "y4_top": 0.2,
+}
+
+
+def test_module_surface():
+    assert issubclass(hpge_cv.HpgeError, ValueError)
+    for f in ("simulate", "capacitance", "pulse", "field", "predict", "measure", "fit"):
+        doc = getattr(hpge_cv, f).__doc__
+        assert doc and ("V" in doc or "pF" in doc), f
+    assert "discovery.json" in hpge_cv.discover.__doc__
+
+
+def test_simulate_equals_the_command_line(cli_json):
+    det = hpge_cv.Detector(COAX)
+    assert det.contacts and det.name == "coax-analytic"
+    seen = []
+    got = hpge_cv.simulate(det, [3000.0, 1000.0, 4000.0], progress=lambda k, n: seen.append((k, n)))
+    ref = cli_json("simulate", "--detector", COAX, "--voltages", "1000,3000,4000", "--json")
+    np.testing.assert_array_equal(got["voltage_V"], ref["voltage_V"])
+    np.testing.assert_allclose(got["c12_pF"], ref["c12_pF"], rtol=1e-12)
+    np.testing.assert_allclose(got["c12_err_pF"], ref["c12_err_pF"], rtol=1e-12)
+    assert list(got["fully_depleted"]) == ref["fully_depleted"]
+    assert got["depletion_voltage_V"] == pytest.approx(ref["depletion_voltage_V"], rel=1e-12)
+    # The closed form: full depletion of this coax at 3501.1 V (detectors/coax-analytic.toml).
+    assert got["depletion_voltage_V"] == pytest.approx(3501.1, rel=2e-3)
+    assert seen, "the progress callable was never called"
+
+
+def test_capacitance_matrix(cli_json):
+    det = hpge_cv.Detector(COAX)
+    c = hpge_cv.capacitance(det, 4000.0)
+    m = c["maxwell_pF"]
+    assert m.shape == (len(det.contacts), len(det.contacts))
+    np.testing.assert_allclose(m, m.T, rtol=1e-9, atol=1e-9)
+    assert c["c12_pF"] > 0
+    ref = cli_json("capacitance", "--detector", COAX, "--voltage", "4000", "--json")
+    np.testing.assert_allclose(m, np.array(ref["maxwell_pF"]), rtol=1e-12)
+    assert c["c12_pF"] == pytest.approx(ref["c12_pF"], rel=1e-12)
+
+
+def test_field_and_pulse():
+    det = hpge_cv.Detector(COAX)
+    f = hpge_cv.field(det, 4000.0, 0.0, 5.0, np.linspace(0.0, 39.0, 40))
+    ok = np.array(f["status"]) == "depleted"
+    assert ok.any() and np.all(np.isfinite(f["e_V_per_cm"][ok]))
+    assert np.all(np.isnan(f["e_V_per_cm"][~ok]))
+    p = hpge_cv.pulse(det, 4000.0, (20.0, 0.0, 5.0), normalise=True)
+    assert p["t_ns"].ndim == 1 and len(p["signals"]) == len(det.contacts)
+    assert p["collection_time_ns"] > 0
+
+
+def test_predict_with_jacobian(cli_json):
+    volts = [100.0, 500.0, 1500.0, 2900.0]
+    got = hpge_cv.predict(MODEL, PARAMS, volts, jacobian=True)
+    names = got["parameter_names"]
+    assert got["jacobian_pF"].shape == (len(volts), len(names))
+    ref = cli_json(
+        "predict", "--model", MODEL,
+        "--params", ",".join(f"{k}={v}" for k, v in PARAMS.items()),
+        "--voltages", ",".join(str(v) for v in volts), "--jacobian", "--json",
+    )
+    # (predict's JSON spells its keys c12_pf, jacobian_pf)
+    np.testing.assert_allclose(got["c12_pF"], ref["c12_pf"], rtol=1e-12)
+    np.testing.assert_allclose(got["jacobian_pF"], np.array(ref["jacobian_pf"]), rtol=1e-12)
+    # The Jacobian is the derivative: a central difference in d_li_mm.
+    h = 1e-4
+    up = hpge_cv.predict(MODEL, {**PARAMS, "d_li_mm": 1.0 + h}, volts)["c12_pF"]
+    dn = hpge_cv.predict(MODEL, {**PARAMS, "d_li_mm": 1.0 - h}, volts)["c12_pF"]
+    k = names.index("d_li_mm")
+    np.testing.assert_allclose(got["jacobian_pF"][:, k], (up - dn) / (2 * h), rtol=1e-3, atol=1e-6)
+
+
+def test_errors_are_hpge_errors_naming_the_input(tmp_path):
+    with pytest.raises(hpge_cv.HpgeError, match="nowhere.toml"):
+        hpge_cv.Detector(tmp_path / "nowhere.toml")
+    bad = tmp_path / "bad.toml"
+    bad.write_text(COAX.read_text().replace('name = "coax-analytic"', 'nmae = "x"'))
+    with pytest.raises(hpge_cv.HpgeError, match="bad.toml"):
+        hpge_cv.Detector(bad)
+    det = hpge_cv.Detector(COAX)
+    with pytest.raises(hpge_cv.HpgeError, match="positive"):
+        hpge_cv.simulate(det, [-5.0])
+    with pytest.raises(hpge_cv.HpgeError, match="y9_top"):
+        hpge_cv.predict(MODEL, {**PARAMS, "y9_top": 0.1}, [100.0])
+    with pytest.raises(hpge_cv.HpgeError, match="outside|range|training"):
+        hpge_cv.predict(MODEL, PARAMS, [1e6])
+    with pytest.raises(hpge_cv.HpgeError, match="nothing-here"):
+        hpge_cv.measure(tmp_path / "nothing-here")
+    with pytest.raises(hpge_cv.HpgeError, match="no-such-model"):
+        hpge_cv.discover(start_model="no-such-model", progress=False)
+    with pytest.raises(hpge_cv.HpgeError, match="not-an-effect"):
+        hpge_cv.discover(only=["not-an-effect"], progress=False)
+    with pytest.raises(hpge_cv.HpgeError, match="no-prior.toml"):
+        hpge_cv.fit(prior=tmp_path / "no-prior.toml", data=ROOT / "data/super-siegfried-k1/cv.csv",
+                    model=MODEL, detector=ROOT / "detectors/super-siegfried-k1.toml")
+
+
+def test_measure_equals_the_shipped_curve():
+    """The shipped cv.csv was measured from the shipped raw pulses by `hpge-cv measure`."""
+    raw = ROOT / "data" / "super-siegfried-k1" / "raw"
+    got = hpge_cv.measure(raw)
+    pd = pytest.importorskip("pandas")
+    ref = pd.read_csv(ROOT / "data/super-siegfried-k1/cv.csv", comment="#")
+    np.testing.assert_array_equal(got["voltage_V"], ref["voltage_V"])
+    np.testing.assert_allclose(got["c12_pF"], ref["c12_pF"], rtol=1e-9)
+    np.testing.assert_allclose(got["sigma_pF"], ref["sigma_pF"], rtol=1e-9)
+    n = len(got["voltage_V"])
+    assert got["covariance_pF2"].shape == (n, n)
+
+
+@pytest.mark.skipif(os.environ.get("HPGE_SKIP_FIT") == "1", reason="HPGE_SKIP_FIT=1")
+def test_fit_equals_the_command_line(cli_json, tmp_path):
+    """A CI-sized B_RZ fit (ESS 200, no exact check): the same seed gives the same summary."""
+    common = dict(
+        data=ROOT / "data/super-siegfried-k1/cv.csv",
+        model=MODEL,
+        prior=ROOT / "priors/b-rz.toml",
+        detector=ROOT / "detectors/super-siegfried-k1.toml",
+    )
+    got = hpge_cv.fit(**common, seed=11, ess=200.0, progress=False)
+    ref = cli_json(
+        "fit", "--data", common["data"], "--model", MODEL, "--prior", common["prior"],
+        "--detector", common["detector"], "--seed", "11", "--ess", "200", "--no-exact-check",
+        "--no-plots", "--allow-unconverged", "--out", tmp_path / "fit", "--json",
+    )
+    s = got["summary"]
+    assert [p["name"] for p in s["parameters"]] == [p["name"] for p in ref["parameters"]]
+    for a, b in zip(s["parameters"], ref["parameters"]):
+        for key in ("mean", "std", "global_mode", "rhat", "ess_bulk"):
+            assert a[key] == pytest.approx(b[key], rel=1e-12, abs=1e-15), (a["name"], key)
+    assert got["draws"].ndim == 3 and got["draws"].shape[2] == len(got["names"])
+    means = got["draws"].reshape(-1, len(got["names"])).mean(axis=0)
+    np.testing.assert_allclose(means, [p["mean"] for p in s["parameters"]], rtol=1e-9)
