@@ -46,12 +46,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             reference("N^1.5", &|n| n.powf(1.5)),
         ]
         .into_iter()
-        .chain(before_rows.as_deref().map(|b| Curve {
-            label: "fast before band steps (plain active set)".into(),
-            points: series(b, "fast")
-                .iter()
-                .map(|&(x, y)| (x, Some(y)))
-                .collect(),
+        .chain(before_rows.as_deref().map(|b| {
+            Curve {
+                label: "fast before band steps (plain active set)".into(),
+                points: series(b, "fast")
+                    .iter()
+                    .map(|&(x, y)| (x, Some(y)))
+                    .collect(),
+            }
         }))
         .collect(),
         y_from_zero: false,
@@ -70,8 +72,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     Ok(())
 }
 
-/// (method, nodes, seconds per point) of every row of a `solver_scaling` CSV.
-fn read_rows(csv: &std::path::Path) -> Result<Vec<(String, f64, f64)>, Box<dyn std::error::Error>> {
+/// (method, nodes, seconds per point) of one row of a `solver_scaling` CSV.
+type Row = (String, f64, f64);
+
+/// Every row of a `solver_scaling` CSV.
+fn read_rows(csv: &std::path::Path) -> Result<Vec<Row>, Box<dyn std::error::Error>> {
     let text = std::fs::read_to_string(csv).map_err(|e| format!("{}: {e}", csv.display()))?;
     let mut rows = Vec::new();
     for (k, line) in text.lines().enumerate().skip(1) {
@@ -94,7 +99,7 @@ fn read_rows(csv: &std::path::Path) -> Result<Vec<(String, f64, f64)>, Box<dyn s
 }
 
 /// (log10 nodes, log10 seconds) of one method's rows.
-fn series(rows: &[(String, f64, f64)], method: &str) -> Vec<(f64, f64)> {
+fn series(rows: &[Row], method: &str) -> Vec<(f64, f64)> {
     rows.iter()
         .filter(|r| r.0 == method)
         .map(|r| (r.1.log10(), r.2.log10()))
