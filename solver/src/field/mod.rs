@@ -15,6 +15,7 @@ mod pinch_off;
 pub(crate) mod pockets;
 mod point;
 mod report;
+mod round;
 mod settings;
 pub(crate) mod sor;
 mod system;
