@@ -138,7 +138,14 @@ pub(crate) fn band_state(
                 })
         })
         .collect();
-    let members = band(sys, &seeds, bounded, BAND_DEPTH);
+    let mut members = band(sys, &seeds, bounded, BAND_DEPTH);
+    // A tied unknown whose pocket level lies beyond the contact potentials has l > h (and a
+    // level may be NaN after a singular levels' system): no interval to project on, so the
+    // plain step's state stands there.
+    members.retain(|&u| {
+        let (l, h) = bounds(u);
+        l <= h && l.is_finite() && h.is_finite() && x[u].is_finite()
+    });
     let mut xt: Vec<f64> = x.to_vec();
     let mut span: f64 = 1.0;
     for &u in &members {
@@ -170,6 +177,7 @@ mod tests {
     use crate::expr::Parameters;
     use crate::field::depletion::solve_with_band_steps;
     use crate::field::mesh::Mesh;
+    use crate::field::round::Bound;
     use crate::grid::{Grid, GridSettings};
 
     fn detector(file: &str) -> Detector {
@@ -234,6 +242,42 @@ mod tests {
             seeded_b < seeded_p,
             "seeded: {seeded_b} band vs {seeded_p} plain"
         );
+    }
+
+    /// Bounds without an interval (a tied level beyond the contact potentials: l > h; a NaN
+    /// level) leave the plain step's state in place instead of panicking in a projection
+    /// (found by `tests/surrogate.rs`: a p-n junction pocket of a tiny training space).
+    #[test]
+    fn empty_or_nan_bounds_keep_the_plain_state() {
+        let det = detector("planar-pn.toml");
+        let m = mesh(&det, 0.25);
+        let (dofs, (lo, hi)) = crate::field::depletion::potential_dofs(&m, &det, 50.0);
+        let sys = super::System::assemble(&m, &dofs, &m.charge_c);
+        let bounded = vec![true; sys.n];
+        // A front in the middle: the first half active at the upper bound.
+        let next: Vec<Bound> = (0..sys.n)
+            .map(|u| {
+                if u < sys.n / 2 {
+                    Bound::Upper
+                } else {
+                    Bound::Free
+                }
+            })
+            .collect();
+        let x: Vec<f64> = (0..sys.n)
+            .map(|u| if u < sys.n / 2 { hi } else { 0.5 * (lo + hi) })
+            .collect();
+        let bounds = |u: usize| match u % 3 {
+            0 => (hi + 1.0, hi),
+            1 => (f64::NAN, hi),
+            _ => (lo, hi),
+        };
+        let out = super::band_state(&sys, &bounded, bounds, &x, &next);
+        for u in 0..sys.n {
+            if u % 3 != 2 {
+                assert_eq!(out[u], next[u], "unknown {u}");
+            }
+        }
     }
 
     /// The band is the seeds' graph neighbourhood: the seed alone at depth 0, the seed and its
