@@ -18,9 +18,10 @@ pub fn partial_dir(model: &Path) -> PathBuf {
     model.with_extension("partial")
 }
 
-/// Writes learning curves: a comment line naming `model` and this program's version, the header
-/// `member,epoch,cycle,lr,train_loss,test_loss,test_rel_rms,seconds`, one line per epoch (losses
-/// in `{:e}`, seconds with 3 decimals).
+/// Writes learning curves: the header `member,epoch,cycle,lr,train_loss,test_loss,test_rel_rms,
+/// seconds`, one line per epoch (losses in `{:e}`, seconds with 3 decimals), no comment lines;
+/// the provenance (this program's version, `model`) goes to the sidecar `<stem>.json`
+/// (`NAME.curves.csv` -> `NAME.curves.json`).
 pub fn write_curves(path: &Path, curves: &[EpochRecord], model: &Path) -> Result<()> {
     let failed = |source| Error::RunFile {
         action: "cannot write the learning curves",
@@ -28,19 +29,28 @@ pub fn write_curves(path: &Path, curves: &[EpochRecord], model: &Path) -> Result
         source,
     };
     let mut f = std::fs::File::create(path).map_err(failed)?;
-    let mut text = format!(
-        "# learning curves of {} (hpge-cv {}): mean loss over each set after every epoch\n\
-         member,epoch,cycle,lr,train_loss,test_loss,test_rel_rms,seconds\n",
-        model.display(),
-        env!("CARGO_PKG_VERSION")
-    );
+    let mut text =
+        String::from("member,epoch,cycle,lr,train_loss,test_loss,test_rel_rms,seconds\n");
     for r in curves {
         text += &format!(
             "{},{},{},{:e},{:e},{:e},{:e},{:.3}\n",
             r.member, r.epoch, r.cycle, r.lr, r.train_loss, r.test_loss, r.test_rel_rms, r.seconds
         );
     }
-    f.write_all(text.as_bytes()).map_err(failed)
+    f.write_all(text.as_bytes()).map_err(failed)?;
+    let sidecar = path.with_extension("json");
+    let meta = serde_json::json!({
+        "program": "hpge-cv",
+        "version": env!("CARGO_PKG_VERSION"),
+        "what": "learning curves: mean loss over each set after every epoch",
+        "model": model.display().to_string(),
+        "csv": path.file_name().map(|n| n.to_string_lossy().into_owned()),
+    });
+    std::fs::write(&sidecar, format!("{meta:#}\n")).map_err(|source| Error::RunFile {
+        action: "cannot write the learning curves' sidecar",
+        file: sidecar.clone(),
+        source,
+    })
 }
 
 /// Reads the learning curves of checkpoint member `m` (the lines [`write_curves`] writes).
