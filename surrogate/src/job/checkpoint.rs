@@ -139,3 +139,41 @@ pub fn resume_members(dir: &Path, info: &ModelInfo) -> Result<Vec<Member>> {
         done.push((net, records));
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Learning curves as written before issue 22 (a leading `#` line, as the shipped
+    /// models/*.curves.csv still are) read as well as today's plain tables.
+    #[test]
+    fn reads_old_curves_with_a_comment_line_and_new_ones_without() {
+        let d = std::env::temp_dir().join(format!("hpge-curves-old-{}", std::process::id()));
+        std::fs::create_dir_all(&d).unwrap();
+        let rows = "member,epoch,cycle,lr,train_loss,test_loss,test_rel_rms,seconds\n\
+                    0,1,1,1e-2,2e0,3e0,1e-1,0.100\n0,2,1,1e-2,1e0,2e0,5e-2,0.200\n";
+        let old = d.join("old.curves.csv");
+        std::fs::write(
+            &old,
+            format!("# learning curves of m.safetensors (hpge-cv 0.1.0): mean loss\n{rows}"),
+        )
+        .unwrap();
+        let a = read_curves(&old, 3).unwrap();
+        assert_eq!(a.len(), 2);
+        assert_eq!(a[1].member, 3);
+        assert_eq!(a[1].train_loss, 1.0);
+        // Today's: written without a comment line, with the sidecar; read back the same.
+        let new = d.join("new.curves.csv");
+        write_curves(&new, &a, Path::new("m.safetensors")).unwrap();
+        let text = std::fs::read_to_string(&new).unwrap();
+        assert!(text.starts_with("member,epoch,"), "{text}");
+        assert!(!text.contains('#'), "{text}");
+        assert_eq!(read_curves(&new, 3).unwrap(), a);
+        let side: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(d.join("new.curves.json")).unwrap())
+                .unwrap();
+        assert_eq!(side["model"], "m.safetensors");
+        assert_eq!(side["version"], env!("CARGO_PKG_VERSION"));
+        let _ = std::fs::remove_dir_all(&d);
+    }
+}
