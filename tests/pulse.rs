@@ -269,6 +269,15 @@ fn paper_section9_outputs() {
         "section9.csv",
     ] {
         assert!(dir.join(f).is_file(), "{f}");
+        // Plain tables (issue 22): the header first, no comment line, rows of equal length.
+        if f.ends_with(".csv") {
+            let text = std::fs::read_to_string(dir.join(f)).unwrap();
+            let n: Vec<usize> = text.lines().map(|l| l.split(',').count()).collect();
+            assert!(
+                !text.starts_with('#') && n.iter().all(|&k| k == n[0]),
+                "{f}"
+            );
+        }
     }
     let v: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("section9.json")).unwrap()).unwrap();

@@ -78,3 +78,15 @@ def test_measured_curve_and_covariance_load_as_they_are(cli, tmp_path):
     assert c.shape == (4,) and len(c.dtype.names) == 5
     report = json.loads((tmp_path / "cv.measure.json").read_text())
     assert report["program"] == "hpge-cv" and "uncertainties" in report
+
+
+def test_paper_section9_tables_load_as_they_are(cli, tmp_path):
+    code, _, err = cli("paper-section9", "--out", tmp_path)
+    assert code == 0, err
+    for name, first in [("field-r.csv", "r_mm"), ("pulses-nplus.csv", "t_ns"),
+                        ("section9.csv", "model")]:
+        df = pd.read_csv(tmp_path / name)
+        assert df.columns[0] == first and len(df) > 0, name
+        check(tmp_path / name, list(df.columns), len(df))
+    side = json.loads((tmp_path / "section9.json").read_text())
+    assert "provenance" in side and "field-r.csv" in side["tables"]
