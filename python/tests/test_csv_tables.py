@@ -90,3 +90,13 @@ def test_paper_section9_tables_load_as_they_are(cli, tmp_path):
         check(tmp_path / name, list(df.columns), len(df))
     side = json.loads((tmp_path / "section9.json").read_text())
     assert "provenance" in side and "field-r.csv" in side["tables"]
+
+
+def test_predict_table_on_stdout_loads_as_it_is(cli, tmp_path):
+    params = ",".join(["d_li_mm=3"] + [f"y{k}_{s}=0.5" for s in ("bot", "top") for k in range(1, 5)])
+    code, out, err = cli("predict", "--model", "models/super-siegfried-rz-split.safetensors",
+                         "--params", params, "--voltages", "1000,2000,3000")
+    assert code == 0, err
+    path = tmp_path / "c.csv"
+    path.write_text(out)
+    check(path, ["voltage_V", "c12_pF", "sigma_pF"], 3)
