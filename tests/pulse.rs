@@ -76,12 +76,13 @@ fn pulse_normalise_plot_and_csv() {
     assert!(std::fs::read_to_string(&svg).unwrap().contains("<svg"));
     let text = std::fs::read_to_string(&csv).unwrap();
     let mut lines = text.lines();
-    let head = lines.next().unwrap();
-    assert!(
-        head.starts_with("# hpge-cv ") && head.contains(DET),
-        "{head}"
-    );
+    // A plain table (issue 22): the header first, the provenance in the sidecar p.json.
     assert_eq!(lines.next().unwrap(), "t_ns,q1,q2");
+    let side = std::fs::read_to_string(csv.with_extension("json")).unwrap();
+    assert!(
+        side.contains(DET) && side.contains(env!("CARGO_PKG_VERSION")),
+        "{side}"
+    );
     assert_eq!(
         lines.count(),
         v["t_ns"].as_array().unwrap().len(),
@@ -268,6 +269,15 @@ fn paper_section9_outputs() {
         "section9.csv",
     ] {
         assert!(dir.join(f).is_file(), "{f}");
+        // Plain tables (issue 22): the header first, no comment line, rows of equal length.
+        if f.ends_with(".csv") {
+            let text = std::fs::read_to_string(dir.join(f)).unwrap();
+            let n: Vec<usize> = text.lines().map(|l| l.split(',').count()).collect();
+            assert!(
+                !text.starts_with('#') && n.iter().all(|&k| k == n[0]),
+                "{f}"
+            );
+        }
     }
     let v: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("section9.json")).unwrap()).unwrap();

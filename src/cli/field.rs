@@ -111,13 +111,24 @@ pub fn run(a: &FieldArgs) -> Result<()> {
     if let Some(path) = &a.out {
         let ctx = || format!("--out {}: cannot write the file", path.display());
         let mut f = std::io::BufWriter::new(std::fs::File::create(path).with_context(ctx)?);
-        writeln!(f, "# {provenance}").with_context(ctx)?;
         writeln!(f, "r_mm,e_V_per_cm,status").with_context(ctx)?;
         for ((r, e), s) in line.r_mm.iter().zip(&v_cm).zip(&line.status) {
             let e = e.map_or(String::new(), |e| e.to_string());
             writeln!(f, "{r},{e},{}", s.as_str()).with_context(ctx)?;
         }
         f.flush().with_context(ctx)?;
+        super::sidecar::write(
+            path,
+            super::args::with_detector_provenance(
+                json!({
+                    "voltage_V": a.voltage,
+                    "phi_deg": a.phi,
+                    "z_mm": a.z,
+                    "columns": {"r_mm": "radius (mm)", "e_V_per_cm": "|E| (V/cm), empty where there is no field", "status": "the radius's status"},
+                }),
+                &det,
+            ),
+        )?;
     }
     if let Some(path) = &a.plot {
         let fig = plot::LineFigure {

@@ -7,7 +7,7 @@ use anyhow::{Context, Result, bail};
 use hpge_measurement::synth::voltage_seed;
 use hpge_measurement::{
     MeasureOptions, Measurement, PulseSet, RawProblem, SynthOptions, depletion_voltage, measure,
-    read_raw_dir, synthesize_voltage, write_curve_with_comments, write_pulses,
+    read_raw_dir, synthesize_voltage, write_curve, write_pulses,
 };
 use hpge_reports::plot;
 use indicatif::{ProgressBar, ProgressStyle};
@@ -50,20 +50,29 @@ pub fn run(o: &MeasureOptions, plot: Option<&PathBuf>, json: bool) -> Result<()>
             p.message
         );
     }
-    let comments = vec![
-        format!(
-            "hpge-cv {} measure --raw {}",
-            env!("CARGO_PKG_VERSION"),
-            o.raw.display()
-        ),
-        format!("settings: {settings_source}"),
-        format!(
-            "uncertainties: relative {:?}; covariance in the sibling .covariance.csv",
-            settings.uncertainties
-        ),
-    ];
-    write_curve_with_comments(&o.out, &m.curve, &comments)?;
-    let report = report_json(&m, &o.raw, &settings_source, &run.problems);
+    write_curve(&o.out, &m.curve)?;
+    let mut report = report_json(&m, &o.raw, &settings_source, &run.problems);
+    if let Some(obj) = report.as_object_mut() {
+        // The curve's provenance (cv.csv is a plain table: one header row, no comment lines).
+        obj.insert("program".into(), "hpge-cv".into());
+        obj.insert("version".into(), env!("CARGO_PKG_VERSION").into());
+        obj.insert(
+            "command".into(),
+            std::env::args().skip(1).collect::<Vec<_>>().into(),
+        );
+        obj.insert(
+            "uncertainties".into(),
+            serde_json::to_value(&settings.uncertainties)?,
+        );
+        obj.insert(
+            "covariance_file".into(),
+            m.curve
+                .covariance_pf2
+                .as_ref()
+                .map(|_| covariance_name(&o.out))
+                .into(),
+        );
+    }
     let report_path = o.out.with_extension("measure.json");
     std::fs::write(&report_path, format!("{report:#}\n"))
         .with_context(|| format!("{}: cannot write the report", report_path.display()))?;
@@ -102,6 +111,14 @@ pub fn run(o: &MeasureOptions, plot: Option<&PathBuf>, json: bool) -> Result<()>
         );
     }
     Ok(())
+}
+
+/// The name of the curve's covariance file: `<stem>.covariance.csv`.
+fn covariance_name(csv: &Path) -> String {
+    format!(
+        "{}.covariance.csv",
+        csv.file_stem().unwrap_or_default().to_string_lossy()
+    )
 }
 
 /// Everything about the run as one JSON object (also written beside the curve).

@@ -11,6 +11,7 @@ mod impurity;
 mod measure;
 mod pulse;
 mod sensitivity;
+mod sidecar;
 mod simulate;
 mod surrogate;
 mod validate;

@@ -52,7 +52,8 @@ pub struct PulseArgs {
     /// Draw the signals of every contact against time (.svg or .png).
     #[arg(long, value_name = "FILE")]
     plot: Option<PathBuf>,
-    /// Write the signals as CSV (t_ns, then one column per contact; first line: provenance).
+    /// Write the signals as CSV (t_ns, then one column per contact), the provenance in the sidecar
+    /// `<stem>.json`.
     #[arg(long, value_name = "FILE")]
     out: Option<PathBuf>,
 }
@@ -252,24 +253,6 @@ fn print_summary(
 fn write_csv(path: &Path, p: &Pulse, prov: &Provenance<'_>) -> Result<()> {
     let ctx = || format!("--out {}: cannot write the file", path.display());
     let mut f = std::io::BufWriter::new(std::fs::File::create(path).with_context(ctx)?);
-    let cols: Vec<String> = prov
-        .det
-        .contacts
-        .iter()
-        .map(|c| format!("q{} = {}", c.id, c.name))
-        .collect();
-    writeln!(
-        f,
-        "# {}; columns q<contact id>: {} ({})",
-        prov.line(),
-        cols.join("; "),
-        if prov.normalised {
-            "normalised"
-        } else {
-            "units of the pair charge"
-        }
-    )
-    .with_context(ctx)?;
     let head: Vec<String> = prov
         .det
         .contacts
@@ -282,6 +265,22 @@ fn write_csv(path: &Path, p: &Pulse, prov: &Provenance<'_>) -> Result<()> {
         writeln!(f, "{t},{}", row.join(",")).with_context(ctx)?;
     }
     f.flush().with_context(ctx)?;
+    let (r, phi, z) = prov.at;
+    super::sidecar::write(
+        path,
+        super::args::with_detector_provenance(
+            json!({
+                "provenance": prov.line(),
+                "voltage_V": prov.voltage_v,
+                "at": {"r_mm": r, "phi_deg": phi, "z_mm": z},
+                "drift_parameters": prov.drift_file.map(|f| f.display().to_string()),
+                "normalised": prov.normalised,
+                "columns": prov.det.contacts.iter().map(|c| (format!("q{}", c.id), serde_json::Value::from(c.name.clone()))).collect::<serde_json::Map<_, _>>(),
+                "unit": if prov.normalised { "normalised" } else { "units of the pair charge" },
+            }),
+            prov.det,
+        ),
+    )?;
     Ok(())
 }
 

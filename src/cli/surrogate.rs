@@ -271,8 +271,10 @@ pub fn predict(o: &PredictOptions, json: bool) -> Result<()> {
         println!("{}", serde_json::to_string(&j)?);
         return Ok(());
     }
-    println!(
-        "# model {} (recipe {}), sigma_p {:.4}%",
+    // The table on stdout is a plain CSV (`predict ... > c.csv` loads with pandas as it is);
+    // the model line goes to stderr.
+    eprintln!(
+        "model {} (recipe {}), sigma_p {:.4}%",
         o.model.display(),
         model.info.recipe_name,
         100.0 * model.sigma_p()

@@ -76,6 +76,18 @@ pub fn coverage(o: &CoverageOptions, as_json: bool) -> Result<()> {
             if o.exact { "exact" } else { "surrogate" }.into(),
         );
         obj.insert("settings".into(), serde_json::to_value(settings)?);
+        // ranks.csv's provenance (it is a plain table: one header row, no comment lines).
+        obj.insert(
+            "ranks_csv".into(),
+            serde_json::json!({
+                "file": "ranks.csv",
+                "columns": "truth, then each parameter's rank of the truth among the draws",
+                "rank_among_draws": o.ranks,
+                "prior": o.prior.display().to_string(),
+                "model": o.model.display().to_string(),
+                "seed": o.seed,
+            }),
+        );
     }
     let path = out.join("coverage.json");
     std::fs::write(&path, serde_json::to_string_pretty(&json)? + "\n")
@@ -85,16 +97,6 @@ pub fn coverage(o: &CoverageOptions, as_json: bool) -> Result<()> {
         std::fs::File::create(&path)
             .with_context(|| format!("cannot create {}", path.display()))?,
     );
-    writeln!(
-        w,
-        "# hpge-cv {} validate coverage: prior {} model {} data-from {} seed {}; rank among {} draws",
-        env!("CARGO_PKG_VERSION"),
-        o.prior.display(),
-        o.model.display(),
-        if o.exact { "exact" } else { "surrogate" },
-        o.seed,
-        o.ranks
-    )?;
     let names: Vec<&str> = report.parameters.iter().map(|p| p.name.as_str()).collect();
     writeln!(w, "truth,{}", names.join(","))?;
     for i in 0..report.n_truths {

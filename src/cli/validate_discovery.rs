@@ -9,7 +9,7 @@ use std::sync::Arc;
 use anyhow::{Context, Result};
 use hpge_inference::posterior::NoiseKind;
 use hpge_inference::{CvModel, PriorSpec};
-use hpge_measurement::write_curve_with_comments;
+use hpge_measurement::write_curve;
 use hpge_validation::studies::hidden::simulate_hidden;
 use hpge_validation::{HiddenOptions, HiddenOutcome, hidden_effects, run_hidden};
 use serde::Serialize;
@@ -79,17 +79,21 @@ pub fn run(a: &DiscoveryArgs) -> Result<()> {
         );
         let seed = o.seed + i as u64;
         let data = simulate_hidden(h, &s.exact, &start, &volts, seed)?;
-        write_curve_with_comments(
-            &dir.join("cv.csv"),
-            &data,
-            &[format!(
-                "hpge-cv {} validate discovery --seed {}: exact solver, hidden effect {} {:?}, paper noise x {} (seed {seed})",
-                env!("CARGO_PKG_VERSION"),
-                o.seed,
-                h.effect,
-                h.truth,
-                h.noise_scale
-            )],
+        let csv = dir.join("cv.csv");
+        write_curve(&csv, &data)?;
+        super::sidecar::write(
+            &csv,
+            serde_json::json!({
+                "provenance": format!(
+                    "validate discovery --seed {}: exact solver, hidden effect {} {:?}, paper noise x {} (seed {seed})",
+                    o.seed, h.effect, h.truth, h.noise_scale
+                ),
+                "study_seed": o.seed,
+                "data_seed": seed,
+                "hidden_effect": h.effect,
+                "noise_scale": h.noise_scale,
+                "truth": "truth.json",
+            }),
         )?;
         std::fs::write(
             dir.join("truth.json"),

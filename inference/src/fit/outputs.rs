@@ -1,31 +1,17 @@
 //! The tables a fit writes beside its summary: `samples.csv` (every draw), `predictive.csv`
 //! (c_p - c_m bands per voltage), `zeta-mode.csv` (the profiles at the global mode) and
-//! `summary.json`; each CSV starts with one `#` line naming the program version and the inputs.
+//! `summary.json`. The CSVs are plain tables (one header row, no comment lines) that
+//! `pandas.read_csv` and `numpy.genfromtxt(names=True, delimiter=',')` load as they are; their
+//! provenance (program version, inputs with hashes, sampler, seed, likelihood) is in
+//! `summary.json` (`program_version`, `inputs`, `settings`, `likelihood`).
 
 use std::io::Write as _;
 use std::path::Path;
 
 use super::Fit;
-use super::job::FitFiles;
 use super::truth::TruthRecord;
 use super::zeta::ZetaAtMode;
 use crate::{Error, Result};
-
-/// The `#` line that heads every table of a fit: program version, inputs, sampler, seed and
-/// likelihood.
-pub fn output_header(files: &FitFiles, sampler: &str, seed: u64, likelihood: &str) -> String {
-    format!(
-        "# hpge-cv {} fit: data {} model {} prior {} detector {} sampler {} seed {} likelihood {}",
-        env!("CARGO_PKG_VERSION"),
-        files.data.display(),
-        files.model.display(),
-        files.prior.display(),
-        files.detector.display(),
-        sampler,
-        seed,
-        likelihood
-    )
-}
 
 /// Writes `lines` (already newline-terminated) to `path`.
 fn write_text(path: &Path, text: &str) -> Result<()> {
@@ -42,9 +28,8 @@ fn write_text(path: &Path, text: &str) -> Result<()> {
 }
 
 /// `samples.csv`: `chain,draw,<parameters>,ln_posterior`, one row per draw.
-pub fn write_samples(path: &Path, header: &str, fit: &Fit) -> Result<()> {
+pub fn write_samples(path: &Path, fit: &Fit) -> Result<()> {
     let mut w = String::new();
-    w.push_str(&format!("{header}\n"));
     w.push_str(&format!(
         "chain,draw,{},ln_posterior\n",
         fit.samples.names.join(",")
@@ -60,10 +45,9 @@ pub fn write_samples(path: &Path, header: &str, fit: &Fit) -> Result<()> {
 
 /// `predictive.csv`: per voltage the data, the curve at the global mode, sigma, the pull at the
 /// mode and the median and 68.3/95.5/99.7% bands of c_p - c_m over the posterior.
-pub fn write_predictive(path: &Path, header: &str, fit: &Fit) -> Result<()> {
+pub fn write_predictive(path: &Path, fit: &Fit) -> Result<()> {
     let p = &fit.predictive;
-    let mut w = format!("{header}\n");
-    w.push_str(
+    let mut w = String::from(
         "voltage_V,c_m_pF,c_mode_pF,sigma_pF,pull_at_mode,diff_median_pF,diff_lo683_pF,diff_hi683_pF,diff_lo955_pF,diff_hi955_pF,diff_lo997_pF,diff_hi997_pF\n",
     );
     for k in 0..p.voltage_v.len() {
@@ -86,8 +70,8 @@ pub fn write_predictive(path: &Path, header: &str, fit: &Fit) -> Result<()> {
 }
 
 /// `zeta-mode.csv`: `profile,label,coordinate_mm,zeta_cm3` (profiles `along_z`, `along_r`).
-pub fn write_zeta(path: &Path, header: &str, zeta: &ZetaAtMode) -> Result<()> {
-    let mut w = format!("{header}\nprofile,label,coordinate_mm,zeta_cm3\n");
+pub fn write_zeta(path: &Path, zeta: &ZetaAtMode) -> Result<()> {
+    let mut w = String::from("profile,label,coordinate_mm,zeta_cm3\n");
     for (kind, list) in [("along_z", &zeta.along_z), ("along_r", &zeta.along_r)] {
         for prof in list {
             for (x, v) in prof.x_mm.iter().zip(&prof.zeta_cm3) {

@@ -149,7 +149,9 @@ pub fn write_curve(csv: &Path, data: &CvData) -> Result<()> {
 }
 
 /// As [`write_curve`], with a leading comment block: each line of each comment written as
-/// `# <line>` (e.g. provenance); [`read_curve`] skips them.
+/// `# <line>` (e.g. provenance); [`read_curve`] skips them. The command line no longer uses it
+/// (its CSVs are plain tables, their provenance in a JSON sidecar, so that `pandas.read_csv`
+/// loads them without `comment='#'`); it stays for library users and old-format tests.
 pub fn write_curve_with_comments(csv: &Path, data: &CvData, comments: &[String]) -> Result<()> {
     let n = data.voltage_v.len();
     let argument = |message: String| Error::Argument {

@@ -12,16 +12,11 @@ pub use report::write_report;
 
 use crate::{Error, Result, plot};
 
-/// The per-voltage table: data, both models at their modes, sigma, standardised residuals.
+/// The per-voltage table: data, both models at their modes, sigma, standardised residuals; one
+/// header row, no comment lines (the provenance is in `discovery.json`: `program_version`,
+/// `start_model`, `chosen`).
 pub fn write_residuals(path: &Path, d: &Discovery) -> Result<()> {
     let mut f = String::new();
-    let _ = writeln!(
-        f,
-        "# hpge-cv {} discover: start model {}, chosen {}",
-        env!("CARGO_PKG_VERSION"),
-        d.summary.start_model,
-        d.summary.chosen.as_deref().unwrap_or("none")
-    );
     let _ = writeln!(
         f,
         "voltage_V,c_m_pF,before_c_pF,before_sigma_pF,before_residual,after_c_pF,after_sigma_pF,after_residual"

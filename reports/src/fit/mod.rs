@@ -104,11 +104,10 @@ pub fn write_outputs(
     truth: Option<&[Option<f64>]>,
     truth_records: Option<&[TruthRecord]>,
 ) -> Result<()> {
-    let header = outputs::output_header(&s.files, &o.sampler, o.seed, &o.likelihood);
-    outputs::write_samples(&out.join("samples.csv"), &header, fit)?;
-    outputs::write_predictive(&out.join("predictive.csv"), &header, fit)?;
+    outputs::write_samples(&out.join("samples.csv"), fit)?;
+    outputs::write_predictive(&out.join("predictive.csv"), fit)?;
     let zeta = s.zeta_at_mode(fit)?;
-    outputs::write_zeta(&out.join("zeta-mode.csv"), &header, &zeta)?;
+    outputs::write_zeta(&out.join("zeta-mode.csv"), &zeta)?;
     let mut figures = Vec::new();
     if !o.no_plots {
         let names = s.prior.names();

@@ -316,10 +316,9 @@ fn write_text(path: &Path, text: &str) -> Result<PathBuf> {
 }
 
 fn tables(out: &Path, inputs: &Section9Inputs, res: &[ModelResult]) -> Result<Vec<PathBuf>> {
-    let foot = provenance(inputs);
     let keys: Vec<&str> = res.iter().map(|m| m.model.key.as_str()).collect();
     // Field lines.
-    let mut t = format!("# {foot}\n# |E| in V/cm, empty where there is no field\nr_mm");
+    let mut t = String::from("r_mm");
     for k in &keys {
         t += &format!(",e_V_per_cm_{k},status_{k}");
     }
@@ -336,7 +335,7 @@ fn tables(out: &Path, inputs: &Section9Inputs, res: &[ModelResult]) -> Result<Ve
     // Pulses on one time axis (each ends at its collection time; later samples repeat the end).
     let n = res.iter().map(|m| m.t_ns.len()).max().unwrap_or(0);
     let dt = DriftSettings::default().sample_ns;
-    let mut t = format!("# {foot}\n# normalised n+ charge\nt_ns");
+    let mut t = String::from("t_ns");
     for k in &keys {
         t += &format!(",q_nplus_{k}");
     }
@@ -356,7 +355,7 @@ fn tables(out: &Path, inputs: &Section9Inputs, res: &[ModelResult]) -> Result<Ve
     }
     files.push(write_text(&out.join("pulses-nplus.csv"), &t)?);
     // The numbers.
-    let mut t = format!("# {foot}\nmodel,d_li_mm,fully_depleted");
+    let mut t = String::from("model,d_li_mm,fully_depleted");
     for r in &inputs.radii_mm {
         t += &format!(",e_V_per_cm_at_r{r}mm");
     }
@@ -382,6 +381,12 @@ fn tables(out: &Path, inputs: &Section9Inputs, res: &[ModelResult]) -> Result<Ve
             "drift_settings": DriftSettings::default(),
         },
         "models": res.iter().map(|m| m.summary.clone()).collect::<Vec<_>>(),
+        "provenance": provenance(inputs),
+        "tables": {
+            "field-r.csv": "|E| in V/cm along r, empty where there is no field",
+            "pulses-nplus.csv": "normalised n+ charge; each pulse repeats its end after its collection time",
+            "section9.csv": "per impurity model: d_Li, full depletion, |E| at the radii, collection and rise times, where the carriers stopped",
+        },
     });
     let text = serde_json::to_string_pretty(&v)?;
     files.push(write_text(&out.join("section9.json"), &(text + "\n"))?);

@@ -313,7 +313,9 @@ impl Generator {
                     Ok(c) => (c[j], "ok".to_string()),
                     Err(e) => (
                         f64::NAN,
-                        format!("failed: {e}").replace([',', '\n', '\r'], ";"),
+                        format!("failed: {e}")
+                            .replace([',', '\n', '\r'], ";")
+                            .replace(['#', '"'], "'"),
                     ),
                 };
                 Sample {
@@ -352,7 +354,9 @@ impl Generator {
             Ok(c) => (c, "ok".to_string()),
             Err(e) => (
                 f64::NAN,
-                format!("failed: {e}").replace([',', '\n', '\r'], ";"),
+                format!("failed: {e}")
+                    .replace([',', '\n', '\r'], ";")
+                    .replace(['#', '"'], "'"),
             ),
         };
         Sample {

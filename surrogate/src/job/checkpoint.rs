@@ -18,9 +18,10 @@ pub fn partial_dir(model: &Path) -> PathBuf {
     model.with_extension("partial")
 }
 
-/// Writes learning curves: a comment line naming `model` and this program's version, the header
-/// `member,epoch,cycle,lr,train_loss,test_loss,test_rel_rms,seconds`, one line per epoch (losses
-/// in `{:e}`, seconds with 3 decimals).
+/// Writes learning curves: the header `member,epoch,cycle,lr,train_loss,test_loss,test_rel_rms,
+/// seconds`, one line per epoch (losses in `{:e}`, seconds with 3 decimals), no comment lines;
+/// the provenance (this program's version, `model`) goes to the sidecar `<stem>.json`
+/// (`NAME.curves.csv` -> `NAME.curves.json`).
 pub fn write_curves(path: &Path, curves: &[EpochRecord], model: &Path) -> Result<()> {
     let failed = |source| Error::RunFile {
         action: "cannot write the learning curves",
@@ -28,19 +29,28 @@ pub fn write_curves(path: &Path, curves: &[EpochRecord], model: &Path) -> Result
         source,
     };
     let mut f = std::fs::File::create(path).map_err(failed)?;
-    let mut text = format!(
-        "# learning curves of {} (hpge-cv {}): mean loss over each set after every epoch\n\
-         member,epoch,cycle,lr,train_loss,test_loss,test_rel_rms,seconds\n",
-        model.display(),
-        env!("CARGO_PKG_VERSION")
-    );
+    let mut text =
+        String::from("member,epoch,cycle,lr,train_loss,test_loss,test_rel_rms,seconds\n");
     for r in curves {
         text += &format!(
             "{},{},{},{:e},{:e},{:e},{:e},{:.3}\n",
             r.member, r.epoch, r.cycle, r.lr, r.train_loss, r.test_loss, r.test_rel_rms, r.seconds
         );
     }
-    f.write_all(text.as_bytes()).map_err(failed)
+    f.write_all(text.as_bytes()).map_err(failed)?;
+    let sidecar = path.with_extension("json");
+    let meta = serde_json::json!({
+        "program": "hpge-cv",
+        "version": env!("CARGO_PKG_VERSION"),
+        "what": "learning curves: mean loss over each set after every epoch",
+        "model": model.display().to_string(),
+        "csv": path.file_name().map(|n| n.to_string_lossy().into_owned()),
+    });
+    std::fs::write(&sidecar, format!("{meta:#}\n")).map_err(|source| Error::RunFile {
+        action: "cannot write the learning curves' sidecar",
+        file: sidecar.clone(),
+        source,
+    })
 }
 
 /// Reads the learning curves of checkpoint member `m` (the lines [`write_curves`] writes).
@@ -127,5 +137,43 @@ pub fn resume_members(dir: &Path, info: &ModelInfo) -> Result<Vec<Member>> {
         };
         let records = read_curves(&curves, m)?;
         done.push((net, records));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Learning curves as written before issue 22 (a leading `#` line, as the shipped
+    /// models/*.curves.csv still are) read as well as today's plain tables.
+    #[test]
+    fn reads_old_curves_with_a_comment_line_and_new_ones_without() {
+        let d = std::env::temp_dir().join(format!("hpge-curves-old-{}", std::process::id()));
+        std::fs::create_dir_all(&d).unwrap();
+        let rows = "member,epoch,cycle,lr,train_loss,test_loss,test_rel_rms,seconds\n\
+                    0,1,1,1e-2,2e0,3e0,1e-1,0.100\n0,2,1,1e-2,1e0,2e0,5e-2,0.200\n";
+        let old = d.join("old.curves.csv");
+        std::fs::write(
+            &old,
+            format!("# learning curves of m.safetensors (hpge-cv 0.1.0): mean loss\n{rows}"),
+        )
+        .unwrap();
+        let a = read_curves(&old, 3).unwrap();
+        assert_eq!(a.len(), 2);
+        assert_eq!(a[1].member, 3);
+        assert_eq!(a[1].train_loss, 1.0);
+        // Today's: written without a comment line, with the sidecar; read back the same.
+        let new = d.join("new.curves.csv");
+        write_curves(&new, &a, Path::new("m.safetensors")).unwrap();
+        let text = std::fs::read_to_string(&new).unwrap();
+        assert!(text.starts_with("member,epoch,"), "{text}");
+        assert!(!text.contains('#'), "{text}");
+        assert_eq!(read_curves(&new, 3).unwrap(), a);
+        let side: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(d.join("new.curves.json")).unwrap())
+                .unwrap();
+        assert_eq!(side["model"], "m.safetensors");
+        assert_eq!(side["version"], env!("CARGO_PKG_VERSION"));
+        let _ = std::fs::remove_dir_all(&d);
     }
 }

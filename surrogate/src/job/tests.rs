@@ -140,18 +140,18 @@ fn a_tiny_network_trains_writes_its_files_and_resumes_from_a_checkpoint() {
     assert_eq!(curves_path(&job.out), curves_file);
     let text = std::fs::read_to_string(&curves_file).unwrap();
     let mut lines = text.lines();
-    assert_eq!(
-        lines.next().unwrap(),
-        format!(
-            "# learning curves of {} (hpge-cv {}): mean loss over each set after every epoch",
-            job.out.display(),
-            env!("CARGO_PKG_VERSION")
-        )
-    );
+    // A plain table (issue 22): the header first, no comment lines; the provenance in the
+    // sidecar tiny.curves.json.
     assert_eq!(
         lines.next().unwrap(),
         "member,epoch,cycle,lr,train_loss,test_loss,test_rel_rms,seconds"
     );
+    assert!(!text.lines().any(|l| l.starts_with('#')), "{text}");
+    let sidecar: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d.join("tiny.curves.json")).unwrap())
+            .unwrap();
+    assert_eq!(sidecar["version"], env!("CARGO_PKG_VERSION"));
+    assert_eq!(sidecar["model"], job.out.display().to_string());
     let l = losses(&curves_file);
     assert_eq!(l.len(), 12);
     assert!(l[11] < 0.5 * l[0], "{l:?}");
