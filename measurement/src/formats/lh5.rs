@@ -196,7 +196,9 @@ pub fn read_lh5_pulses(path: &Path) -> Result<PulseSet> {
     let period_ns = checked.sidecar.sampling_period_ns;
     for (p, &d) in periods.iter().enumerate() {
         let d_ns = d * ns_per_unit;
-        if !((d_ns - period_ns).abs() <= PERIOD_TOLERANCE * period_ns) {
+        // NaN compares false: a NaN dt is refused too.
+        let agrees = (d_ns - period_ns).abs() <= PERIOD_TOLERANCE * period_ns;
+        if !agrees {
             return Err(lh5(
                 path,
                 &dt_name,
