@@ -367,3 +367,34 @@ fn bad_legend_records() {
         }
     }
 }
+
+#[test]
+fn bad_lh5_pulse_files() {
+    // A truncated HDF5 file (its signature and nothing else) and a text file named .lh5, each
+    // with a valid sidecar: given alone or as the only file of a folder, exit 2 naming the file.
+    let sidecar = "bias_V = 100.0\nsampling_period_ns = 160.0\ncharge_unit = \"pC\"\n";
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("bad_input_lh5");
+    for (name, bytes) in [
+        ("truncated", b"\x89HDF\r\n\x1a\n\0".as_slice()),
+        ("text", b"bias,values\n".as_slice()),
+    ] {
+        let folder = dir.join(name);
+        std::fs::create_dir_all(&folder).unwrap();
+        let lh5 = folder.join(format!("{name}.lh5"));
+        std::fs::write(&lh5, bytes).unwrap();
+        std::fs::write(lh5.with_extension("toml"), sidecar).unwrap();
+        let out = dir.join(format!("{name}-cv.csv"));
+        for raw in [&lh5, &folder] {
+            let msg = fails(&[
+                "measure",
+                "--raw",
+                raw.to_str().unwrap(),
+                "--out",
+                out.to_str().unwrap(),
+            ]);
+            assert!(msg.contains(lh5.to_str().unwrap()), "{msg}");
+            assert!(msg.contains("HDF5"), "{msg}");
+            assert!(!msg.contains("HDF5-DIAG"), "{msg}");
+        }
+    }
+}

@@ -48,6 +48,26 @@ pub enum Error {
         /// What is wrong with it ("must be positive, got -1").
         message: String,
     },
+    /// A file that the HDF5 library cannot open as HDF5 (not HDF5, truncated, unreadable): an
+    /// `.lh5` pulse file.
+    #[error("{}: cannot open as an HDF5 (LH5) file: {reason}", file.display())]
+    Hdf5Open {
+        /// The file.
+        file: PathBuf,
+        /// The HDF5 library's reason.
+        reason: String,
+    },
+    /// An HDF5 file that opens but does not hold the expected LH5 waveform table: a missing
+    /// table or dataset, a wrong rank or element type, units that disagree with the sidecar.
+    #[error("{}: `{dataset}`: {reason}", file.display())]
+    Lh5 {
+        /// The file.
+        file: PathBuf,
+        /// The table or dataset at fault (an HDF5 path, e.g. `/ch000/raw/waveform/values`).
+        dataset: String,
+        /// What is wrong with it.
+        reason: String,
+    },
     /// A numerical step failed (a fit that did not converge, too few events in a peak).
     #[error("{what}: {message}")]
     Numerical {

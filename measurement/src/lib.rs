@@ -6,7 +6,8 @@
 //! The pipeline, one bias at a time ([`measure`], in parallel over the biases):
 //!
 //! 1. **Pulses** ([`PulseSet`]): decay-corrected, calibrated preamplifier traces in pC, read from
-//!    `<stem>.npy` files with `<stem>.toml` sidecars ([`read_pulses`], [`read_raw_dir`]).
+//!    `<stem>.npy` files with `<stem>.toml` sidecars ([`read_pulses`], [`read_raw_dir`]), or LH5
+//!    waveform tables `<stem>.lh5` with the same sidecars ([`read_lh5_pulses`]).
 //! 2. **Tail fit** ([`tail::fit_tail`], paper Eq. 7): the total charge Q_t of every pulse,
 //!    including the slow part that still arrives from the undepleted bulk.
 //! 3. **Pulser peak** ([`peak::fit_peak`]): the pulser line in the Q_t spectrum (gammas are
@@ -82,8 +83,8 @@ mod types;
 
 pub use error::{Error, Result};
 pub use formats::{
-    Data, RawProblem, RawRun, load_data, read_curve, read_pulses, read_raw_dir, write_curve,
-    write_curve_with_comments, write_pulses,
+    Data, PulseFormat, RawProblem, RawRun, load_data, read_curve, read_lh5_pulses, read_pulse_file,
+    read_pulses, read_raw_dir, write_curve, write_curve_with_comments, write_pulses,
 };
 pub use measure::{MeasureSettings, Measurement, Problem, VoltagePoint, measure};
 pub use options::{MeasureOptions, SynthOptions};

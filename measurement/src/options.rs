@@ -11,10 +11,11 @@ use crate::synth::{DEFAULT_DECIMATE, DEFAULT_PULSER_PULSES, SynthSettings};
 #[derive(Debug, Clone, PartialEq)]
 #[cfg_attr(feature = "clap", derive(clap::Args))]
 pub struct MeasureOptions {
-    /// Directory of pulse files: <stem>.npy [pulses, samples] in pC with a <stem>.toml sidecar
-    /// (bias_V, sampling_period_ns, charge_unit); optional measurement.toml (voltages_V,
-    /// circuit, uncertainties, tail fit).
-    #[cfg_attr(feature = "clap", arg(long, value_name = "DIR"))]
+    /// Directory of pulse files: <stem>.npy [pulses, samples] in pC, or <stem>.lh5 (an LH5
+    /// waveform table, one bias per file), each with a <stem>.toml sidecar (bias_V,
+    /// sampling_period_ns, charge_unit); optional measurement.toml (voltages_V, circuit,
+    /// uncertainties, tail fit). Or one .lh5 file (settings from measurement.toml beside it).
+    #[cfg_attr(feature = "clap", arg(long, value_name = "DIR|FILE.lh5"))]
     pub raw: PathBuf,
     /// The C-V curve (voltage_V,c12_pF,sigma_pF); the covariance goes to <stem>.covariance.csv
     /// and a report to <stem>.measure.json.
@@ -27,14 +28,21 @@ pub struct MeasureOptions {
 
 impl MeasureOptions {
     /// The settings and where they came from: `settings`, else `<raw>/measurement.toml` if
-    /// present, else the defaults (source `defaults`).
+    /// present (the folder of `raw` when it is a file), else the defaults (source `defaults`).
     ///
     /// # Errors
     /// A settings file that cannot be read or is refused.
     pub fn measure_settings(&self) -> Result<(MeasureSettings, String)> {
         let path = match &self.settings {
             Some(p) => Some(p.clone()),
-            None => Some(self.raw.join("measurement.toml")).filter(|p| p.is_file()),
+            None => {
+                let dir = if self.raw.is_file() {
+                    self.raw.parent().unwrap_or(Path::new("."))
+                } else {
+                    self.raw.as_path()
+                };
+                Some(dir.join("measurement.toml")).filter(|p| p.is_file())
+            }
         };
         Ok(match path {
             Some(p) => (MeasureSettings::from_file(&p)?, p.display().to_string()),

@@ -7,6 +7,10 @@
 //!   `samples`). The directory may hold the run's settings `measurement.toml`, whose optional
 //!   top-level `voltages_V` array lists the biases expected to have a pulse file. See
 //!   [`read_pulses`], [`write_pulses`], [`read_raw_dir`].
+//! * Raw data in LH5: `<stem>.lh5` instead of `<stem>.npy` (HDF5 as `legend-pydataobj` writes a
+//!   waveform table, one file per bias), with the same sidecar `<stem>.toml`. See
+//!   [`read_lh5_pulses`]; [`read_pulse_file`] reads either kind, [`read_raw_dir`] both kinds in
+//!   one directory, or one `.lh5` file given instead of a directory.
 //! * A C-V curve: a CSV `voltage_V,c12_pF,sigma_pF` (lines starting with `#` are comments), with
 //!   an optional covariance `<stem>.covariance.csv` (pF^2). See [`read_curve`], [`write_curve`].
 //!
@@ -14,6 +18,7 @@
 
 mod curve;
 mod files;
+mod lh5;
 mod npy;
 mod raw_dir;
 mod sidecar;
@@ -21,8 +26,9 @@ mod sidecar;
 use std::path::Path;
 
 pub use curve::{read_curve, write_curve, write_curve_with_comments};
+pub use lh5::read_lh5_pulses;
 pub use npy::{read_pulses, write_pulses};
-pub use raw_dir::{RawProblem, RawRun, read_raw_dir};
+pub use raw_dir::{PulseFormat, RawProblem, RawRun, read_pulse_file, read_raw_dir};
 
 use files::{MEASUREMENT_FILE, read_text, toml_message};
 
@@ -62,6 +68,7 @@ pub fn load_data(path: &Path) -> Result<Data> {
         .map(str::to_ascii_lowercase);
     match extension.as_deref() {
         Some("csv") => read_curve(path, None).map(Data::Curve),
+        Some("lh5") => read_raw_dir(path, None).map(Data::Raw),
         Some("npy") => Err(Error::format(
             path,
             "a single pulse file is not a measurement: pass the directory that holds the pulse \

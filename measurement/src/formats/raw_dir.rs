@@ -1,12 +1,58 @@
-//! A raw-data directory: one pulse file (`<stem>.npy` + `<stem>.toml`) per bias.
+//! A raw-data directory: one pulse file (`<stem>.npy` or `<stem>.lh5`, + `<stem>.toml`) per
+//! bias, whatever the format: the analysis sees only [`PulseSet`]s.
 
 use std::path::{Path, PathBuf};
 
 use super::files::{MEASUREMENT_FILE, VOLTAGE_TOLERANCE_V};
+use super::lh5::read_lh5_pulses;
 use super::npy::read_pulses;
 use super::sidecar;
 use crate::error::{Error, Result};
 use crate::types::PulseSet;
+
+/// The formats of a pulse file, by extension; each has the sidecar `<stem>.toml`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PulseFormat {
+    /// `<stem>.npy`: a 2-D array [pulses, samples] ([`read_pulses`]).
+    Npy,
+    /// `<stem>.lh5`: an HDF5 file with a LEGEND waveform table ([`read_lh5_pulses`]).
+    Lh5,
+}
+
+impl PulseFormat {
+    /// Every format, in the order their extensions are tried.
+    pub const ALL: [PulseFormat; 2] = [PulseFormat::Npy, PulseFormat::Lh5];
+
+    /// The file extension, without the dot.
+    pub fn extension(self) -> &'static str {
+        match self {
+            PulseFormat::Npy => "npy",
+            PulseFormat::Lh5 => "lh5",
+        }
+    }
+
+    /// The format of a file by its extension (case-insensitive), if it is a pulse file.
+    pub fn of(path: &Path) -> Option<PulseFormat> {
+        let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+        PulseFormat::ALL.into_iter().find(|f| f.extension() == ext)
+    }
+}
+
+/// Reads a pulse file of either format (by extension) with its sidecar into pulses in pC.
+///
+/// # Errors
+/// Those of [`read_pulses`] or [`read_lh5_pulses`]; a file with another extension is an
+/// [`Error::Format`].
+pub fn read_pulse_file(path: &Path) -> Result<PulseSet> {
+    match PulseFormat::of(path) {
+        Some(PulseFormat::Npy) => read_pulses(path),
+        Some(PulseFormat::Lh5) => read_lh5_pulses(path),
+        None => Err(Error::format(
+            path,
+            "not a pulse file: expected the extension .npy or .lh5",
+        )),
+    }
+}
 
 /// The pulse files of a raw-data directory, read as far as possible.
 #[derive(Debug, Clone)]
@@ -32,7 +78,8 @@ pub struct RawProblem {
 }
 
 /// Reads every pulse file of a directory (not recursive, in file-name order) with
-/// [`read_pulses`].
+/// [`read_pulse_file`]: `.npy` and `.lh5` files (see [`PulseFormat`]). `dir` may also be one
+/// `.lh5` file: a run of that one bias, whose errors are returned as such.
 ///
 /// Problems that do not stop the reading are collected in [`RawRun::problems`]: a pulse file
 /// that fails to read (bad array, missing or invalid sidecar), a sidecar `<stem>.toml` without
@@ -51,11 +98,19 @@ pub fn read_raw_dir(dir: &Path, expected_voltages_v: Option<&[f64]>) -> Result<R
         }
     };
     let meta = std::fs::metadata(dir).map_err(io("cannot open the raw-data directory"))?;
+    if meta.is_file() && PulseFormat::of(dir) == Some(PulseFormat::Lh5) {
+        let set = read_lh5_pulses(dir)?;
+        return Ok(RawRun {
+            dir: dir.to_path_buf(),
+            sets: vec![set],
+            problems: Vec::new(),
+        });
+    }
     if !meta.is_dir() {
         return Err(Error::format(
             dir,
-            "not a directory: raw data are a directory of pulse files <stem>.npy with sidecars \
-             <stem>.toml",
+            "not a directory: raw data are a directory of pulse files <stem>.npy or <stem>.lh5 \
+             with sidecars <stem>.toml, or one .lh5 file",
         ));
     }
     let mut files = Vec::new();
@@ -73,8 +128,8 @@ pub fn read_raw_dir(dir: &Path, expected_voltages_v: Option<&[f64]>) -> Result<R
     let mut sets: Vec<PulseSet> = Vec::new();
     let mut problems = Vec::new();
     for file in &files {
-        if has_extension(file, "npy") {
-            match read_pulses(file) {
+        if PulseFormat::of(file).is_some() {
+            match read_pulse_file(file) {
                 Ok(set) => match sets
                     .iter()
                     .find(|s| (s.bias_v - set.bias_v).abs() <= VOLTAGE_TOLERANCE_V)
@@ -100,12 +155,15 @@ pub fn read_raw_dir(dir: &Path, expected_voltages_v: Option<&[f64]>) -> Result<R
             && file.file_name().is_none_or(|n| n != MEASUREMENT_FILE)
         {
             let npy = file.with_extension("npy");
-            if !npy.is_file() {
+            let has_pulses = PulseFormat::ALL
+                .iter()
+                .any(|f| file.with_extension(f.extension()).is_file());
+            if !has_pulses {
                 problems.push(RawProblem {
                     file: file.clone(),
                     bias_v: sidecar::loose_bias_v(file),
                     message: format!(
-                        "sidecar without pulse file: expected {} next to it",
+                        "sidecar without pulse file: expected {} (or .lh5) next to it",
                         npy.display()
                     ),
                 });
@@ -119,7 +177,7 @@ pub fn read_raw_dir(dir: &Path, expected_voltages_v: Option<&[f64]>) -> Result<R
             .map(|p| format!("\n  {}", p.message))
             .collect();
         let what = if problems.is_empty() {
-            " (no <stem>.npy file with a <stem>.toml sidecar was found)".to_string()
+            " (no <stem>.npy or <stem>.lh5 file with a <stem>.toml sidecar was found)".to_string()
         } else {
             format!("; the problems:{listing}")
         };
