@@ -61,7 +61,18 @@ def runs(cli, tmp_path_factory):
     small.write_text("\n".join([rows[0], rows[1], rows[10], rows[30]]) + "\n")
     npy_dir = tmp / "npy"
     code, _, err = cli(
-        "synthesize", "--curve", small, "--out", npy_dir, "--pulses", 60, "--decimate", 40
+        "synthesize",
+        "--curve",
+        small,
+        "--out",
+        npy_dir,
+        "--pulses",
+        60,
+        "--decimate",
+        40,
+        # three biases below full depletion: the curve cannot say where it ends
+        "--depletion-voltage",
+        4000,
     )
     assert code == 0, err
     lh5_dir = tmp / "lh5"
