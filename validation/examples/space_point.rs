@@ -25,7 +25,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let t = std::time::Instant::now();
     let p = solve_point(&det, bias, &ex.settings, None)?;
     for r in &p.reports {
-        println!("  pass: {} iterations, {:.3} s", r.iterations, r.seconds);
+        println!(
+            "  pass: {} iterations, {} factorisations, {} pocket rounds, {:.3} s",
+            r.iterations, r.factorisations, r.pocket_rounds, r.seconds
+        );
     }
     // The independent checks: the deepest depression of each carrier's landscape, and of
     // those the deepest empty well (a depleted node carriers would flow into).

@@ -175,7 +175,7 @@ mod tests {
     use super::BAND_STEPS;
     use crate::detector::Detector;
     use crate::expr::Parameters;
-    use crate::field::depletion::solve_with_band_steps;
+    use crate::field::depletion::{FastSeed, solve_with_band_steps};
     use crate::field::mesh::Mesh;
     use crate::field::round::Bound;
     use crate::grid::{Grid, GridSettings};
@@ -213,23 +213,26 @@ mod tests {
             let det = detector(file);
             let coarse = mesh(&det, 2.0 * h_mm);
             let fine = mesh(&det, h_mm);
-            let c = solve_with_band_steps(&coarse, &det, bias_v, None, None, 0).unwrap();
+            let c = solve_with_band_steps(&coarse, &det, bias_v, &FastSeed::default(), 0).unwrap();
             let guess = coarse.grid.interpolate_to(&c.phi_v, &fine.grid);
-            for seed in [None, Some(guess.as_slice())] {
-                let plain = solve_with_band_steps(&fine, &det, bias_v, seed, None, 0).unwrap();
-                let band =
-                    solve_with_band_steps(&fine, &det, bias_v, seed, None, BAND_STEPS).unwrap();
+            for phi_v in [None, Some(guess.as_slice())] {
+                let seed = FastSeed {
+                    phi_v,
+                    ..FastSeed::default()
+                };
+                let plain = solve_with_band_steps(&fine, &det, bias_v, &seed, 0).unwrap();
+                let band = solve_with_band_steps(&fine, &det, bias_v, &seed, BAND_STEPS).unwrap();
                 assert_eq!(plain.phi_v, band.phi_v, "{file} at {bias_v} V");
                 assert_eq!(plain.undepleted, band.undepleted, "{file} at {bias_v} V");
                 assert_eq!(plain.pockets.len(), band.pockets.len(), "{file}");
                 let (p, b) = (plain.report.iterations, band.report.iterations);
                 eprintln!(
                     "{file} {bias_v} V, seeded {}: {p} plain iterations, {b} with band steps",
-                    seed.is_some()
+                    phi_v.is_some()
                 );
                 assert!(b <= p, "{file}: {b} band iterations > {p} plain");
-                totals[usize::from(seed.is_some())].0 += p;
-                totals[usize::from(seed.is_some())].1 += b;
+                totals[usize::from(phi_v.is_some())].0 += p;
+                totals[usize::from(phi_v.is_some())].1 += b;
             }
         }
         // A cold start crosses the grid layer by layer without them: at least 40% fewer.

@@ -12,11 +12,10 @@
 use std::time::Instant;
 
 use super::band::{BAND_STEPS, band_state};
-use super::cholesky::Factor;
 use super::mesh::{Mesh, NodeKind};
 use super::pockets::{self, Pocket, Ties, depression_depths_v, find_pockets};
 use super::report::{Backend, Method, SolveReport, Termination};
-use super::round::{Bound, Round, Saddle, pocket_ties};
+use super::round::{Bound, Factored, Round, Saddle, pocket_ties};
 use super::system::{Dof, System};
 use crate::carrier::Carrier;
 use crate::detector::Detector;
@@ -124,20 +123,55 @@ pub fn solve_fast_with(
     guess_v: Option<&[f64]>,
     untied_guess_v: Option<&[f64]>,
 ) -> Result<PotentialSolution> {
-    solve_with_band_steps(mesh, det, bias_v, guess_v, untied_guess_v, BAND_STEPS)
+    let seed = FastSeed {
+        phi_v: guess_v,
+        untied_phi_v: untied_guess_v,
+        held: None,
+    };
+    solve_with_band_steps(mesh, det, bias_v, &seed, BAND_STEPS)
 }
 
-/// [`solve_fast_with`] with `band_steps` band-relaxation steps per round (0: the plain
+/// What a `fast` solve may start from: node fields on the solve's mesh, e.g. a coarser grid's
+/// solution interpolated. Each changes only the work, never the answer's definition (see
+/// [`solve_fast_seeded`]).
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct FastSeed<'a> {
+    /// The potential (V): seeds the first active set where `untied_phi_v` is None, and with
+    /// `held` the second round's ties.
+    pub(crate) phi_v: Option<&'a [f64]>,
+    /// The potential without pocket ties (V): seeds the first round's active set.
+    pub(crate) untied_phi_v: Option<&'a [f64]>,
+    /// The nodes that held trapped carriers in `phi_v` (its pockets' nodes).
+    pub(crate) held: Option<&'a [bool]>,
+}
+
+/// [`solve_fast_with`] from a [`FastSeed`]. Where the seed carries a solution with pockets
+/// (`phi_v` and `held`, e.g. the coarser grid's final answer) and the first round's own flood
+/// finds a pocket, the second round takes its ties from the seed's flood (its pockets at
+/// their levels) instead of from the first round's: the pocket rounds then start next to
+/// their end instead of from the potential without ties. The rounds still end only when the
+/// flood of a round's solution returns that round's ties (or in the cycle rule), so the answer
+/// is a self-consistent solution as before; measured on the paper's space it is the same one
+/// (`field::pockets::tests`).
+pub(crate) fn solve_fast_seeded(
+    mesh: &Mesh,
+    det: &Detector,
+    bias_v: f64,
+    seed: &FastSeed<'_>,
+) -> Result<PotentialSolution> {
+    solve_with_band_steps(mesh, det, bias_v, seed, BAND_STEPS)
+}
+
+/// [`solve_fast_seeded`] with `band_steps` band-relaxation steps per round (0: the plain
 /// active-set method, which reaches the same solution in more iterations; `band.rs`).
 pub(crate) fn solve_with_band_steps(
     mesh: &Mesh,
     det: &Detector,
     bias_v: f64,
-    guess_v: Option<&[f64]>,
-    untied_guess_v: Option<&[f64]>,
+    seed: &FastSeed<'_>,
     band_steps: usize,
 ) -> Result<PotentialSolution> {
-    let guess_v = untied_guess_v.or(guess_v);
+    let guess_v = seed.untied_phi_v.or(seed.phi_v);
     let start = Instant::now();
     let (dofs, (lo, hi)) = potential_dofs(mesh, det, bias_v);
     let sys = System::assemble(mesh, &dofs, &mesh.charge_c);
@@ -184,7 +218,7 @@ pub(crate) fn solve_with_band_steps(
     }
     let sym = sys.symbolic()?;
     // One factor's storage for every active-set iteration of every round.
-    let mut factor: Option<Factor> = None;
+    let mut factor: Option<Factored> = None;
     let mut iterations = 0;
     let mut ties: Ties = vec![None; mesh.kind.len()];
     let mut rounds = 0;
@@ -214,7 +248,18 @@ pub(crate) fn solve_with_band_steps(
                     && sys.node_unknown[k].is_some_and(|u| bounded[u] && state[u] != Bound::Free)
             })
             .collect();
-        let next = pockets::ties(mesh, &phi, (lo, hi), &occupied, POCKET_TOL * span);
+        let mut next = pockets::ties(mesh, &phi, (lo, hi), &occupied, POCKET_TOL * span);
+        if rounds == 1
+            && next.iter().any(Option::is_some)
+            && let (Some(g), Some(held)) = (seed.phi_v, seed.held)
+            && g.len() == phi.len()
+            && held.len() == phi.len()
+        {
+            let seeded = pockets::ties(mesh, g, (lo, hi), held, POCKET_TOL * span);
+            if seeded.iter().any(Option::is_some) {
+                next = seeded;
+            }
+        }
         let same_x = history
             .last()
             .is_some_and(|(_, l, _)| l.iter().zip(&x).all(|(a, b)| (a - b).abs() <= 1e-13 * span));
@@ -312,6 +357,8 @@ pub(crate) fn solve_with_band_steps(
             iterations,
             residual_v,
             termination,
+            pocket_rounds: rounds,
+            factorisations: factor.as_ref().map_or(0, |f| f.factorisations),
             seconds: start.elapsed().as_secs_f64(),
         },
     })

@@ -2,8 +2,9 @@
 
 use super::adaptive::{Accuracy, Weighed, refinement_marks, undepleted_nodes, weigh};
 use super::capacitance::CapacitanceMatrix;
-use super::depletion::{PotentialSolution, solve_fast_with};
+use super::depletion::{FastSeed, PotentialSolution, solve_fast_seeded};
 use super::mesh::Mesh;
+use super::pockets::pocket_nodes;
 use super::report::{Backend, Method, SolveReport};
 use super::settings::FieldSettings;
 use super::weighting::WeightingPotentials;
@@ -204,7 +205,7 @@ pub(crate) fn solve_point_with(
     };
     let (mut mesh, mut pot) = match start_grid {
         Some(grid) if grid != mesh.grid => {
-            let guess = Guess::interpolated(&mesh.grid, &potential, &grid);
+            let guess = Guess::interpolated(&mesh, &potential, &grid);
             let m = Mesh::new(det, grid);
             let p = solve(&m, Some(&guess))?;
             reports.push(p.report.clone());
@@ -232,7 +233,7 @@ pub(crate) fn solve_point_with(
         let c12_err_pf = (0..2)
             .filter_map(|phase| mesh.grid.coarsened_phase(&keep_r, &keep_z, phase))
             .map(|h| {
-                let guess = Guess::interpolated(&mesh.grid, &pot, &h);
+                let guess = Guess::interpolated(&mesh, &pot, &h);
                 let hm = Mesh::new(det, h);
                 solve(&hm, Some(&guess))
                     .and_then(|hp| weigh(det, settings, &hm, &hp, bias_v, pair))
@@ -263,7 +264,7 @@ pub(crate) fn solve_point_with(
             }
             return Ok(finish(mesh, pot, w, reports, accuracy));
         };
-        let guess = Guess::interpolated(&mesh.grid, &pot, &finer);
+        let guess = Guess::interpolated(&mesh, &pot, &finer);
         mesh = Mesh::new(det, finer);
         pot = solve(&mesh, Some(&guess))?;
         reports.push(pot.report.clone());
@@ -329,17 +330,32 @@ struct Guess {
     phi_v: Vec<f64>,
     /// The potential without pocket ties, where it differs (`PotentialSolution::untied_phi_v`).
     untied_phi_v: Option<Vec<f64>>,
+    /// The nodes inside the solution's pockets (where it has any): the new grid's nodes whose
+    /// bilinear weight on the old grid's pocket nodes is at least 1/2.
+    held: Option<Vec<bool>>,
 }
 
 impl Guess {
-    /// A solution on grid `from`, interpolated to `to`.
-    fn interpolated(from: &Grid, pot: &PotentialSolution, to: &Grid) -> Self {
+    /// A solution on `from`'s mesh, interpolated to `to`.
+    fn interpolated(from: &Mesh, pot: &PotentialSolution, to: &Grid) -> Self {
+        let grid = &from.grid;
+        let held = (!pot.pockets.is_empty()).then(|| {
+            let inside: Vec<f64> = pocket_nodes(from, &pot.undepleted)
+                .into_iter()
+                .map(f64::from)
+                .collect();
+            grid.interpolate_to(&inside, to)
+                .into_iter()
+                .map(|w| w >= 0.5)
+                .collect()
+        });
         Self {
-            phi_v: from.interpolate_to(&pot.phi_v, to),
+            phi_v: grid.interpolate_to(&pot.phi_v, to),
             untied_phi_v: pot
                 .untied_phi_v
                 .as_ref()
-                .map(|u| from.interpolate_to(u, to)),
+                .map(|u| grid.interpolate_to(u, to)),
+            held,
         }
     }
 
@@ -348,6 +364,7 @@ impl Guess {
         Self {
             phi_v,
             untied_phi_v: None,
+            held: None,
         }
     }
 }
@@ -360,10 +377,14 @@ fn potential_on(
     mesh: &Mesh,
     guess: Option<&Guess>,
 ) -> Result<PotentialSolution> {
-    let untied = guess.and_then(|g| g.untied_phi_v.as_deref());
-    let guess = guess.map(|g| g.phi_v.as_slice());
+    let seed = FastSeed {
+        phi_v: guess.map(|g| g.phi_v.as_slice()),
+        untied_phi_v: guess.and_then(|g| g.untied_phi_v.as_deref()),
+        held: guess.and_then(|g| g.held.as_deref()),
+    };
+    let guess = seed.phi_v;
     match (settings.backend, settings.method) {
-        (Backend::Cpu, Method::Fast) => solve_fast_with(mesh, det, bias_v, guess, untied),
+        (Backend::Cpu, Method::Fast) => solve_fast_seeded(mesh, det, bias_v, &seed),
         (Backend::Cpu, Method::Sor) => super::sor::solve_sor(mesh, det, bias_v, guess),
         // (Wgpu, Fast) is rejected by validate().
         (Backend::Wgpu, _) => {
@@ -410,7 +431,7 @@ fn refined_potential(
     // Moves to a finer grid: the current potential, interpolated, seeds the new solve.
     let mut advance =
         |grid: &mut Grid, mesh: &mut Mesh, pot: &mut PotentialSolution, finer: Grid| {
-            let g = Guess::interpolated(grid, pot, &finer);
+            let g = Guess::interpolated(mesh, pot, &finer);
             *mesh = Mesh::new(det, finer.clone());
             *grid = finer;
             *pot = solve(mesh, Some(&g))?;

@@ -78,6 +78,14 @@ pub struct SolveReport {
     pub residual_v: f64,
     /// Why it stopped.
     pub termination: Termination,
+    /// Pocket rounds (a solve with fixed ties, then a new flood; `field::pockets`): 1 where no
+    /// pocket formed. A work counter of the `fast` method; 0 in reports written before it.
+    #[serde(default)]
+    pub pocket_rounds: usize,
+    /// Numeric sparse Cholesky factorisations (`fast`): at most `iterations`, fewer where a
+    /// pocket round starts from the active set the previous one ended on. 0 for `sor`.
+    #[serde(default)]
+    pub factorisations: usize,
     /// Wall time in seconds.
     pub seconds: f64,
 }

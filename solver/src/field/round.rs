@@ -25,6 +25,14 @@ pub(crate) enum Bound {
     Lower,
 }
 
+/// A numeric factorisation with the active set it was made for.
+pub(super) struct Factored {
+    pub(super) factor: Factor,
+    pub(super) state: Vec<Bound>,
+    /// Numeric factorisations made (a work counter).
+    pub(super) factorisations: usize,
+}
+
 /// A pocket in unknown space: its pour point and side; members are the unknowns tied to it.
 pub(super) struct PocketTie {
     /// The pour point: an unknown, or a fixed node's potential (V).
@@ -95,10 +103,14 @@ impl Round<'_> {
     }
 
     /// Runs the semismooth Newton iteration from `state` to its stationary active set.
+    ///
+    /// `factor` holds the factorisation of the last active set factorised (kept across rounds):
+    /// the matrix depends on the active set only, not on the ties, so a round that starts from
+    /// the active set the previous round ended on (the usual case) reuses its factorisation.
     pub(super) fn solve(
         &self,
         sym: &Symbolic,
-        factor: &mut Option<Factor>,
+        factor: &mut Option<Factored>,
         state: &mut [Bound],
         iterations: &mut usize,
     ) -> Result<(Vec<f64>, bool)> {
@@ -150,11 +162,21 @@ impl Round<'_> {
                 }
             };
             let factor = match factor {
+                Some(f) if f.state == *state => &f.factor,
                 Some(f) => {
-                    sys.refactor(f, &val)?;
-                    f
+                    sys.refactor(&mut f.factor, &val)?;
+                    f.state.copy_from_slice(state);
+                    f.factorisations += 1;
+                    &f.factor
                 }
-                None => factor.insert(sys.factor(sym, &val)?),
+                None => {
+                    let f = factor.insert(Factored {
+                        factor: sys.factor(sym, &val)?,
+                        state: state.to_vec(),
+                        factorisations: 1,
+                    });
+                    &f.factor
+                }
             };
             let ax = sys.matvec(&sys.val, &xa);
             let rhs: Vec<f64> = (0..n)

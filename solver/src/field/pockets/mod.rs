@@ -181,6 +181,59 @@ pub struct Pocket {
 /// The pockets of a solution: connected sets of undepleted semiconductor nodes (joined along
 /// conducting edges) that touch no conductor. In order of their first node.
 pub fn find_pockets(mesh: &Mesh, phi_v: &[f64], undepleted: &[bool]) -> Vec<Pocket> {
+    let (r, z) = (mesh.grid.r_mm(), mesh.grid.z_mm());
+    let nr = mesh.grid.nr();
+    let mut out = Vec::new();
+    for members in pocket_components(mesh, undepleted) {
+        let mut vol = 0.0;
+        let (mut cr, mut cz, mut level, mut q) = (0.0, 0.0, 0.0, 0.0);
+        let (mut rr, mut zr) = (
+            (f64::INFINITY, f64::NEG_INFINITY),
+            (f64::INFINITY, f64::NEG_INFINITY),
+        );
+        for &n in &members {
+            let (i, j) = (n % nr, n / nr);
+            let v = mesh.volume_m3[n];
+            vol += v;
+            cr += v * r[i];
+            cz += v * z[j];
+            level += phi_v[n];
+            q += mesh.charge_c[n];
+            rr = (rr.0.min(r[i]), rr.1.max(r[i]));
+            zr = (zr.0.min(z[j]), zr.1.max(z[j]));
+        }
+        let k = members.len() as f64;
+        let w = if vol > 0.0 { vol } else { 1.0 };
+        out.push(Pocket {
+            carrier: if q < 0.0 {
+                Carrier::Hole
+            } else {
+                Carrier::Electron
+            },
+            level_v: level / k,
+            volume_cm3: vol * 1e6,
+            nodes: members.len(),
+            centroid_mm: (cr / w, cz / w),
+            r_range_mm: rr,
+            z_range_mm: zr,
+        });
+    }
+    out
+}
+
+/// The nodes of every pocket (see [`find_pockets`]): true for an undepleted semiconductor node
+/// whose undepleted region touches no conductor.
+pub(crate) fn pocket_nodes(mesh: &Mesh, undepleted: &[bool]) -> Vec<bool> {
+    let mut out = vec![false; undepleted.len()];
+    for n in pocket_components(mesh, undepleted).into_iter().flatten() {
+        out[n] = true;
+    }
+    out
+}
+
+/// Connected sets of undepleted semiconductor nodes (joined along conducting edges) that touch
+/// no conductor, in order of their first node.
+fn pocket_components(mesh: &Mesh, undepleted: &[bool]) -> Vec<Vec<usize>> {
     let (nr, nz) = (mesh.grid.nr(), mesh.grid.nz());
     let nn = nr * nz;
     let und = |n: usize| undepleted[n] && mesh.kind[n] == NodeKind::Semiconductor;
@@ -214,42 +267,9 @@ pub fn find_pockets(mesh: &Mesh, phi_v: &[f64], undepleted: &[bool]) -> Vec<Pock
                 }
             }
         }
-        if touches {
-            continue;
+        if !touches {
+            out.push(members);
         }
-        let (r, z) = (mesh.grid.r_mm(), mesh.grid.z_mm());
-        let mut vol = 0.0;
-        let (mut cr, mut cz, mut level, mut q) = (0.0, 0.0, 0.0, 0.0);
-        let (mut rr, mut zr) = (
-            (f64::INFINITY, f64::NEG_INFINITY),
-            (f64::INFINITY, f64::NEG_INFINITY),
-        );
-        for &n in &members {
-            let (i, j) = (n % nr, n / nr);
-            let v = mesh.volume_m3[n];
-            vol += v;
-            cr += v * r[i];
-            cz += v * z[j];
-            level += phi_v[n];
-            q += mesh.charge_c[n];
-            rr = (rr.0.min(r[i]), rr.1.max(r[i]));
-            zr = (zr.0.min(z[j]), zr.1.max(z[j]));
-        }
-        let k = members.len() as f64;
-        let w = if vol > 0.0 { vol } else { 1.0 };
-        out.push(Pocket {
-            carrier: if q < 0.0 {
-                Carrier::Hole
-            } else {
-                Carrier::Electron
-            },
-            level_v: level / k,
-            volume_cm3: vol * 1e6,
-            nodes: members.len(),
-            centroid_mm: (cr / w, cz / w),
-            r_range_mm: rr,
-            z_range_mm: zr,
-        });
     }
     out
 }

@@ -3,11 +3,14 @@
 
 use std::path::Path;
 
+use super::pocket_nodes;
 use super::{CARRIERS, deepest_depression_v};
 use crate::carrier::Carrier;
 use crate::detector::Detector;
 use crate::expr::Parameters;
-use crate::field::depletion::{PotentialSolution, solve_fast, solve_fast_with};
+use crate::field::depletion::{
+    FastSeed, PotentialSolution, solve_fast, solve_fast_seeded, solve_fast_with,
+};
 use crate::field::mesh::{Mesh, NodeKind};
 use crate::field::sor::solve_sor;
 use crate::grid::{Grid, GridSettings};
@@ -158,6 +161,71 @@ fn untied_seed_gives_the_same_solution_with_less_work() {
         "active-set iterations: tied seed {}, untied seed {}",
         plain.report.iterations, seeded.report.iterations
     );
+}
+
+/// Issue 20: a finer grid's second pocket round tied from the coarse grid's pockets (the seed's
+/// flood with its pocket nodes held) ends self-consistent (flat pockets, no depression) in no
+/// more pocket rounds than from the first round's flood, here at the same solution; and a
+/// round that starts from the active set the previous round ended on reuses its factorisation
+/// (work counters pinned: fewer factorisations than active-set iterations).
+#[test]
+fn pocket_ties_seeded_from_a_coarser_grid_need_no_more_rounds() {
+    let det = icpc();
+    let coarse = coarse_mesh(&det);
+    let u = find_pocket_bias(&det, &coarse);
+    let c = solve_fast(&coarse, &det, u, None).unwrap();
+    assert!(!c.pockets.is_empty());
+    let gs = GridSettings {
+        max_spacing_semiconductor_mm: 1.0,
+        max_spacing_mm: 2.5,
+        ..GridSettings::default()
+    };
+    let fine = Mesh::new(&det, Grid::initial(&det, &gs));
+    let to_fine = |v: &[f64]| coarse.grid.interpolate_to(v, &fine.grid);
+    let phi = to_fine(&c.phi_v);
+    let untied = c.untied_phi_v.as_deref().map(to_fine);
+    let inside: Vec<f64> = pocket_nodes(&coarse, &c.undepleted)
+        .into_iter()
+        .map(f64::from)
+        .collect();
+    let held: Vec<bool> = to_fine(&inside).into_iter().map(|w| w >= 0.5).collect();
+    assert!(
+        held.iter().any(|&h| h),
+        "the coarse pocket has no node on the fine grid"
+    );
+    let mut seed = FastSeed {
+        phi_v: Some(&phi),
+        untied_phi_v: untied.as_deref(),
+        held: None,
+    };
+    let plain = solve_fast_seeded(&fine, &det, u, &seed).unwrap();
+    seed.held = Some(&held);
+    let tied = solve_fast_seeded(&fine, &det, u, &seed).unwrap();
+    let span = (tied.bounds_v.1 - tied.bounds_v.0).abs();
+    assert!(!tied.pockets.is_empty());
+    assert!(
+        depth(&fine, &tied) <= 1e-9 * span,
+        "depression {:e} V",
+        depth(&fine, &tied)
+    );
+    let d = max_diff(&plain.phi_v, &tied.phi_v);
+    assert!(d <= 1e-8, "solutions differ by {d:e} V");
+    let (p, t) = (&plain.report, &tied.report);
+    eprintln!(
+        "pocket rounds: first round's flood {}, seeded ties {}; factorisations / iterations: \
+         {} / {}, {} / {}",
+        p.pocket_rounds,
+        t.pocket_rounds,
+        p.factorisations,
+        p.iterations,
+        t.factorisations,
+        t.iterations
+    );
+    assert!(t.pocket_rounds <= p.pocket_rounds);
+    for r in [p, t] {
+        assert!(r.pocket_rounds > 1);
+        assert!(r.factorisations < r.iterations, "{r:?}");
+    }
 }
 
 /// A bias in the pinch-off window on the coarse mesh.

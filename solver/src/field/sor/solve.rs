@@ -226,6 +226,8 @@ pub fn solve_sor_with(
             iterations: sweeps,
             residual_v,
             termination: Termination::ToleranceReached,
+            pocket_rounds: rounds,
+            factorisations: 0,
             seconds: start.elapsed().as_secs_f64(),
         },
     })

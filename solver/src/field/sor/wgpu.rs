@@ -169,6 +169,8 @@ pub(crate) fn solve_sor_wgpu_with(
             iterations: sweeps,
             residual_v,
             termination: Termination::ToleranceReached,
+            pocket_rounds: rounds,
+            factorisations: 0,
             seconds: start.elapsed().as_secs_f64(),
         },
     })
