@@ -176,6 +176,9 @@ fn a_world_too_large_for_memory_is_refused_before_allocating() {
         );
         bad(&o, &[name, "world.r_max_mm", "5000000"]);
         assert!(!out.exists(), "{name}: no output file");
+        // `detector`, which checks a description, says so too.
+        let o = run(&["detector", "--detector", s(&det)]);
+        bad(&o, &[name, "world.r_max_mm", "5000000"]);
     }
     let _ = std::fs::remove_dir_all(&d);
 }
