@@ -376,7 +376,7 @@ fn evaluate_and_train_refuse(d: &Path, file: &Path, needles: &[&str]) {
         s(file),
     ]);
     bad(&o, needles);
-    let model = d.join("m.safetensors");
+    let (model, plots) = (d.join("m.safetensors"), d.join("plots"));
     let o = run(&[
         "train",
         "--data",
@@ -387,9 +387,12 @@ fn evaluate_and_train_refuse(d: &Path, file: &Path, needles: &[&str]) {
         "poly3",
         "--out",
         s(&model),
+        "--plot",
+        s(&plots),
     ]);
     bad(&o, needles);
     assert!(!model.exists());
+    assert!(!plots.exists(), "no empty --plot folder");
 }
 
 #[test]
