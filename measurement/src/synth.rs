@@ -36,6 +36,13 @@ pub const DEFAULT_PULSER_PULSES: usize = 200;
 /// Samples of synthetic data averaged into one (1: none).
 pub const DEFAULT_DECIMATE: usize = 1;
 
+/// Most bytes the samples of one synthetic bias may take: 1 GiB. One bias is held in memory
+/// (8-byte samples, pulser and gamma events) and written as one .npy file, so this bounds both;
+/// at the default trace (5000 samples, 0.5 gamma events per pulser event) it allows 17 895
+/// pulser pulses per bias, 90 times the default. [`SynthSettings::validate`] refuses more,
+/// naming the largest `pulser_pulses` the trace allows.
+pub const MAX_SYNTH_BYTES_PER_BIAS: f64 = 1024.0 * 1024.0 * 1024.0;
+
 /// Settings of the generator, with the defaults used for the shipped data ("the paper's noise
 /// level": about 1 keV pulser-amplitude spread and 3.7 keV white noise per 4 ns sample).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -132,7 +139,45 @@ impl SynthSettings {
         if self.edge_ns >= self.trace_ns {
             return Err(Error::setting("edge_ns", "must lie inside the trace"));
         }
+        self.check_memory()?;
         self.circuit.validate()
+    }
+
+    /// Refuses settings whose one bias would take more than [`MAX_SYNTH_BYTES_PER_BIAS`] (the
+    /// pulses of a bias, at most `1 + gammas_per_pulser` events per pulser pulse, and the native
+    /// trace), before anything is allocated.
+    fn check_memory(&self) -> Result<()> {
+        let native = (self.trace_ns / self.sampling_period_ns).round();
+        let samples = (native / self.decimate as f64).floor().max(1.0);
+        let events_per_pulse = 1.0 + self.gammas_per_pulser;
+        let bytes = |pulses: f64| 8.0 * (pulses * events_per_pulse * samples + native);
+        let need = bytes(self.pulser_pulses as f64);
+        if need <= MAX_SYNTH_BYTES_PER_BIAS {
+            return Ok(());
+        }
+        if bytes(10.0) > MAX_SYNTH_BYTES_PER_BIAS {
+            return Err(Error::setting(
+                "trace_ns",
+                format!(
+                    "a trace of {} ns at {} ns per sample ({native} samples) takes more than \
+                     the limit of 1 GiB per bias even with 10 pulses",
+                    self.trace_ns, self.sampling_period_ns
+                ),
+            ));
+        }
+        let most =
+            ((MAX_SYNTH_BYTES_PER_BIAS / 8.0 - native) / (events_per_pulse * samples)).floor();
+        Err(Error::setting(
+            "pulser_pulses",
+            format!(
+                "{} pulses per bias (with {} gamma events per pulser event, {samples} samples \
+                 each) would take {:.1} GB of memory and file per bias; at most {most} pulses per \
+                 bias fit the limit of 1 GiB at this trace length and decimation",
+                self.pulser_pulses,
+                self.gammas_per_pulser,
+                need / 1e9
+            ),
+        ))
     }
 }
 
@@ -185,11 +230,16 @@ pub fn synthesize_voltage(
         name: "synth settings".into(),
         message: e.to_string(),
     })?;
-    if !(c12_pf.is_finite() && c12_pf > 0.0 && bias_v.is_finite() && depletion_v > 0.0) {
+    if !(c12_pf.is_finite()
+        && c12_pf > 0.0
+        && bias_v.is_finite()
+        && bias_v > 0.0
+        && depletion_v > 0.0)
+    {
         return Err(Error::Argument {
             name: "curve".into(),
             message: format!(
-                "need finite bias, c12 > 0 and U_fd > 0, got {bias_v} V, {c12_pf} pF, {depletion_v} V"
+                "need a finite bias > 0, c12 > 0 and U_fd > 0, got {bias_v} V, {c12_pf} pF, {depletion_v} V"
             ),
         });
     }

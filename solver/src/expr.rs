@@ -3,6 +3,9 @@
 //! A length in a detector file is either a number or a string such as `"5.0 + d_li_mm"`. The
 //! grammar is: numbers (with optional exponent), parameter names, `+ - * /`, unary minus and
 //! parentheses. Evaluation is exact IEEE arithmetic; a non-finite result is an error.
+//!
+//! The parser recurses once per parenthesis and unary sign, so nesting is bounded
+//! ([`MAX_EXPRESSION_DEPTH`]): a deeper expression is an error, not a stack overflow.
 
 use std::collections::BTreeMap;
 use std::fmt;
@@ -154,6 +157,12 @@ impl<'de> Deserialize<'de> for Quantity {
     }
 }
 
+/// Deepest nesting of parentheses and unary signs an expression may have. The recursive-descent
+/// parser takes one stack frame per level (a few hundred bytes); 256 levels are far beyond any
+/// written length and far below the 2 MiB stack of a spawned thread, so a hostile expression
+/// (200 000 `(`, or `- - - ...`) is refused instead of overflowing the stack (an abort).
+pub const MAX_EXPRESSION_DEPTH: usize = 256;
+
 /// Evaluates an arithmetic expression over `params`; the error is an [`Error::Expression`].
 pub(crate) fn eval_expr(text: &str, params: &Parameters) -> Result<f64> {
     parse_and_eval(text, params).map_err(|reason| Error::Expression {
@@ -171,6 +180,7 @@ fn parse_and_eval(text: &str, params: &Parameters) -> Parsed<f64> {
     let mut p = ExprParser {
         tokens: &tokens,
         pos: 0,
+        depth: 0,
         params,
     };
     let value = p.expr()?;
@@ -249,6 +259,8 @@ fn tokenize(text: &str) -> Parsed<Vec<Token>> {
 struct ExprParser<'a> {
     tokens: &'a [Token],
     pos: usize,
+    /// Current nesting of parentheses and unary signs (bounded by [`MAX_EXPRESSION_DEPTH`]).
+    depth: usize,
     params: &'a Parameters,
 }
 
@@ -283,19 +295,34 @@ impl ExprParser<'_> {
         Ok(acc)
     }
 
+    /// A factor one nesting level down: refused beyond [`MAX_EXPRESSION_DEPTH`] (the message
+    /// does not quote the expression, which may be huge).
+    fn nested(&mut self, parse: fn(&mut Self) -> Parsed<f64>) -> Parsed<f64> {
+        if self.depth >= MAX_EXPRESSION_DEPTH {
+            return Err(format!(
+                "nested deeper than {MAX_EXPRESSION_DEPTH} levels of parentheses or unary signs \
+                 (the limit that keeps the parser's recursion bounded); write it flatter"
+            ));
+        }
+        self.depth += 1;
+        let v = parse(self);
+        self.depth -= 1;
+        v
+    }
+
     fn factor(&mut self) -> Parsed<f64> {
         match self.tokens.get(self.pos) {
             Some(Token::Op('-')) => {
                 self.pos += 1;
-                Ok(-self.factor()?)
+                Ok(-self.nested(Self::factor)?)
             }
             Some(Token::Op('+')) => {
                 self.pos += 1;
-                self.factor()
+                self.nested(Self::factor)
             }
             Some(Token::Op('(')) => {
                 self.pos += 1;
-                let v = self.expr()?;
+                let v = self.nested(Self::expr)?;
                 if self.peek_op() != Some(')') {
                     return Err("missing `)`".to_string());
                 }
@@ -346,6 +373,25 @@ mod tests {
         assert_eq!(eval_expr("-r - -1", &p).unwrap(), -1.0);
         assert_eq!(eval_expr("67 - d_li_mm / 2", &p).unwrap(), 66.25);
         assert_eq!(eval_expr("1e1 + 2.5E-1", &p).unwrap(), 10.25);
+    }
+
+    #[test]
+    fn nesting_is_bounded_not_a_stack_overflow() {
+        let p = params();
+        let n = MAX_EXPRESSION_DEPTH;
+        // At the limit: fine (parentheses and signs alike).
+        let ok = format!("{}1{}", "(".repeat(n), ")".repeat(n));
+        assert_eq!(eval_expr(&ok, &p).unwrap(), 1.0);
+        assert_eq!(eval_expr(&format!("{}1", "- ".repeat(n)), &p).unwrap(), 1.0);
+        // 200 000 deep: an error naming the limit, not an abort.
+        for text in [
+            format!("{}1{}", "(".repeat(200_000), ")".repeat(200_000)),
+            format!("1 {}1", "+ -".repeat(200_000)),
+        ] {
+            let e = eval_expr(&text, &p).unwrap_err().to_string();
+            assert!(e.contains("nested deeper than 256"), "{e}");
+            assert!(e.len() < 300, "the message must not quote the expression");
+        }
     }
 
     #[test]

@@ -66,7 +66,7 @@ pub mod scan;
 pub use detector::Detector;
 pub use drift::{Pulse, pulse};
 pub use error::{Error, Result};
-pub use expr::Parameters;
+pub use expr::{MAX_EXPRESSION_DEPTH, Parameters};
 pub use field::{
     Backend, CvCurve, CvPoint, FieldSettings, Method, PointResult, WeightingMode, cv_curve,
     full_depletion_voltage, pinch_off_voltage, solve_point, solve_potential,

@@ -73,6 +73,9 @@ pub fn from_legend(
 }
 
 fn show(det: &Detector, plots: &[PathBuf], as_json: bool) -> Result<()> {
+    // The check every solving command makes: a world too large for any grid is refused here
+    // already (at the file's own [grid] settings, else the defaults).
+    hpge_solver::grid::Grid::check_initial_size(det, &det.grid.clone().unwrap_or_default())?;
     for p in plots {
         plot::cross_section(det, p)?;
         eprintln!("wrote {}", p.display());

@@ -193,7 +193,17 @@ fn read_truth(path: &Path) -> Result<(Vec<f64>, Vec<f64>)> {
                     )
                 })
         };
-        u.push(num(cu, "voltage_V")?);
+        let volts = num(cu, "voltage_V")?;
+        if volts <= 0.0 {
+            // A pulse file is named by its bias (U0025V.npy): -25 V would make U-025V.npy, and a
+            // bias of 0 or below is no reverse bias at all.
+            bail!(
+                "--curve {}: line {}, voltage_V: {volts} V: the bias U_B must be above 0 V",
+                path.display(),
+                i + 2
+            );
+        }
+        u.push(volts);
         c.push(num(cc, "c12_pF")?);
     }
     if u.len() < 2 || u.windows(2).any(|w| w[1] <= w[0]) || c.iter().any(|x| *x <= 0.0) {
@@ -207,11 +217,18 @@ fn read_truth(path: &Path) -> Result<(Vec<f64>, Vec<f64>)> {
 
 /// Writes one pulse file per bias (`U<bias>V.npy` + sidecar), `measurement.toml` listing the
 /// biases, and `truth.json` with the curve, seed and settings.
+///
+/// Everything is checked before the folder is made (the pulses' memory among it:
+/// [`hpge_measurement::synth::MAX_SYNTH_BYTES_PER_BIAS`]); a folder this run made is removed
+/// again when a later step fails, so a failure leaves no empty or partial folder behind.
 pub fn synthesize(o: &SynthOptions) -> Result<()> {
     let settings = o.settings();
-    settings
-        .validate()
-        .map_err(|m| anyhow::anyhow!("synthesis settings: {m}"))?;
+    settings.validate().map_err(|e| match &e {
+        hpge_measurement::Error::Setting { key, message } if key == "pulser_pulses" => {
+            anyhow::anyhow!("--pulses {}: {message}", o.pulses)
+        }
+        _ => anyhow::anyhow!("synthesis settings: {e}"),
+    })?;
     let (volts, c12) = read_truth(&o.curve)?;
     let ufd = match o.depletion_voltage {
         Some(v) if v.is_finite() && v > 0.0 => v,
@@ -223,15 +240,31 @@ pub fn synthesize(o: &SynthOptions) -> Result<()> {
             )
         })?,
     };
+    let made = !o.out.exists();
     std::fs::create_dir_all(&o.out)
         .with_context(|| format!("--out {}: cannot create the folder", o.out.display()))?;
+    let written = write_synthetic(o, &settings, &volts, &c12, ufd);
+    if written.is_err() && made {
+        let _ = std::fs::remove_dir_all(&o.out);
+    }
+    written
+}
+
+/// The files of [`synthesize`] into the existing folder `o.out`.
+fn write_synthetic(
+    o: &SynthOptions,
+    settings: &hpge_measurement::SynthSettings,
+    volts: &[f64],
+    c12: &[f64],
+    ufd: f64,
+) -> Result<()> {
     let bar = ProgressBar::new(volts.len() as u64);
     bar.set_style(
         ProgressStyle::with_template("{bar:40} {pos}/{len} voltages, eta {eta}")
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
-    for (k, (&u, &c)) in volts.iter().zip(&c12).enumerate() {
-        let v = synthesize_voltage(u, c, ufd, &settings, voltage_seed(o.seed, k))?;
+    for (k, (&u, &c)) in volts.iter().zip(c12).enumerate() {
+        let v = synthesize_voltage(u, c, ufd, settings, voltage_seed(o.seed, k))?;
         let name = o.out.join(format!("U{:04}V.npy", u.round() as i64));
         let set = PulseSet {
             source: name.clone(),

@@ -102,6 +102,7 @@ impl TrainProgress<'_> {
 /// Trains, evaluates on the test set and writes the model file and its learning curves.
 pub fn train(job: &TrainJob, plot: Option<&Path>, quiet: bool) -> Result<()> {
     job.check_out().map_err(|e| anyhow::anyhow!("--out {e}"))?;
+    let made_plot_dir = plot.filter(|d| !d.exists());
     if let Some(dir) = plot {
         std::fs::create_dir_all(dir)
             .with_context(|| format!("--plot {}: cannot create the folder", dir.display()))?;
@@ -111,7 +112,17 @@ pub fn train(job: &TrainJob, plot: Option<&Path>, quiet: bool) -> Result<()> {
         quiet,
         bar: None,
     };
-    let outcome = job.run(&mut |e| progress.event(e))?;
+    let outcome = match job.run(&mut |e| progress.event(e)) {
+        Ok(o) => o,
+        Err(e) => {
+            // No empty --plot folder left behind by a run that failed (the folder is removed
+            // only if this run made it and it is still empty).
+            if let Some(dir) = made_plot_dir {
+                let _ = std::fs::remove_dir(dir);
+            }
+            return Err(e.into());
+        }
+    };
     let model = &outcome.model;
     if let Some(dir) = plot {
         if !outcome.curves.is_empty() {

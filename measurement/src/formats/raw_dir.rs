@@ -87,8 +87,10 @@ pub struct RawProblem {
 /// with the bias of an earlier one (the first is kept), and each bias of `expected_voltages_v`
 /// (V, matched within 1e-6 V) without a pulse set. Other files are ignored.
 ///
-/// Errors: the directory does not exist, is not a directory or cannot be listed, or it holds no
-/// readable pulse file at all (the message lists the problems).
+/// Errors: the directory does not exist, is not a directory or cannot be listed, it holds no
+/// readable pulse file at all (the message lists the problems), or a sidecar declares a bias that
+/// is not a finite number of volts above 0 (`bias_V`: a mistake in the run's description, not an
+/// unreadable file; measuring the rest would write a curve that silently lacks that bias).
 pub fn read_raw_dir(dir: &Path, expected_voltages_v: Option<&[f64]>) -> Result<RawRun> {
     let io = |action: &'static str| {
         move |source: std::io::Error| Error::Io {
@@ -145,6 +147,9 @@ pub fn read_raw_dir(dir: &Path, expected_voltages_v: Option<&[f64]>) -> Result<R
                     }),
                     None => sets.push(set),
                 },
+                Err(e) if matches!(&e, Error::Invalid { key, .. } if key == "bias_V") => {
+                    return Err(e);
+                }
                 Err(e) => problems.push(RawProblem {
                     file: file.clone(),
                     bias_v: sidecar::loose_bias_v(&sidecar::sidecar_path(file)),

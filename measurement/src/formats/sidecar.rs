@@ -28,7 +28,7 @@ pub(super) struct Checked {
 }
 
 /// Reads and validates the sidecar of `npy`: it must exist, parse (no unknown keys), have a
-/// finite `bias_V`, a finite positive `sampling_period_ns` and `charge_unit` "pC" or "fC".
+/// finite positive `bias_V`, a finite positive `sampling_period_ns` and `charge_unit` "pC" or "fC".
 pub(super) fn read_checked(npy: &Path) -> Result<Checked> {
     let file = sidecar_path(npy);
     if !file.is_file() {
@@ -48,12 +48,13 @@ pub(super) fn read_checked(npy: &Path) -> Result<Checked> {
             format!("invalid sidecar: {}", toml_message(&text, &e)),
         )
     })?;
-    if !sidecar.bias_v.is_finite() {
+    if !(sidecar.bias_v.is_finite() && sidecar.bias_v > 0.0) {
         return Err(Error::invalid(
             &file,
             "bias_V",
             format!(
-                "the bias must be a finite number of volts, got {}",
+                "the bias must be a finite number of volts above 0 (the reverse bias U_B, \
+                 positive by this program's convention), got {}",
                 sidecar.bias_v
             ),
         ));

@@ -2,6 +2,7 @@
 
 mod build;
 mod initial_grid;
+pub use initial_grid::MAX_GRID_NODES;
 pub mod legend;
 mod model;
 mod spec;

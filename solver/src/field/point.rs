@@ -412,6 +412,7 @@ fn refined_potential(
     }
     pair(det)?;
     let gs = &settings.grid;
+    Grid::check_initial_size(det, gs)?;
     let mut grid = Grid::initial(det, gs);
     let mut guess: Option<Guess> = None;
     if let Some(sd) = seed {

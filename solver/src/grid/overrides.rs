@@ -33,7 +33,9 @@ impl GridOverrides {
     /// `base` with the detector's `[grid]` table, then these options, in force.
     ///
     /// # Errors
-    /// [`Error::GridOption`] naming the option when the grid settings refuse a key or value.
+    /// [`Error::GridOption`] naming the option when the grid settings refuse a key or value;
+    /// [`Error::Invalid`] naming the detector's world key when its initial grid would be larger
+    /// than [`crate::detector::MAX_GRID_NODES`] at these settings.
     pub fn apply(&self, base: &FieldSettings, det: &Detector) -> Result<FieldSettings> {
         let mut s = base.for_detector(det);
         s.grid = with_overrides(&s.grid, &self.grid)?;
@@ -44,6 +46,7 @@ impl GridOverrides {
                 message: m.to_string(),
             })?;
         }
+        crate::grid::Grid::check_initial_size(det, &s.grid)?;
         Ok(s)
     }
 }

@@ -30,6 +30,7 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<MergeReport> {
     if dirs.is_empty() {
         return Err(arg("no shard folders given".into()));
     }
+    check_out_outside(dirs, out)?;
     let mut first: Option<RunInfo> = None;
     let mut seen_k = Vec::new();
     let mut rows: BTreeMap<u64, String> = BTreeMap::new();
@@ -101,16 +102,33 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<MergeReport> {
             source: e,
         }
     };
-    let mut f = std::io::BufWriter::new(std::fs::File::create(out).map_err(io("cannot create"))?);
-    writeln!(f, "{}", info.header).map_err(io("cannot write"))?;
-    let mut failed = 0;
-    for line in rows.values() {
-        if line.rsplit(',').nth(1) != Some("ok") {
-            failed += 1;
+    // Written beside `out` and renamed into place: an interrupted or failed write leaves no
+    // partial file under the name asked for.
+    let tmp = temp_beside(out);
+    let written = (|| -> std::io::Result<usize> {
+        let mut f = std::io::BufWriter::new(std::fs::File::create(&tmp)?);
+        writeln!(f, "{}", info.header)?;
+        let mut failed = 0;
+        for line in rows.values() {
+            if line.rsplit(',').nth(1) != Some("ok") {
+                failed += 1;
+            }
+            writeln!(f, "{line}")?;
         }
-        writeln!(f, "{line}").map_err(io("cannot write"))?;
+        f.into_inner().map_err(|e| e.into_error())?.sync_all()?;
+        Ok(failed)
+    })();
+    let failed = match written {
+        Ok(n) => n,
+        Err(e) => {
+            let _ = std::fs::remove_file(&tmp);
+            return Err(io("cannot write")(e));
+        }
+    };
+    if let Err(e) = std::fs::rename(&tmp, out) {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(io("cannot write")(e));
     }
-    f.flush().map_err(io("cannot write"))?;
     let side = out.with_extension("json");
     let text = serde_json::to_string_pretty(&serde_json::json!({
         "fingerprint": fp,
@@ -131,4 +149,40 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<MergeReport> {
         failed,
         info,
     })
+}
+
+/// `<file>.tmp` beside `file`.
+fn temp_beside(file: &Path) -> PathBuf {
+    let mut name = file.as_os_str().to_os_string();
+    name.push(".tmp");
+    PathBuf::from(name)
+}
+
+/// Refuses an output inside one of the shard folders: `--out s1/rows.csv` would overwrite the
+/// shard's own rows (and `<out>.json` its `generate.json`), any other name there would be read
+/// as part of the shard by a later `generate` or `merge`. Compared after resolving `.`, `..` and
+/// links, so `./s1/../s1/rows.csv` is caught as well.
+fn check_out_outside(dirs: &[PathBuf], out: &Path) -> Result<()> {
+    let parent = match out.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    let Ok(parent) = parent.canonicalize() else {
+        // A folder that does not exist is no shard folder; creating the file will say so.
+        return Ok(());
+    };
+    for d in dirs {
+        if d.canonicalize().is_ok_and(|d| d == parent) {
+            return Err(Error::Argument {
+                name: "--out".into(),
+                message: format!(
+                    "{} lies in the shard folder {}: merging would overwrite the shard's own \
+                     files; write the merged set outside the shard folders",
+                    out.display(),
+                    d.display()
+                ),
+            });
+        }
+    }
+    Ok(())
 }

@@ -133,8 +133,10 @@ fn with_sources(e: &dyn std::error::Error) -> String {
 }
 
 impl TrainJob {
-    /// Checks the output path: it must end in `.safetensors` and its folder must exist
-    /// ([`Error::ModelPath`]). [`Self::run`] checks it first.
+    /// Checks the output path before any training: it must end in `.safetensors`, must not be
+    /// a folder, and its folder must exist and take new files (a file is created there and
+    /// removed again), so a long run is not lost at the end ([`Error::ModelPath`]).
+    /// [`Self::run`] checks it first.
     pub fn check_out(&self) -> Result<()> {
         let bad = |message: String| Error::ModelPath {
             file: self.out.clone(),
@@ -147,6 +149,28 @@ impl TrainJob {
             && !dir.is_dir()
         {
             return Err(bad(format!("the folder {} does not exist", dir.display())));
+        }
+        if self.out.is_dir() {
+            return Err(bad("is a folder, not a model file".into()));
+        }
+        // The model is written as <out>.tmp and renamed (checkpoints and learning curves go
+        // beside it too): the folder must take new files.
+        let mut probe = self.out.as_os_str().to_os_string();
+        probe.push(format!(".probe-{}", std::process::id()));
+        let probe = PathBuf::from(probe);
+        match std::fs::OpenOptions::new()
+            .write(true)
+            .create_new(true)
+            .open(&probe)
+        {
+            Ok(_) => {
+                let _ = std::fs::remove_file(&probe);
+            }
+            Err(e) => {
+                return Err(bad(format!(
+                    "cannot write into its folder ({e}); nothing was trained"
+                )));
+            }
         }
         Ok(())
     }

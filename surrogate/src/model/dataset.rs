@@ -24,7 +24,8 @@ pub struct DataSet {
     /// The solver's c12 (pF) of each sample.
     pub c12_pf: Vec<f64>,
     /// Rows without a c12 (status not `ok`, e.g. an undepleted region joining two contacts):
-    /// left out, counted here.
+    /// left out, counted here. A row with status `ok` whose c12 is not a finite positive
+    /// number is an error, as is an index that appears twice.
     pub excluded: usize,
     /// Number of input dimensions d.
     pub dim: usize,
@@ -54,7 +55,8 @@ impl DataSet {
     /// Reads a rows file (`index,u_<name>...,<name>...,c12_pF,status[,seconds]`) and checks it
     /// against `space`: the columns must name the space's dimensions in its order, and every
     /// physical value must equal the space's map of its unit coordinate (so a file of another
-    /// space with the same names but other ranges is refused too).
+    /// space with the same names but other ranges is refused too), every index must appear
+    /// once, and every row with status `ok` must have a finite c12 above 0.
     pub fn read(path: &Path, space: &ParameterSpace) -> Result<Self> {
         let text = std::fs::read_to_string(path).map_err(|e| Error::Io {
             file: path.into(),
@@ -105,6 +107,7 @@ impl DataSet {
         };
         let mut u = vec![0.0; d];
         let mut x = vec![0.0; d];
+        let mut seen: std::collections::HashMap<u64, usize> = std::collections::HashMap::new();
         for (k, line) in lines {
             if line.trim().is_empty() {
                 continue;
@@ -135,11 +138,30 @@ impl DataSet {
                 u[j] = num(1 + j)?;
                 x[j] = num(1 + d + j)?;
             }
+            if let Some(first) = seen.insert(index, line_no) {
+                return Err(invalid(
+                    format!("line {line_no}, column `index`"),
+                    format!(
+                        "index {index} appears twice (lines {first} and {line_no}): every sample \
+                         must appear once (shards merged twice, or files concatenated?)"
+                    ),
+                ));
+            }
             let status = cols[2 + 2 * d].trim();
-            let c12 = cols[1 + 2 * d].trim().parse::<f64>().unwrap_or(f64::NAN);
-            if status != "ok" || !(c12.is_finite() && c12 > 0.0) {
+            if status != "ok" {
                 set.excluded += 1;
                 continue;
+            }
+            let c12_text = cols[1 + 2 * d].trim();
+            let c12 = c12_text.parse::<f64>().unwrap_or(f64::NAN);
+            if !(c12.is_finite() && c12 > 0.0) {
+                return Err(invalid(
+                    format!("line {line_no}, column `c12_pF`"),
+                    format!(
+                        "`{c12_text}` with status ok: a solved c12 must be a finite number of pF \
+                         above 0 (a corrupted row?)"
+                    ),
+                ));
             }
             let mapped = space.from_unit(&u);
             for j in 0..d {

@@ -82,10 +82,15 @@ impl Surrogate {
             message: e.to_string(),
         })?;
         let info = HashMap::from([(META_KEY.to_string(), meta)]);
-        safetensors::serialize_to_file(views, Some(info), path).map_err(|e| Error::Io {
+        let bytes = safetensors::serialize(views, Some(info)).map_err(|e| Error::Io {
             file: path.into(),
             action: "cannot write the model file",
             source: std::io::Error::other(e.to_string()),
+        })?;
+        write_replacing(path, &bytes).map_err(|e| Error::Io {
+            file: path.into(),
+            action: "cannot write the model file",
+            source: e,
         })
     }
 
@@ -230,4 +235,18 @@ impl Surrogate {
         };
         Surrogate::new(info, predictor)
     }
+}
+
+/// Writes `bytes` to `<path>.tmp` and renames it onto `path`: a reader never sees a half-written
+/// model, and the file gets the permissions of every other output (0666 less the umask, 0644
+/// usually; safetensors' own `serialize_to_file` goes through a temporary file created 0600).
+fn write_replacing(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    let mut name = path.as_os_str().to_os_string();
+    name.push(".tmp");
+    let tmp = std::path::PathBuf::from(name);
+    let written = std::fs::write(&tmp, bytes).and_then(|()| std::fs::rename(&tmp, path));
+    if written.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    written
 }

@@ -138,6 +138,16 @@ impl ParameterSpace {
                     format!("log-uniform needs lo > 0, got {lo}"),
                 ));
             }
+            if Target::parse(&d.target) == Some(Target::Bias) && lo <= 0.0 {
+                return Err(bad(
+                    k,
+                    "range",
+                    format!(
+                        "the bias U_B must be above 0 V (the reverse bias, positive by this \
+                         program's convention), got [{lo}, {hi}]"
+                    ),
+                ));
+            }
             if Target::parse(&d.target).is_none() {
                 return Err(bad(
                     k,

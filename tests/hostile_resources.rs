@@ -1,0 +1,448 @@
+//! Every bad input refused, every resource bounded (issue 24, groups 2, 3, 4, 6 and 7): a merge
+//! that would overwrite its own input, inputs that would exhaust the stack or the memory,
+//! non-positive biases, a training run's output checked up front and written like every other
+//! output, data sets with unusable or duplicated rows. Each case is exit code 2 with a message
+//! naming the file, flag or key; never a panic or an abort, and no partial output left behind.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use common::{bad, ok, run, temp};
+
+/// The analytic coax (a 10 mm slice: fast solves).
+const COAX: &str = "detectors/coax-analytic.toml";
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+/// `hpge-cv ARGS` in the repository root with its virtual memory limited to `kib` KiB
+/// (`ulimit -v`): an allocation beyond it fails, which Rust turns into an abort (exit 134).
+fn run_limited(kib: u64, args: &[&str]) -> Output {
+    Command::new("bash")
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .arg("-c")
+        .arg(format!("ulimit -v {kib} && exec \"$0\" \"$@\""))
+        .arg(env!("CARGO_BIN_EXE_hpge-cv"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+/// The coax detector file with each `(from, to)` replaced, written to `dir/name`.
+fn coax_with(dir: &Path, name: &str, edits: &[(&str, &str)]) -> PathBuf {
+    let mut text =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join(COAX)).unwrap();
+    for (from, to) in edits {
+        assert!(text.contains(from), "{from}");
+        text = text.replacen(from, to, 1);
+    }
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+/// A one-dimensional space (the bias only) over `range`.
+fn bias_space(dir: &Path, range: &str) -> PathBuf {
+    let path = dir.join("space.toml");
+    std::fs::write(
+        &path,
+        format!(
+            "name = \"bias-only\"\n[[dimensions]]\nname = \"U_B\"\nunit = \"V\"\nrange = {range}\ntarget = \"bias\"\n"
+        ),
+    )
+    .unwrap();
+    path
+}
+
+/// `generate` of `n` rows of `space` on the coax into `out` (fixed grid), extra arguments after.
+fn generate(space: &Path, n: &str, out: &Path, extra: &[&str]) -> Output {
+    let mut args = vec![
+        "generate",
+        "--space",
+        s(space),
+        "--detector",
+        COAX,
+        "--n",
+        n,
+        "--out",
+        s(out),
+        "--grid",
+        "adaptive=false",
+        "--threads",
+        "1",
+    ];
+    args.extend_from_slice(extra);
+    run(&args)
+}
+
+// ---------------------------------------------------------------------------------------------
+// Group 2: a merge never overwrites its own input.
+
+#[test]
+fn merge_refuses_an_out_inside_a_shard_folder() {
+    let d = temp("merge-into-shard");
+    let space = bias_space(&d, "[1000.0, 3000.0]");
+    let (s0, s1) = (d.join("s0"), d.join("s1"));
+    ok(&generate(&space, "2", &s0, &["--shard", "0/2"]));
+    ok(&generate(&space, "2", &s1, &["--shard", "1/2"]));
+    let rows = s1.join("rows.csv");
+    let (rows_before, info_before) = (
+        std::fs::read(&rows).unwrap(),
+        std::fs::read(s1.join("generate.json")).unwrap(),
+    );
+    // The shard's own rows, and a file of the same folder whose sidecar would be generate.json;
+    // also spelled through `..`.
+    let roundabout = d.join("s0").join("..").join("s1").join("merged.csv");
+    for out in [rows.clone(), s1.join("generate.csv"), roundabout] {
+        let o = run(&["merge", "--out", s(&out), s(&s0), s(&s1)]);
+        bad(&o, &["--out", "shard folder", s(&s1)]);
+        assert_eq!(std::fs::read(&rows).unwrap(), rows_before, "{out:?}");
+        assert_eq!(
+            std::fs::read(s1.join("generate.json")).unwrap(),
+            info_before,
+            "{out:?}"
+        );
+    }
+    assert!(!s1.join("merged.csv").exists());
+    // Outside the shard folders the merge works, and leaves no temporary file.
+    let merged = d.join("merged.csv");
+    ok(&run(&["merge", "--out", s(&merged), s(&s0), s(&s1)]));
+    assert_eq!(std::fs::read_to_string(&merged).unwrap().lines().count(), 3);
+    assert!(!d.join("merged.csv.tmp").exists());
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Group 3: no stack overflow, no allocation beyond the inputs' documented bounds.
+
+#[test]
+fn a_detector_expression_nested_200000_deep_is_refused() {
+    let d = temp("deep-expression");
+    let cases = [
+        (
+            "parentheses.toml",
+            format!("\"{}40.0{}\"", "(".repeat(200_000), ")".repeat(200_000)),
+        ),
+        (
+            "signs.toml",
+            format!("\"40.0 {}0.0\"", "+ -".repeat(200_000)),
+        ),
+    ];
+    for (name, value) in cases {
+        let det = coax_with(
+            &d,
+            name,
+            &[("r_max_mm = 40.0", &format!("r_max_mm = {value}"))],
+        );
+        let o = run(&["detector", "--detector", s(&det)]);
+        bad(&o, &[name, "world.r_max_mm", "nested deeper than 256"]);
+        assert!(
+            o.stderr.len() < 2000,
+            "the message must not quote the expression"
+        );
+    }
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn a_world_too_large_for_memory_is_refused_before_allocating() {
+    let d = temp("huge-world");
+    // At the default spacings: 1e6 mm by 100 mm is over 8 million nodes (the limit is 5 million),
+    // 1e308 mm overflows every count.
+    for (name, r_max) in [("wide.toml", "1e6"), ("vast.toml", "1e308")] {
+        let det = coax_with(
+            &d,
+            name,
+            &[
+                ("r_max_mm = 40.0", &format!("r_max_mm = {r_max}")),
+                ("z_max_mm = 10.0\nmedium", "z_max_mm = 100.0\nmedium"),
+            ],
+        );
+        let out = d.join(format!("{name}.csv"));
+        let o = run_limited(
+            2_000_000,
+            &[
+                "simulate",
+                "--detector",
+                s(&det),
+                "--voltages",
+                "1000",
+                "--out",
+                s(&out),
+            ],
+        );
+        bad(&o, &[name, "world.r_max_mm", "5000000"]);
+        assert!(!out.exists(), "{name}: no output file");
+        // `detector`, which checks a description, says so too.
+        let o = run(&["detector", "--detector", s(&det)]);
+        bad(&o, &[name, "world.r_max_mm", "5000000"]);
+    }
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// A two-point truth curve for `synthesize`.
+fn truth_curve(dir: &Path, rows: &str) -> PathBuf {
+    let path = dir.join("truth.csv");
+    std::fs::write(&path, format!("voltage_V,c12_pF\n{rows}")).unwrap();
+    path
+}
+
+#[test]
+fn synthesize_refuses_a_million_pulses_before_allocating() {
+    let d = temp("million-pulses");
+    let curve = truth_curve(&d, "100,40\n200,35\n");
+    let out = d.join("raw");
+    let o = run_limited(
+        4_000_000,
+        &[
+            "synthesize",
+            "--curve",
+            s(&curve),
+            "--depletion-voltage",
+            "3000",
+            "--pulses",
+            "1000000",
+            "--out",
+            s(&out),
+        ],
+    );
+    // 5000 samples of 8 bytes, 1.5 events per pulser pulse: 17 895 pulses fit in 1 GiB.
+    bad(&o, &["--pulses 1000000", "at most 17895", "1 GiB"]);
+    assert!(!out.exists(), "no empty output folder");
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Group 4: a bias is above 0 V wherever it enters.
+
+/// A raw-data folder of three shipped pulse files, the middle one's sidecar declaring `bias`.
+fn raw_with_bias(tag: &str, bias: &str) -> (PathBuf, PathBuf) {
+    let d = temp(tag);
+    let raw = d.join("raw");
+    std::fs::create_dir_all(&raw).unwrap();
+    let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/super-siegfried-k1/raw");
+    for stem in ["U0025V", "U0075V", "U0125V"] {
+        for ext in ["npy", "toml"] {
+            let name = format!("{stem}.{ext}");
+            std::fs::copy(shipped.join(&name), raw.join(&name)).unwrap();
+        }
+    }
+    let sidecar = raw.join("U0075V.toml");
+    let text = std::fs::read_to_string(&sidecar).unwrap();
+    std::fs::write(
+        &sidecar,
+        text.replace("bias_V = 75.0", &format!("bias_V = {bias}")),
+    )
+    .unwrap();
+    (d, sidecar)
+}
+
+fn measure_refuses_sidecar_bias(tag: &str, bias: &str) {
+    let (d, sidecar) = raw_with_bias(tag, bias);
+    let out = d.join("cv.csv");
+    let o = run(&["measure", "--raw", s(&d.join("raw")), "--out", s(&out)]);
+    bad(
+        &o,
+        &[s(&sidecar), "`bias_V`", "above 0", &format!("got {bias}")],
+    );
+    assert!(!out.exists(), "no curve written");
+    assert!(!d.join("cv.measure.json").exists(), "no report written");
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn measure_refuses_a_sidecar_bias_of_minus_5() {
+    measure_refuses_sidecar_bias("sidecar-minus-5", "-5");
+}
+
+#[test]
+fn measure_refuses_a_sidecar_bias_of_0() {
+    measure_refuses_sidecar_bias("sidecar-zero", "0");
+}
+
+#[test]
+fn synthesize_refuses_a_negative_bias() {
+    let d = temp("synth-negative");
+    let curve = truth_curve(&d, "-25,40\n100,35\n");
+    let out = d.join("raw");
+    let o = run(&[
+        "synthesize",
+        "--curve",
+        s(&curve),
+        "--depletion-voltage",
+        "3000",
+        "--out",
+        s(&out),
+    ]);
+    bad(&o, &["--curve", "line 2", "voltage_V", "-25", "above 0"]);
+    assert!(!out.exists(), "no output folder");
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn generate_refuses_a_space_with_negative_biases() {
+    let d = temp("space-negative-bias");
+    let space = bias_space(&d, "[-100.0, 3000.0]");
+    let out = d.join("rows");
+    let o = generate(&space, "3", &out, &[]);
+    bad(
+        &o,
+        &["space.toml", "dimensions[0].range", "above 0", "-100"],
+    );
+    assert!(!out.join("rows.csv").exists(), "no rows written");
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Group 6: train checks --out before training and writes its model like every other output.
+
+#[test]
+fn train_checks_its_out_before_training() {
+    let d = temp("train-out");
+    // A folder where the model file should go. The training data do not exist: a run that read
+    // them before checking --out would complain about them instead.
+    let out = d.join("model.safetensors");
+    std::fs::create_dir_all(&out).unwrap();
+    let missing = d.join("missing.csv");
+    let o = run(&[
+        "train",
+        "--data",
+        s(&missing),
+        "--test",
+        s(&missing),
+        "--recipe",
+        "poly3",
+        "--out",
+        s(&out),
+    ]);
+    bad(&o, &["--out", s(&out), "is a folder"]);
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn model_files_are_written_like_every_other_output() {
+    use std::os::unix::fs::PermissionsExt;
+    let d = temp("model-mode");
+    let out = d.join("poly.safetensors");
+    let data = "data/training/heldout.csv";
+    ok(&run(&[
+        "train",
+        "--data",
+        data,
+        "--test",
+        data,
+        "--recipe",
+        "poly3",
+        "--out",
+        s(&out),
+    ]));
+    // Any file created here gets 0666 less the umask (0644 usually); so must the model.
+    let other = d.join("other.txt");
+    std::fs::write(&other, "x").unwrap();
+    let mode = |p: &Path| std::fs::metadata(p).unwrap().permissions().mode() & 0o777;
+    assert_eq!(
+        format!("{:o}", mode(&out)),
+        format!("{:o}", mode(&other)),
+        "model file mode"
+    );
+    assert!(!d.join("poly.safetensors.tmp").exists());
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Group 7: rows with status ok but no usable c12, and duplicated indices, are refused.
+
+/// The header and the first `n` rows of the shipped held-out set, `edit` applied to the rows.
+fn heldout_rows(n: usize, edit: impl Fn(&mut Vec<String>)) -> String {
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("data/training/heldout.csv"),
+    )
+    .unwrap();
+    let mut lines: Vec<String> = text.lines().take(n + 1).map(str::to_string).collect();
+    edit(&mut lines);
+    lines.join("\n") + "\n"
+}
+
+/// `evaluate` with the shipped model and `train` (poly3) on `file` both fail naming `needles`.
+fn evaluate_and_train_refuse(d: &Path, file: &Path, needles: &[&str]) {
+    let o = run(&[
+        "evaluate",
+        "--model",
+        "models/super-siegfried-rz-paper.safetensors",
+        "--data",
+        s(file),
+    ]);
+    bad(&o, needles);
+    let (model, plots) = (d.join("m.safetensors"), d.join("plots"));
+    let o = run(&[
+        "train",
+        "--data",
+        s(file),
+        "--test",
+        s(file),
+        "--recipe",
+        "poly3",
+        "--out",
+        s(&model),
+        "--plot",
+        s(&plots),
+    ]);
+    bad(&o, needles);
+    assert!(!model.exists());
+    assert!(!plots.exists(), "no empty --plot folder");
+}
+
+#[test]
+fn evaluate_and_train_refuse_ok_rows_without_a_positive_c12() {
+    let d = temp("ok-without-c12");
+    for (tag, c12) in [("nan", "NaN"), ("negative", "-3.5"), ("zero", "0")] {
+        let file = d.join(format!("{tag}.csv"));
+        let text = heldout_rows(400, |lines| {
+            // Line 4 of the file: its c12 column (third from the end).
+            let mut cols: Vec<&str> = lines[3].split(',').collect();
+            let n = cols.len();
+            assert_eq!(cols[n - 2], "ok");
+            cols[n - 3] = c12;
+            lines[3] = cols.join(",");
+        });
+        std::fs::write(&file, text).unwrap();
+        evaluate_and_train_refuse(
+            &d,
+            &file,
+            &[s(&file), "line 4", "`c12_pF`", c12, "status ok"],
+        );
+    }
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn evaluate_and_train_refuse_duplicated_indices() {
+    let d = temp("duplicated-index");
+    let file = d.join("dup.csv");
+    let text = heldout_rows(400, |lines| {
+        let again = lines[2].clone();
+        lines.insert(6, again);
+    });
+    std::fs::write(&file, text).unwrap();
+    let index = heldout_rows(2, |_| {})
+        .lines()
+        .nth(2)
+        .unwrap()
+        .split(',')
+        .next()
+        .unwrap()
+        .to_string();
+    evaluate_and_train_refuse(
+        &d,
+        &file,
+        &[
+            s(&file),
+            &format!("index {index} appears twice"),
+            "lines 3 and 7",
+        ],
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}
