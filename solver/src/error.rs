@@ -37,17 +37,22 @@ pub enum Error {
         /// What is wrong with it.
         message: String,
     },
-    /// Two contacts share space (or touch) in the r-z plane.
+    /// Two parts of a detector (contacts, passives, the crystal) share space (or touch, where
+    /// that is not allowed) in the r-z plane.
     #[error(
-        "{}: contacts `{first}` and `{second}` overlap or touch near (r, z) = ({r_mm:.4}, {z_mm:.4}) mm",
+        "{}: `{first_key}` ({first}) and `{second_key}` ({second}) overlap or touch near (r, z) = ({r_mm:.4}, {z_mm:.4}) mm",
         file.display()
     )]
     Overlap {
         /// The detector file.
         file: PathBuf,
-        /// The first contact, as `id (name)`.
+        /// The key path of the first part's geometry, e.g. `contacts[0].geometry`.
+        first_key: String,
+        /// The first part in words, e.g. `contact 1 (n+)` or `passive can`.
         first: String,
-        /// The second contact, as `id (name)`.
+        /// The key path of the second part's geometry, e.g. `semiconductor.geometry`.
+        second_key: String,
+        /// The second part in words.
         second: String,
         /// A point inside both, in mm.
         r_mm: f64,

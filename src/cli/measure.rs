@@ -208,6 +208,7 @@ fn read_truth(path: &Path) -> Result<(Vec<f64>, Vec<f64>)> {
 /// Writes one pulse file per bias (`U<bias>V.npy` + sidecar), `measurement.toml` listing the
 /// biases, and `truth.json` with the curve, seed and settings.
 pub fn synthesize(o: &SynthOptions) -> Result<()> {
+    o.validate()?;
     let settings = o.settings();
     settings
         .validate()
