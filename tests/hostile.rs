@@ -47,6 +47,13 @@ struct Case {
     absent: Vec<String>,
     #[serde(default)]
     memory_kib: Option<u64>,
+    /// Environment variables removed for the run.
+    #[serde(default)]
+    unset: Vec<String>,
+    /// The case needs the wgpu backend: skipped where no adapter is found (unless
+    /// `HPGE_REQUIRE_GPU=1`, as in CI, where Mesa's software Vulkan provides one).
+    #[serde(default)]
+    needs_gpu: bool,
     #[serde(default)]
     #[allow(dead_code)]
     why: String,
@@ -151,19 +158,33 @@ fn run_case(c: &Case) -> Vec<String> {
         args.join(" ")
     );
     let start = std::time::Instant::now();
-    let out = Command::new("bash")
-        .arg("-c")
+    let mut cmd = Command::new("bash");
+    cmd.arg("-c")
         .arg(&script)
         .current_dir(root())
-        .env("RUST_BACKTRACE", "0")
-        .output()
-        .unwrap();
+        .env("RUST_BACKTRACE", "0");
+    for k in &c.unset {
+        cmd.env_remove(k);
+    }
+    let out = cmd.output().unwrap();
     let seconds = start.elapsed().as_secs_f64();
     let err = String::from_utf8_lossy(&out.stderr).into_owned();
     let mut fails = Vec::new();
     let code = out.status.code();
+    if c.needs_gpu
+        && code == Some(2)
+        && err.contains("no GPU adapter for the wgpu backend")
+        && !std::env::var("HPGE_REQUIRE_GPU").is_ok_and(|v| v == "1")
+    {
+        eprintln!("{}: skipped, no wgpu adapter here", c.name);
+        let _ = std::fs::remove_dir_all(&tmp);
+        return fails;
+    }
     if code != Some(c.exit) {
-        fails.push(format!("exit {:?} (signal or code), expected {}", out.status, c.exit));
+        fails.push(format!(
+            "exit {:?} (signal or code), expected {}",
+            out.status, c.exit
+        ));
     }
     if matches!(code, Some(134 | 139)) || code.is_none() {
         fails.push("aborted or killed by a signal".into());
@@ -245,6 +266,7 @@ const NAMED: &[&str] = &[
     "g10_synthesize_names_flags",
     "g10_os_error_once",
     "g10_detector_plot_to_a_folder",
+    "g10_wgpu_run_prints_no_xdg_error",
     "g11_fit_one_row_leaves_nothing",
     "g11_discover_one_row_leaves_nothing_and_names_the_file",
 ];
@@ -283,6 +305,7 @@ case!(
     g10_synthesize_names_flags,
     g10_os_error_once,
     g10_detector_plot_to_a_folder,
+    g10_wgpu_run_prints_no_xdg_error,
     g11_fit_one_row_leaves_nothing,
     g11_discover_one_row_leaves_nothing_and_names_the_file,
 );
@@ -315,10 +338,11 @@ fn the_rest_of_the_table() {
                     };
                     let fails = run_case(c);
                     if !fails.is_empty() {
-                        failures
-                            .lock()
-                            .unwrap()
-                            .push(format!("{}:\n  {}", c.name, fails.join("\n  ")));
+                        failures.lock().unwrap().push(format!(
+                            "{}:\n  {}",
+                            c.name,
+                            fails.join("\n  ")
+                        ));
                     }
                 }
             });

@@ -4,8 +4,8 @@
 use std::path::{Path, PathBuf};
 
 use crate::measure::MeasureSettings;
-use crate::{Error, Result};
 use crate::synth::{DEFAULT_DECIMATE, DEFAULT_PULSER_PULSES, SynthSettings};
+use crate::{Error, Result};
 
 /// The fewest samples a synthesized (decimated) trace keeps: the baseline before the pulser edge
 /// and the flat top after it must each span many samples for the amplitude fit.
@@ -108,7 +108,12 @@ impl SynthOptions {
     /// # Errors
     /// [`Error::Argument`] naming the flag and its value.
     pub fn validate(&self) -> Result<()> {
-        let bad = |flag: String, message: String| Err(Error::Argument { name: flag, message });
+        let bad = |flag: String, message: String| {
+            Err(Error::Argument {
+                name: flag,
+                message,
+            })
+        };
         if self.pulses < 10 {
             return bad(
                 format!("--pulses {}", self.pulses),

@@ -4,9 +4,9 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use hpge_reports::plot;
+use hpge_solver::Detector;
 use hpge_solver::detector::WorldSide;
 use hpge_solver::detector::legend::{self, LegendOptions};
-use hpge_solver::Detector;
 use serde_json::json;
 
 use super::DetectorInput;

@@ -172,6 +172,12 @@ impl FitOptions {
     pub fn validate(&self) -> Result<()> {
         self.sampler_kind()?;
         self.noise()?;
+        if self.chains < 2 {
+            return Err(Error::BadOption {
+                option: format!("--chains {}", self.chains),
+                message: "R-hat needs at least 2 chains".into(),
+            });
+        }
         check_positive("--max-seconds", self.max_seconds, "seconds")?;
         check_positive("--ess", self.ess, "effective draws")?;
         if !(self.rhat.is_finite() && self.rhat > 1.0) {
@@ -183,7 +189,9 @@ impl FitOptions {
         if self.exact_draws == 0 && !self.no_exact_check {
             return Err(Error::BadOption {
                 option: "--exact-draws 0".into(),
-                message: "the exact-solver check needs at least 1 draw; pass --no-exact-check to skip it".into(),
+                message:
+                    "the exact-solver check needs at least 1 draw; pass --no-exact-check to skip it"
+                        .into(),
             });
         }
         Ok(())

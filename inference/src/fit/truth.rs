@@ -52,10 +52,7 @@ pub fn read_truth(path: &Path, prior: &Prior) -> Result<Vec<Option<f64>>> {
             ),
         });
     }
-    Ok(names
-        .iter()
-        .map(|n| table.get(n).copied())
-        .collect())
+    Ok(names.iter().map(|n| table.get(n).copied()).collect())
 }
 
 /// One record per parameter with a known truth.

@@ -134,12 +134,7 @@ pub(crate) fn build(spec: &DetectorSpec, file: &Path, overrides: &Parameters) ->
         check_knots_in_crystal(knots, sb.r_max_mm, file, "semiconductor.rz_knots_mm")?;
     }
     if let Some(knots) = &s.impurity.knots_mm {
-        check_knots_in_crystal(
-            knots,
-            sb.r_max_mm,
-            file,
-            "semiconductor.impurity.knots_mm",
-        )?;
+        check_knots_in_crystal(knots, sb.r_max_mm, file, "semiconductor.impurity.knots_mm")?;
     }
     let impurity_context = ImpurityContext {
         z_bottom_mm: z_bottom,

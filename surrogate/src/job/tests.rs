@@ -422,7 +422,10 @@ fn the_test_set_must_not_be_the_training_set() {
     let mut job = job(&d, POLYNOMIAL_RECIPE, 0);
     job.test = job.data.clone();
     let e = job.run(&mut |_| {}).unwrap_err().to_string();
-    assert!(e.contains("--test") && e.contains("training set itself"), "{e}");
+    assert!(
+        e.contains("--test") && e.contains("training set itself"),
+        "{e}"
+    );
     assert!(!job.out.exists());
     let _ = std::fs::remove_dir_all(&d);
 }
@@ -444,7 +447,10 @@ fn the_polynomial_needs_as_many_rows_as_coefficients() {
         out: d.join("poly3.safetensors"),
     };
     let e = job.run(&mut |_| {}).unwrap_err().to_string();
-    assert!(e.contains("one.csv") && e.contains("1 rows") && e.contains("35"), "{e}");
+    assert!(
+        e.contains("one.csv") && e.contains("1 rows") && e.contains("35"),
+        "{e}"
+    );
     assert!(!job.out.exists());
     let _ = std::fs::remove_dir_all(&d);
 }
