@@ -40,20 +40,18 @@ pub enum Error {
     /// Two parts of a detector (contacts, passives, the crystal) share space (or touch, where
     /// that is not allowed) in the r-z plane.
     #[error(
-        "{}: `{first_key}` ({first}) and `{second_key}` ({second}) overlap or touch near (r, z) = ({r_mm:.4}, {z_mm:.4}) mm",
-        file.display()
+        "{}: `{}` ({}) and `{}` ({}) overlap or touch near (r, z) = ({r_mm:.4}, {z_mm:.4}) mm",
+        file.display(),
+        parts[0].key,
+        parts[0].what,
+        parts[1].key,
+        parts[1].what
     )]
     Overlap {
         /// The detector file.
         file: PathBuf,
-        /// The key path of the first part's geometry, e.g. `contacts[0].geometry`.
-        first_key: String,
-        /// The first part in words, e.g. `contact 1 (n+)` or `passive can`.
-        first: String,
-        /// The key path of the second part's geometry, e.g. `semiconductor.geometry`.
-        second_key: String,
-        /// The second part in words.
-        second: String,
+        /// The two parts (boxed: keeps the error small).
+        parts: Box<[DetectorPart; 2]>,
         /// A point inside both, in mm.
         r_mm: f64,
         /// A point inside both, in mm.
@@ -228,6 +226,25 @@ pub enum Error {
         /// What is wrong, naming the field.
         message: String,
     },
+}
+
+/// One part of a detector named in an [`Error::Overlap`].
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct DetectorPart {
+    /// The key path of its geometry, e.g. `contacts[0].geometry` or `semiconductor.geometry`.
+    pub key: String,
+    /// What it is, in words, e.g. `contact 1 (n+)`, `passive can`, `the semiconductor`.
+    pub what: String,
+}
+
+impl DetectorPart {
+    /// A part from its key path and description.
+    pub fn new(key: impl Into<String>, what: impl Into<String>) -> Self {
+        Self {
+            key: key.into(),
+            what: what.into(),
+        }
+    }
 }
 
 /// Result alias of the solver crate.

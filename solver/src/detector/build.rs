@@ -7,7 +7,7 @@ use std::sync::Arc;
 
 use super::spec::{DetectorSpec, MaterialSpec, PotentialSpec};
 use super::{Contact, ContactPotential, Detector, Passive, PassiveKind, Semiconductor, World};
-use crate::error::{Error, Result};
+use crate::error::{DetectorPart, Error, Result};
 use crate::expr::Parameters;
 use crate::geometry::{BOUNDARY_TOL_MM, Solid, common_point};
 use crate::impurity::{ImpurityContext, ImpurityModel, ImpuritySpec};
@@ -225,10 +225,16 @@ pub(crate) fn build(spec: &DetectorSpec, file: &Path, overrides: &Parameters) ->
             ) {
                 return Err(Error::Overlap {
                     file: file.to_path_buf(),
-                    first_key: format!("contacts[{i}].geometry"),
-                    first: format!("contact {}", contacts[i].label()),
-                    second_key: format!("contacts[{j}].geometry"),
-                    second: format!("contact {}", contacts[j].label()),
+                    parts: Box::new([
+                        DetectorPart::new(
+                            format!("contacts[{i}].geometry"),
+                            format!("contact {}", contacts[i].label()),
+                        ),
+                        DetectorPart::new(
+                            format!("contacts[{j}].geometry"),
+                            format!("contact {}", contacts[j].label()),
+                        ),
+                    ]),
                     r_mm: r,
                     z_mm: z,
                 });
@@ -297,10 +303,10 @@ pub(crate) fn build(spec: &DetectorSpec, file: &Path, overrides: &Parameters) ->
         ) {
             return Err(Error::Overlap {
                 file: file.to_path_buf(),
-                first_key: format!("{key}.geometry"),
-                first: format!("passive {}", p.name),
-                second_key: "semiconductor.geometry".to_string(),
-                second: "the semiconductor".to_string(),
+                parts: Box::new([
+                    DetectorPart::new(format!("{key}.geometry"), format!("passive {}", p.name)),
+                    DetectorPart::new("semiconductor.geometry", "the semiconductor"),
+                ]),
                 r_mm: r,
                 z_mm: z,
             });
@@ -312,10 +318,16 @@ pub(crate) fn build(spec: &DetectorSpec, file: &Path, overrides: &Parameters) ->
                 {
                     return Err(Error::Overlap {
                         file: file.to_path_buf(),
-                        first_key: format!("{key}.geometry"),
-                        first: format!("passive {}", p.name),
-                        second_key: format!("contacts[{ci}].geometry"),
-                        second: format!("contact {}", c.label()),
+                        parts: Box::new([
+                            DetectorPart::new(
+                                format!("{key}.geometry"),
+                                format!("passive {}", p.name),
+                            ),
+                            DetectorPart::new(
+                                format!("contacts[{ci}].geometry"),
+                                format!("contact {}", c.label()),
+                            ),
+                        ]),
                         r_mm: r,
                         z_mm: z,
                     });
@@ -339,10 +351,16 @@ pub(crate) fn build(spec: &DetectorSpec, file: &Path, overrides: &Parameters) ->
             ) {
                 return Err(Error::Overlap {
                     file: file.to_path_buf(),
-                    first_key: format!("passives[{i}].geometry"),
-                    first: format!("passive {}", passives[i].name),
-                    second_key: format!("passives[{j}].geometry"),
-                    second: format!("passive {}", passives[j].name),
+                    parts: Box::new([
+                        DetectorPart::new(
+                            format!("passives[{i}].geometry"),
+                            format!("passive {}", passives[i].name),
+                        ),
+                        DetectorPart::new(
+                            format!("passives[{j}].geometry"),
+                            format!("passive {}", passives[j].name),
+                        ),
+                    ]),
                     r_mm: r,
                     z_mm: z,
                 });
