@@ -114,12 +114,16 @@ fn truth_files_map_to_the_prior_order() {
     let job = FitJob::from_files(&o.files(), o.noise().unwrap(), &o.grid).unwrap();
     let d = temp("truth");
     let t = d.join("truth.toml");
-    std::fs::write(&t, "y_top = 0.5\nunknown = 3\n").unwrap();
+    std::fs::write(&t, "y_top = 0.5\n").unwrap();
     let v = read_truth(&t, &job.prior).unwrap();
     let names = job.prior.names();
     for (n, x) in names.iter().zip(&v) {
         assert_eq!(x.is_some(), n == "y_top", "{n}");
     }
+    // A name the prior does not have is refused, naming it (not silently left out).
+    std::fs::write(&t, "y_top = 0.5\nunknown = 3\n").unwrap();
+    let e = read_truth(&t, &job.prior).unwrap_err().to_string();
+    assert!(e.contains("unknown") && e.contains("y_top"), "{e}");
     std::fs::write(&t, "y_top = \"high\"\n").unwrap();
     assert!(read_truth(&t, &job.prior).is_err());
 }

@@ -87,7 +87,7 @@ pub use formats::{
     read_pulses, read_raw_dir, write_curve, write_curve_with_comments, write_pulses,
 };
 pub use measure::{MeasureSettings, Measurement, Problem, VoltagePoint, measure};
-pub use options::{MeasureOptions, SynthOptions};
+pub use options::{MIN_DECIMATED_SAMPLES, MeasureOptions, SynthOptions};
 pub use slope::depletion_voltage;
 pub use synth::{SynthSettings, synthesize_voltage};
 pub use types::{CvData, PulseSet, Sidecar};

@@ -3,9 +3,13 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::Result;
 use crate::measure::MeasureSettings;
 use crate::synth::{DEFAULT_DECIMATE, DEFAULT_PULSER_PULSES, SynthSettings};
+use crate::{Error, Result};
+
+/// The fewest samples a synthesized (decimated) trace keeps: the baseline before the pulser edge
+/// and the flat top after it must each span many samples for the amplitude fit.
+pub const MIN_DECIMATED_SAMPLES: usize = 100;
 
 /// Everything a user chooses about a measurement (the pipeline's settings are a TOML file).
 #[derive(Debug, Clone, PartialEq)]
@@ -95,6 +99,47 @@ impl SynthOptions {
             pulses: DEFAULT_PULSER_PULSES,
             decimate: DEFAULT_DECIMATE,
         }
+    }
+
+    /// Checks the numbers a user gives, naming the flag (not the settings' internal keys):
+    /// `--pulses` at least 10, `--decimate` at least 1 and small enough to leave
+    /// [`MIN_DECIMATED_SAMPLES`] samples per trace, `--depletion-voltage` positive.
+    ///
+    /// # Errors
+    /// [`Error::Argument`] naming the flag and its value.
+    pub fn validate(&self) -> Result<()> {
+        let bad = |flag: String, message: String| {
+            Err(Error::Argument {
+                name: flag,
+                message,
+            })
+        };
+        if self.pulses < 10 {
+            return bad(
+                format!("--pulses {}", self.pulses),
+                "at least 10 pulser pulses per bias are needed for a peak".into(),
+            );
+        }
+        let defaults = SynthSettings::default();
+        let native = (defaults.trace_ns / defaults.sampling_period_ns).round() as usize;
+        let most = native / MIN_DECIMATED_SAMPLES;
+        if self.decimate == 0 || self.decimate > most {
+            return bad(
+                format!("--decimate {}", self.decimate),
+                format!(
+                    "must lie in 1..={most}: a trace has {native} samples and must keep at least {MIN_DECIMATED_SAMPLES}"
+                ),
+            );
+        }
+        if let Some(v) = self.depletion_voltage
+            && !(v.is_finite() && v > 0.0)
+        {
+            return bad(
+                format!("--depletion-voltage {v}"),
+                "must be a positive number of volts".into(),
+            );
+        }
+        Ok(())
     }
 
     /// The synthesis settings: the defaults with these pulses and decimation.

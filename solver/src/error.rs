@@ -37,18 +37,21 @@ pub enum Error {
         /// What is wrong with it.
         message: String,
     },
-    /// Two contacts share space (or touch) in the r-z plane.
+    /// Two parts of a detector (contacts, passives, the crystal) share space (or touch, where
+    /// that is not allowed) in the r-z plane.
     #[error(
-        "{}: contacts `{first}` and `{second}` overlap or touch near (r, z) = ({r_mm:.4}, {z_mm:.4}) mm",
-        file.display()
+        "{}: `{}` ({}) and `{}` ({}) overlap or touch near (r, z) = ({r_mm:.4}, {z_mm:.4}) mm",
+        file.display(),
+        parts[0].key,
+        parts[0].what,
+        parts[1].key,
+        parts[1].what
     )]
     Overlap {
         /// The detector file.
         file: PathBuf,
-        /// The first contact, as `id (name)`.
-        first: String,
-        /// The second contact, as `id (name)`.
-        second: String,
+        /// The two parts (boxed: keeps the error small).
+        parts: Box<[DetectorPart; 2]>,
         /// A point inside both, in mm.
         r_mm: f64,
         /// A point inside both, in mm.
@@ -223,6 +226,25 @@ pub enum Error {
         /// What is wrong, naming the field.
         message: String,
     },
+}
+
+/// One part of a detector named in an [`Error::Overlap`].
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct DetectorPart {
+    /// The key path of its geometry, e.g. `contacts[0].geometry` or `semiconductor.geometry`.
+    pub key: String,
+    /// What it is, in words, e.g. `contact 1 (n+)`, `passive can`, `the semiconductor`.
+    pub what: String,
+}
+
+impl DetectorPart {
+    /// A part from its key path and description.
+    pub fn new(key: impl Into<String>, what: impl Into<String>) -> Self {
+        Self {
+            key: key.into(),
+            what: what.into(),
+        }
+    }
 }
 
 /// Result alias of the solver crate.

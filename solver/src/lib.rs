@@ -65,7 +65,7 @@ pub mod scan;
 
 pub use detector::Detector;
 pub use drift::{Pulse, pulse};
-pub use error::{Error, Result};
+pub use error::{DetectorPart, Error, Result};
 pub use expr::{MAX_EXPRESSION_DEPTH, Parameters};
 pub use field::{
     Backend, CvCurve, CvPoint, FieldSettings, Method, PointResult, WeightingMode, cv_curve,

@@ -271,6 +271,60 @@ fn no_bias_contact() {
     );
 }
 
+/// Issue 24: every contact at the bias is refused before a solve (it was reported as an
+/// undepleted region, "the impurity density is too high").
+#[test]
+fn every_contact_at_the_bias() {
+    let all = DETECTOR.replace("potential = 0.0", "potential = \"bias\"");
+    let path = write("detector-all-bias.toml", &all);
+    let det = Detector::from_file(&path, &Parameters::new()).unwrap();
+    let msg = det.check_bias_contact().unwrap_err().to_string();
+    assert!(
+        msg.contains("detector-all-bias.toml")
+            && msg.contains("contacts[1].potential")
+            && msg.contains("every contact"),
+        "{msg}"
+    );
+}
+
+/// Issue 24: rz knots beyond the crystal (r <= 37.5 mm here), in the detector's default knots or
+/// in an impurity file, are refused with their key.
+#[test]
+fn rz_knots_beyond_the_crystal() {
+    bad_detector(
+        "knots-beyond.toml",
+        &DETECTOR.replace(
+            "rz_knots_mm = [6.0, 16.0, 27.0, 37.5]",
+            "rz_knots_mm = [6.0, 16.0, 27.0, 45.0]",
+        ),
+        &["semiconductor.rz_knots_mm[3]", "beyond the crystal"],
+    );
+    bad_impurity(
+        "rz-knots-beyond.toml",
+        &RZ.replace("[20.0, 28.0, 33.0, 37.5]", "[20.0, 28.0, 33.0, 39.0]"),
+        &["knots_mm[3]", "beyond the crystal"],
+    );
+}
+
+/// Issue 24: a passive overlapping the crystal names both key paths (it was reported as two
+/// *contacts* overlapping).
+#[test]
+fn passive_overlapping_the_crystal() {
+    let text = format!(
+        "{DETECTOR}\n[[passives]]\nname = \"ring\"\nkind = \"grounded\"\nmaterial = \"copper\"\n\
+         geometry = {{ tube = {{ r_mm = [30.0, 39.0], z_mm = [2.0, 4.0] }} }}\n"
+    );
+    bad_detector(
+        "passive-overlap.toml",
+        &text,
+        &[
+            "`passives[0].geometry` (passive ring)",
+            "`semiconductor.geometry` (the semiconductor)",
+            "overlap",
+        ],
+    );
+}
+
 /// Issue 18: an unknown key or a bad value in a detector's `[grid]` table names the key.
 #[test]
 fn bad_grid_table() {

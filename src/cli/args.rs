@@ -99,12 +99,22 @@ pub use hpge_solver::options::{VoltageList, parse_voltages};
 /// Grid and accuracy options: declared once, in the solver library.
 pub use hpge_solver::GridOverrides as GridArgs;
 
-/// Loads the detector, applies parameter overrides and the impurity file.
-pub fn load_detector(input: &DetectorInput) -> Result<Detector> {
+/// The `--param NAME=VALUE` overrides as parameters; a name given twice is refused (the last
+/// would otherwise silently win).
+pub fn param_overrides(params: &[(String, f64)]) -> Result<Parameters> {
     let mut overrides = Parameters::new();
-    for (k, v) in &input.params {
+    for (k, v) in params {
+        if overrides.get(k).is_some() {
+            anyhow::bail!("--param {k}: given twice; give each parameter once");
+        }
         overrides.set(k.clone(), *v);
     }
+    Ok(overrides)
+}
+
+/// Loads the detector, applies parameter overrides and the impurity file.
+pub fn load_detector(input: &DetectorInput) -> Result<Detector> {
+    let overrides = param_overrides(&input.params)?;
     let mut det = Detector::from_file(&input.detector, &overrides)?;
     if let Some(path) = &input.impurity {
         det.set_impurity_file(path)

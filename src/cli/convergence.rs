@@ -47,6 +47,7 @@ pub fn run(a: &ConvergenceArgs) -> Result<()> {
         plot::check_output(p, "--plot")?;
     }
     let det = load_detector(&a.input)?;
+    det.check_bias_contact()?;
     let settings = a.solver.grid.apply(
         &a.solver
             .field_settings(WeightingOptions::default().weighting),

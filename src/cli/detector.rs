@@ -4,9 +4,9 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use hpge_reports::plot;
+use hpge_solver::Detector;
 use hpge_solver::detector::WorldSide;
 use hpge_solver::detector::legend::{self, LegendOptions};
-use hpge_solver::{Detector, Parameters};
 use serde_json::json;
 
 use super::DetectorInput;
@@ -36,6 +36,7 @@ pub fn from_legend(
     for p in plots {
         plot::check_output(p, "--plot")?;
     }
+    let overrides = super::args::param_overrides(params)?;
     let diode = legend::read_file(record, options)?;
     let text = legend::to_toml(&diode, record, options);
     let file = match out {
@@ -56,10 +57,6 @@ pub fn from_legend(
     match diode.depletion_voltage_v {
         Some(u) => eprintln!("the record's characterization: depletion voltage {u} V"),
         None => eprintln!("the record's characterization gives no depletion voltage"),
-    }
-    let mut overrides = Parameters::new();
-    for (k, v) in params {
-        overrides.set(k.clone(), *v);
     }
     let mut det = Detector::from_toml_str(&text, &file, &overrides)
         .with_context(|| format!("the description converted from {}", record.display()))?;

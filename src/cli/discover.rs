@@ -68,15 +68,17 @@ pub fn run(a: &DiscoverArgs) -> Result<()> {
     }
     let o = &a.options;
     let w = &o.workflow;
+    // Every check before the output folder is made: a refused run leaves nothing behind.
     w.check_only()?;
-    let prior_file = o.start_prior()?;
     let noise = noise_settings(NoiseKind::Paper.as_str())?;
+    let settings = o.settings(noise)?;
+    let prior_file = o.start_prior()?;
     let s = setup(&w.data, &w.model, &prior_file, &w.detector, noise, &w.grid)?;
+    s.posterior()?;
     let spec = PriorSpec::from_file(&prior_file)?;
     let out = o.out_dir(&prior_file);
     std::fs::create_dir_all(&out)
         .with_context(|| format!("--out {}: cannot create the folder", out.display()))?;
-    let settings = o.settings(noise)?;
     eprintln!(
         "discover: {} ({} voltages), start model {} ({} parameters), {}",
         w.data.display(),

@@ -65,6 +65,7 @@ pub fn run(a: &FieldArgs) -> Result<()> {
         }
     }
     let det = load_detector(&a.input)?;
+    det.check_bias_contact()?;
     let b = det.semiconductor.geometry.bbox();
     if a.z < b.z_min_mm || a.z > b.z_max_mm {
         bail!(

@@ -222,6 +222,7 @@ fn read_truth(path: &Path) -> Result<(Vec<f64>, Vec<f64>)> {
 /// [`hpge_measurement::synth::MAX_SYNTH_BYTES_PER_BIAS`]); a folder this run made is removed
 /// again when a later step fails, so a failure leaves no empty or partial folder behind.
 pub fn synthesize(o: &SynthOptions) -> Result<()> {
+    o.validate()?;
     let settings = o.settings();
     settings.validate().map_err(|e| match &e {
         hpge_measurement::Error::Setting { key, message } if key == "pulser_pulses" => {

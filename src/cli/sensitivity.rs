@@ -41,6 +41,7 @@ pub fn run(o: &SensitivityOptions<'_>) -> Result<()> {
         plot::check_output(p, "--plot")?;
     }
     let det = load_detector(o.input)?;
+    det.check_bias_contact()?;
     let settings = o.grid.apply(&o.settings, &det)?;
     let device = super::simulate::backend_json(&settings)?;
     let bar = ProgressBar::new(o.zetas_cm3.len() as u64);

@@ -41,6 +41,11 @@ pub fn run(o: &SimulateOptions<'_>) -> Result<()> {
             bail!("--field-plot needs --field U (the bias in V at which to draw the potential)");
         }
     }
+    if let (Some(u), None) = (o.field, o.field_plot) {
+        bail!(
+            "--field {u}: draws the potential only with --field-plot FILE (.svg or .png); give both, or neither"
+        );
+    }
     if let Some(u) = o.field
         && !(u.is_finite() && u > 0.0)
     {
@@ -61,6 +66,9 @@ pub fn run(o: &SimulateOptions<'_>) -> Result<()> {
     if let Some(d) = o.d_li_mm {
         if !(d.is_finite() && d > 0.0) {
             bail!("--d-li {d}: the lithium thickness must be a positive number of mm");
+        }
+        if input.params.iter().any(|(k, _)| k == "d_li_mm") {
+            bail!("--d-li {d}: --param d_li_mm is given too; give the thickness once");
         }
         input.params.push(("d_li_mm".to_string(), d));
     }
@@ -283,6 +291,7 @@ pub fn capacitance(
         bail!("--voltage {voltage}: the bias must be a positive number of volts");
     }
     let det = load_detector(input)?;
+    det.check_bias_contact()?;
     let settings = &grid.apply(settings, &det)?;
     let device = backend_json(settings)?;
     let p = solve_point(&det, voltage, settings, None)?;

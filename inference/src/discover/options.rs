@@ -10,7 +10,9 @@ use hpge_solver::GridOverrides;
 
 use super::catalogue::catalogue;
 use super::settings::{DEFAULT_MIN_LN_BAYES, DiscoverSettings};
-use crate::fit::{DEFAULT_DATA, DEFAULT_DETECTOR, DEFAULT_MODEL, FIT_MAX_SECONDS, FitSettings};
+use crate::fit::{
+    DEFAULT_DATA, DEFAULT_DETECTOR, DEFAULT_MODEL, FIT_MAX_SECONDS, FitSettings, check_positive,
+};
 use crate::posterior::NoiseSettings;
 use crate::sampler::{DEFAULT_ESS_MIN, DEFAULT_SEED, SampleSettings, SamplerKind};
 use crate::{Error, Result};
@@ -41,7 +43,7 @@ pub struct WorkflowOptions {
     pub only: Vec<String>,
     /// Target bulk and tail ESS of the MCMC fits (lower: faster; the CI's reduced hidden-effect
     /// run uses 300).
-    #[cfg_attr(feature = "clap", arg(long, default_value_t = DEFAULT_ESS_MIN))]
+    #[cfg_attr(feature = "clap", arg(long, default_value_t = DEFAULT_ESS_MIN, allow_hyphen_values = true))]
     pub ess: f64,
     /// Write no figures.
     #[cfg_attr(feature = "clap", arg(long))]
@@ -96,6 +98,8 @@ impl WorkflowOptions {
         seed: u64,
         max_seconds: f64,
     ) -> Result<DiscoverSettings> {
+        check_positive("--ess", self.ess, "effective draws")?;
+        check_positive("--max-seconds", max_seconds, "seconds")?;
         let mut sample = SampleSettings::for_sampler(SamplerKind::Metropolis);
         sample.seed = seed;
         sample.ess_min = self.ess;
@@ -134,10 +138,10 @@ pub struct DiscoverOptions {
     #[cfg_attr(feature = "clap", arg(long, default_value_t = DEFAULT_SEED))]
     pub seed: u64,
     /// Smallest Laplace ln Bayes factor for an extension to be added.
-    #[cfg_attr(feature = "clap", arg(long, default_value_t = DEFAULT_MIN_LN_BAYES))]
+    #[cfg_attr(feature = "clap", arg(long, default_value_t = DEFAULT_MIN_LN_BAYES, allow_hyphen_values = true))]
     pub min_ln_bayes: f64,
     /// Stop each MCMC fit after this many seconds even if its targets are not reached.
-    #[cfg_attr(feature = "clap", arg(long, default_value_t = FIT_MAX_SECONDS))]
+    #[cfg_attr(feature = "clap", arg(long, default_value_t = FIT_MAX_SECONDS, allow_hyphen_values = true))]
     pub max_seconds: f64,
     /// Fit and score on the surrogate wherever it can (MCMC, fast) instead of the exact solver
     /// (Laplace; the default, because the surrogate is up to 27% off on z-only profiles).
@@ -200,6 +204,12 @@ impl DiscoverOptions {
     /// # Errors
     /// Targets [`SampleSettings::validate`] refuses.
     pub fn settings(&self, noise: NoiseSettings) -> Result<DiscoverSettings> {
+        if !self.min_ln_bayes.is_finite() {
+            return Err(Error::BadOption {
+                option: format!("--min-ln-bayes {}", self.min_ln_bayes),
+                message: "must be a finite number (3: strong evidence)".into(),
+            });
+        }
         Ok(DiscoverSettings {
             min_ln_bayes: self.min_ln_bayes,
             exact: !self.surrogate_only,

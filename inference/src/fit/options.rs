@@ -76,13 +76,13 @@ pub struct FitOptions {
     #[cfg_attr(feature = "clap", arg(long, default_value_t = DEFAULT_CHAINS))]
     pub chains: usize,
     /// Target bulk and tail ESS of every parameter.
-    #[cfg_attr(feature = "clap", arg(long, default_value_t = DEFAULT_ESS_MIN))]
+    #[cfg_attr(feature = "clap", arg(long, default_value_t = DEFAULT_ESS_MIN, allow_hyphen_values = true))]
     pub ess: f64,
     /// Target R-hat (rank-normalised, split).
-    #[cfg_attr(feature = "clap", arg(long, default_value_t = DEFAULT_RHAT_MAX))]
+    #[cfg_attr(feature = "clap", arg(long, default_value_t = DEFAULT_RHAT_MAX, allow_hyphen_values = true))]
     pub rhat: f64,
     /// Stop sampling after this many seconds even if the targets are not reached.
-    #[cfg_attr(feature = "clap", arg(long, default_value_t = FIT_MAX_SECONDS))]
+    #[cfg_attr(feature = "clap", arg(long, default_value_t = FIT_MAX_SECONDS, allow_hyphen_values = true))]
     pub max_seconds: f64,
     /// Known parameter values (TOML NAME = VALUE) to mark on the figures and check against the
     /// smallest intervals, e.g. data/super-siegfried-k1/truth-b-rz.toml.
@@ -163,11 +163,47 @@ impl FitOptions {
         noise_settings(&self.likelihood)
     }
 
+    /// Checks the numbers a user gives, naming the flag: `--max-seconds` and `--ess` must be
+    /// positive and finite, `--exact-draws` at least 1 (unless `--no-exact-check`), and the
+    /// sampler and likelihood known names.
+    ///
+    /// # Errors
+    /// [`Error::BadOption`] naming the flag and its value.
+    pub fn validate(&self) -> Result<()> {
+        self.sampler_kind()?;
+        self.noise()?;
+        if self.chains < 2 {
+            return Err(Error::BadOption {
+                option: format!("--chains {}", self.chains),
+                message: "R-hat needs at least 2 chains".into(),
+            });
+        }
+        check_positive("--max-seconds", self.max_seconds, "seconds")?;
+        check_positive("--ess", self.ess, "effective draws")?;
+        if !(self.rhat.is_finite() && self.rhat > 1.0) {
+            return Err(Error::BadOption {
+                option: format!("--rhat {}", self.rhat),
+                message: "the R-hat target must be a number above 1 (e.g. 1.01)".into(),
+            });
+        }
+        if self.exact_draws == 0 && !self.no_exact_check {
+            return Err(Error::BadOption {
+                option: "--exact-draws 0".into(),
+                message:
+                    "the exact-solver check needs at least 1 draw; pass --no-exact-check to skip it"
+                        .into(),
+            });
+        }
+        Ok(())
+    }
+
     /// The fit's settings: the sampler's defaults with these targets, checked.
     ///
     /// # Errors
-    /// An unknown sampler or likelihood, or targets [`SampleSettings::validate`] refuses.
+    /// An unknown sampler or likelihood, or targets [`FitOptions::validate`] or
+    /// [`SampleSettings::validate`] refuses.
     pub fn settings(&self) -> Result<FitSettings> {
+        self.validate()?;
         let mut sample = SampleSettings::for_sampler(self.sampler_kind()?);
         sample.seed = self.seed;
         sample.chains = self.chains;
@@ -180,6 +216,21 @@ impl FitOptions {
             sample,
             noise: self.noise()?,
             ..FitSettings::default()
+        })
+    }
+}
+
+/// Refuses a flag's value unless it is a positive finite number (`what`: its unit, in words).
+///
+/// # Errors
+/// [`Error::BadOption`] naming the flag and its value.
+pub fn check_positive(flag: &str, value: f64, what: &str) -> Result<()> {
+    if value.is_finite() && value > 0.0 {
+        Ok(())
+    } else {
+        Err(Error::BadOption {
+            option: format!("{flag} {value}"),
+            message: format!("must be a positive number of {what}"),
         })
     }
 }

@@ -40,11 +40,19 @@ pub fn read_truth(path: &Path, prior: &Prior) -> Result<Vec<Option<f64>>> {
             format!("expected NAME = number lines: {}", e.to_string().trim_end()),
         )
     })?;
-    Ok(prior
-        .names()
-        .iter()
-        .map(|n| table.get(n).copied())
-        .collect())
+    let names = prior.names();
+    if let Some(unknown) = table.keys().find(|k| !names.iter().any(|n| n == *k)) {
+        return Err(Error::Invalid {
+            file: path.to_path_buf(),
+            key: unknown.clone(),
+            message: format!(
+                "no parameter of the prior {} has this name; its parameters are {}",
+                prior.name,
+                names.join(", ")
+            ),
+        });
+    }
+    Ok(names.iter().map(|n| table.get(n).copied()).collect())
 }
 
 /// One record per parameter with a known truth.

@@ -138,6 +138,18 @@ impl SampleSettings {
                 format!("need at least 2 chains for R-hat, got {}", self.chains),
             );
         }
+        if !(self.ess_min.is_finite() && self.ess_min > 0.0) {
+            return bad(
+                "ess_min",
+                format!("the ESS target must be positive, got {}", self.ess_min),
+            );
+        }
+        if self.max_seconds.is_nan() || self.max_seconds <= 0.0 {
+            return bad(
+                "max_seconds",
+                format!("the time budget must be positive, got {}", self.max_seconds),
+            );
+        }
         if !(self.rhat_max > 1.0 && self.burnin_rhat > 1.0) {
             return bad("rhat_max", "R-hat targets must exceed 1".into());
         }

@@ -55,14 +55,15 @@ pub struct FitRun {
 /// Every input the job refuses (see [`FitJob::from_files`]), an output folder that cannot be
 /// made, and writing failures, each naming its file.
 pub fn run_fit(o: &FitOptions, observer: &dyn FitObserver) -> Result<FitRun> {
-    o.sampler_kind()?;
+    // Every check before the output folder is made: a refused fit leaves nothing behind.
+    let settings = o.settings()?;
     let noise = o.noise()?;
     let job = FitJob::from_files(&o.files(), noise, &o.grid)?;
     let truth = match &o.truth {
         Some(p) => Some(read_truth(p, &job.prior)?),
         None => None,
     };
-    let settings = o.settings()?;
+    job.posterior()?;
     let out = o.out_dir();
     std::fs::create_dir_all(&out).map_err(|e| Error::Output {
         flag: "--out".into(),

@@ -38,6 +38,11 @@ pub fn check_output(path: &Path, flag: &str) -> Result<()> {
             "unknown file type; use a name ending in .svg or .png".into(),
         ));
     }
+    if path.is_dir() {
+        return Err(output(
+            "is a folder; give a file name ending in .svg or .png".into(),
+        ));
+    }
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty())
         && !dir.is_dir()
     {

@@ -7,7 +7,7 @@ use std::sync::Arc;
 
 use super::spec::{DetectorSpec, MaterialSpec, PotentialSpec};
 use super::{Contact, ContactPotential, Detector, Passive, PassiveKind, Semiconductor, World};
-use crate::error::{Error, Result};
+use crate::error::{DetectorPart, Error, Result};
 use crate::expr::Parameters;
 use crate::geometry::{BOUNDARY_TOL_MM, Solid, common_point};
 use crate::impurity::{ImpurityContext, ImpurityModel, ImpuritySpec};
@@ -131,6 +131,10 @@ pub(crate) fn build(spec: &DetectorSpec, file: &Path, overrides: &Parameters) ->
     }
     if let Some(knots) = &s.rz_knots_mm {
         check_knots(knots, file, "semiconductor.rz_knots_mm")?;
+        check_knots_in_crystal(knots, sb.r_max_mm, file, "semiconductor.rz_knots_mm")?;
+    }
+    if let Some(knots) = &s.impurity.knots_mm {
+        check_knots_in_crystal(knots, sb.r_max_mm, file, "semiconductor.impurity.knots_mm")?;
     }
     let impurity_context = ImpurityContext {
         z_bottom_mm: z_bottom,
@@ -221,8 +225,16 @@ pub(crate) fn build(spec: &DetectorSpec, file: &Path, overrides: &Parameters) ->
             ) {
                 return Err(Error::Overlap {
                     file: file.to_path_buf(),
-                    first: format!("contact {}", contacts[i].label()),
-                    second: format!("contact {}", contacts[j].label()),
+                    parts: Box::new([
+                        DetectorPart::new(
+                            format!("contacts[{i}].geometry"),
+                            format!("contact {}", contacts[i].label()),
+                        ),
+                        DetectorPart::new(
+                            format!("contacts[{j}].geometry"),
+                            format!("contact {}", contacts[j].label()),
+                        ),
+                    ]),
                     r_mm: r,
                     z_mm: z,
                 });
@@ -291,21 +303,31 @@ pub(crate) fn build(spec: &DetectorSpec, file: &Path, overrides: &Parameters) ->
         ) {
             return Err(Error::Overlap {
                 file: file.to_path_buf(),
-                first: format!("passive {}", p.name),
-                second: "the semiconductor".to_string(),
+                parts: Box::new([
+                    DetectorPart::new(format!("{key}.geometry"), format!("passive {}", p.name)),
+                    DetectorPart::new("semiconductor.geometry", "the semiconductor"),
+                ]),
                 r_mm: r,
                 z_mm: z,
             });
         }
         if p.kind != PassiveKind::Dielectric {
-            for c in &contacts {
+            for (ci, c) in contacts.iter().enumerate() {
                 if let Some((r, z)) =
                     common_point(&geometry, &c.geometry, BOUNDARY_TOL_MM, BOUNDARY_TOL_MM)
                 {
                     return Err(Error::Overlap {
                         file: file.to_path_buf(),
-                        first: format!("passive {}", p.name),
-                        second: format!("contact {}", c.label()),
+                        parts: Box::new([
+                            DetectorPart::new(
+                                format!("{key}.geometry"),
+                                format!("passive {}", p.name),
+                            ),
+                            DetectorPart::new(
+                                format!("contacts[{ci}].geometry"),
+                                format!("contact {}", c.label()),
+                            ),
+                        ]),
                         r_mm: r,
                         z_mm: z,
                     });
@@ -329,8 +351,16 @@ pub(crate) fn build(spec: &DetectorSpec, file: &Path, overrides: &Parameters) ->
             ) {
                 return Err(Error::Overlap {
                     file: file.to_path_buf(),
-                    first: format!("passive {}", passives[i].name),
-                    second: format!("passive {}", passives[j].name),
+                    parts: Box::new([
+                        DetectorPart::new(
+                            format!("passives[{i}].geometry"),
+                            format!("passive {}", passives[i].name),
+                        ),
+                        DetectorPart::new(
+                            format!("passives[{j}].geometry"),
+                            format!("passive {}", passives[j].name),
+                        ),
+                    ]),
                     r_mm: r,
                     z_mm: z,
                 });
@@ -457,8 +487,32 @@ pub(crate) fn check_knots(knots: &[f64], file: &Path, key: &str) -> Result<()> {
     Ok(())
 }
 
+/// Refuses a knot beyond the crystal's outer radius `r_max_mm`: the profile there would never be
+/// used, and the knots inside would silently describe less than the user meant.
+fn check_knots_in_crystal(knots: &[f64], r_max_mm: f64, file: &Path, key: &str) -> Result<()> {
+    match knots.iter().position(|&k| k > r_max_mm + 1e-9) {
+        Some(i) => Err(Error::invalid(
+            file,
+            format!("{key}[{i}]"),
+            format!(
+                "the knot at r = {} mm lies beyond the crystal, whose outer radius is {r_max_mm} mm",
+                knots[i]
+            ),
+        )),
+        None => Ok(()),
+    }
+}
+
 /// Replaces the detector's impurity model by `spec` (read from `file`).
 pub(crate) fn set_impurity(det: &mut Detector, spec: &ImpuritySpec, file: &Path) -> Result<()> {
+    if let Some(knots) = &spec.knots_mm {
+        check_knots_in_crystal(
+            knots,
+            det.semiconductor.geometry.bbox().r_max_mm,
+            file,
+            "knots_mm",
+        )?;
+    }
     let model: Arc<dyn ImpurityModel> =
         Arc::from(spec.build(&det.semiconductor.impurity_context, file, "")?);
     det.semiconductor.impurity = model;

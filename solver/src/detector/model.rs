@@ -309,10 +309,28 @@ impl Detector {
 
     /// Checks that some contact is held at the bias (else a bias voltage acts on nothing):
     /// [`Error::NoBiasContact`] names the file.
+    ///
+    /// Also refuses a detector whose every contact is at the bias ([`Error::Invalid`] naming
+    /// `contacts[K].potential`): nothing then holds the crystal at another potential, no field
+    /// builds up between the contacts, and every solve would fail as an undepleted region
+    /// joining them.
     pub fn check_bias_contact(&self) -> Result<()> {
-        if self.bias_contacts().is_empty() {
+        let bias = self.bias_contacts();
+        if bias.is_empty() {
             return Err(Error::NoBiasContact {
                 file: self.file.clone(),
+            });
+        }
+        if bias.len() == self.contacts.len() && self.contacts.len() > 1 {
+            let labels: Vec<String> = self.contacts.iter().map(|c| c.label()).collect();
+            return Err(Error::Invalid {
+                file: self.file.clone(),
+                key: format!("contacts[{}].potential", self.contacts.len() - 1),
+                message: format!(
+                    "every contact ({}) has potential = \"bias\", so no field builds up between them; \
+                     hold at least one at a fixed potential (e.g. potential = 0.0)",
+                    labels.join(", ")
+                ),
             });
         }
         Ok(())

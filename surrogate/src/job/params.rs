@@ -20,6 +20,7 @@ pub fn parse_params(model: &Surrogate, items: &[String]) -> Result<Vec<f64>> {
         .filter(|s| !s.is_empty())
         .collect();
     let mut values = vec![f64::NAN; names.len()];
+    let mut given = vec![false; names.len()];
     let named = parts.iter().any(|p| p.contains('='));
     if named {
         for p in &parts {
@@ -35,12 +36,25 @@ pub fn parse_params(model: &Surrogate, items: &[String]) -> Result<Vec<f64>> {
                     names.join(", ")
                 )));
             };
+            if given[k] {
+                return Err(refuse(format!(
+                    "`{}` is given twice; give each parameter once",
+                    names[k]
+                )));
+            }
+            given[k] = true;
             values[k] = v
                 .trim()
                 .parse()
                 .map_err(|_| refuse(format!("`{v}` (for {n}) is not a number")))?;
+            if !values[k].is_finite() {
+                return Err(refuse(format!(
+                    "`{}` = {} is not a finite number",
+                    names[k], values[k]
+                )));
+            }
         }
-        if let Some(k) = values.iter().position(|v| v.is_nan()) {
+        if let Some(k) = given.iter().position(|g| !g) {
             return Err(refuse(format!(
                 "no value for `{}`; the model takes {}",
                 names[k],

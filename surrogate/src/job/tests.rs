@@ -22,7 +22,7 @@ fn space_file(dir: &Path) -> (PathBuf, ParameterSpace) {
     let mut text = String::from("name = \"test\"\n");
     for (k, (lo, hi)) in [(0.2, 5.0), (0.02, 1.0), (-1.0, 1.0)].iter().enumerate() {
         text += &format!(
-            "[[dimensions]]\nname = \"p{k}\"\nunit = \"1\"\nrange = [{lo}, {hi}]\ntarget = \"y_bot[{k}]\"\n"
+            "[[dimensions]]\nname = \"p{k}\"\nunit = \"1\"\nrange = [{lo}, {hi}]\ntarget = \"parameter:p{k}\"\n"
         );
     }
     text +=
@@ -403,5 +403,54 @@ fn parameter_lists_by_name_or_in_order() {
     assert_eq!(e(&["1,x,2"]), "`x` (for p1) is not a number");
     assert_eq!(e(&["p0=1,p1=y,p2=2"]), "`y` (for p1) is not a number");
     assert_eq!(e(&["nan,nan,nan"]), "`p0` = NaN is not a finite number");
+    // A named value that is not finite is named as such, not as missing (issue 24, group 10).
+    assert_eq!(
+        e(&["p0=nan,p1=0.1,p2=0.5"]),
+        "`p0` = NaN is not a finite number"
+    );
+    // A parameter given twice is refused, not the last one silently taken (issue 24, group 9).
+    assert_eq!(
+        e(&["p0=1,p1=0.1,p2=0.5", "p0=2"]),
+        "`p0` is given twice; give each parameter once"
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn the_test_set_must_not_be_the_training_set() {
+    let d = temp("same");
+    let mut job = job(&d, POLYNOMIAL_RECIPE, 0);
+    job.test = job.data.clone();
+    let e = job.run(&mut |_| {}).unwrap_err().to_string();
+    assert!(
+        e.contains("--test") && e.contains("training set itself"),
+        "{e}"
+    );
+    assert!(!job.out.exists());
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn the_polynomial_needs_as_many_rows_as_coefficients() {
+    let d = temp("poly-few");
+    let (space, sp) = space_file(&d);
+    let (data, test) = (d.join("one.csv"), d.join("test.csv"));
+    write_set(&data, &sp, 1, 0);
+    write_set(&test, &sp, 60, 1000);
+    let job = TrainJob {
+        data,
+        test,
+        space,
+        recipe: POLYNOMIAL_RECIPE.into(),
+        seed: 0,
+        detector: None,
+        out: d.join("poly3.safetensors"),
+    };
+    let e = job.run(&mut |_| {}).unwrap_err().to_string();
+    assert!(
+        e.contains("one.csv") && e.contains("1 rows") && e.contains("35"),
+        "{e}"
+    );
+    assert!(!job.out.exists());
     let _ = std::fs::remove_dir_all(&d);
 }

@@ -11,8 +11,8 @@ use super::checkpoint::{curves_path, partial_dir, resume_members, save_member, w
 use crate::generate::ExactSolver;
 use crate::model::{
     DataInfo, DataSet, DetectorInfo, EpochRecord, FORMAT, FORMAT_VERSION, Figures, Member,
-    ModelInfo, OutputTransform, Polynomial, Predictor, Recipe, Surrogate, Trained, network_order,
-    output_transform, train_resuming, unit_to_z,
+    ModelInfo, OutputTransform, Polynomial, Predictor, Recipe, Surrogate, Trained, monomials,
+    network_order, output_transform, train_resuming, unit_to_z,
 };
 use crate::space::ParameterSpace;
 use crate::{Error, Result};
@@ -175,6 +175,23 @@ impl TrainJob {
         Ok(())
     }
 
+    /// Refuses a test set that is the training set itself (the same file): its figures and
+    /// sigma_p would measure how well the model remembers, not how well it predicts.
+    fn check_distinct(&self) -> Result<()> {
+        if let (Ok(a), Ok(b)) = (self.data.canonicalize(), self.test.canonicalize())
+            && a == b
+        {
+            return Err(Error::Argument {
+                name: format!("--test {}", self.test.display()),
+                message: format!(
+                    "is the training set itself (--data {}); test on rows the model never trains on (e.g. data/training/heldout.csv)",
+                    self.data.display()
+                ),
+            });
+        }
+        Ok(())
+    }
+
     /// Trains, evaluates on the test set and writes the model file and (networks) its learning
     /// curves; removes the checkpoint folder once the model is written.
     pub fn run(&self, progress: &mut dyn FnMut(TrainEvent<'_>)) -> Result<TrainOutcome> {
@@ -185,8 +202,24 @@ impl TrainJob {
         } else {
             Some(Recipe::named(&self.recipe)?)
         };
+        self.check_distinct()?;
         let train = DataSet::read(&self.data, &space)?;
         let test = DataSet::read(&self.test, &space)?;
+        if recipe.is_none() {
+            let k = monomials(train.dim, 3).len();
+            let n = train.c12_pf.len();
+            if n < k {
+                return Err(Error::Invalid {
+                    file: self.data.clone(),
+                    key: "rows".into(),
+                    message: format!(
+                        "{n} rows with a c12 cannot determine the {k} coefficients of the recipe \
+                         {POLYNOMIAL_RECIPE} (a cubic in {} inputs); give at least {k} rows",
+                        train.dim
+                    ),
+                });
+            }
+        }
         progress(TrainEvent::DataRead {
             train: &train,
             test: &test,

@@ -70,7 +70,10 @@ impl DataSet {
             key,
             message,
         };
-        let mut lines = text.lines().enumerate();
+        // A byte-order mark (spreadsheet programs write one) is not part of the first column's
+        // name.
+        let body = text.strip_prefix('\u{feff}').unwrap_or(&text);
+        let mut lines = body.lines().enumerate();
         let header: Vec<&str> = match lines.next() {
             Some((_, h)) => h.split(',').collect(),
             None => return Err(invalid("header".into(), "the file is empty".into())),

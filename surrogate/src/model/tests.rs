@@ -10,7 +10,7 @@ fn space() -> ParameterSpace {
     let mut text = String::from("name = \"test\"\n");
     for (k, (lo, hi)) in [(0.2, 5.0), (0.02, 1.0), (-1.0, 1.0)].iter().enumerate() {
         text += &format!(
-            "[[dimensions]]\nname = \"p{k}\"\nunit = \"1\"\nrange = [{lo}, {hi}]\ntarget = \"y_bot[{k}]\"\n"
+            "[[dimensions]]\nname = \"p{k}\"\nunit = \"1\"\nrange = [{lo}, {hi}]\ntarget = \"parameter:p{k}\"\n"
         );
     }
     text +=

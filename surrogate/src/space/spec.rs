@@ -148,6 +148,20 @@ impl ParameterSpace {
                     ),
                 ));
             }
+            let is_y = matches!(
+                Target::parse(&d.target),
+                Some(Target::YBot(_) | Target::YTop(_))
+            );
+            if is_y && (lo < -1.0 || hi > 1.0) {
+                return Err(bad(
+                    k,
+                    "range",
+                    format!(
+                        "[{lo}, {hi}] leaves [-1, 1], the domain of y (`{}`); every sample outside it would fail",
+                        d.target
+                    ),
+                ));
+            }
             if Target::parse(&d.target).is_none() {
                 return Err(bad(
                     k,

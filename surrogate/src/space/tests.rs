@@ -42,6 +42,16 @@ fn bad_spaces_name_the_key() {
     assert!(err(&dim("[1.0, 0.0]", "bias")).contains("dimensions[0].range"));
     assert!(err(&dim("[0.0, nan]", "bias")).contains("range"));
     assert!(err(&dim("[0.0, 1.0]", "nowhere")).contains("dimensions[0].target"));
+    // y outside [-1, 1] is refused up front, not sample by sample (issue 24, group 9).
+    let e = err(&dim("[0.0, 1.5]", "y_bot[0]"));
+    assert!(
+        e.contains("dimensions[0].range") && e.contains("[-1, 1]"),
+        "{e}"
+    );
+    assert!(err(&dim("[-2.0, 0.5]", "y_top[1]")).contains("[-1, 1]"));
+    assert!(
+        ParameterSpace::from_toml_str(&dim("[-1.0, 1.0]", "y_top[1]"), Path::new("s.toml")).is_ok()
+    );
     assert!(err("name = \"x\"\ndimensions = []\n").contains("at least one"));
     assert!(err("name = \"x\"\n[[dimensions]]\nname = \"a\"\n").contains("s.toml"));
 }
