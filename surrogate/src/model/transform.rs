@@ -29,3 +29,21 @@ pub fn physical_to_z(d: &Dimension, x: f64) -> (f64, f64) {
     let pdf = (-0.5 * z * z).exp() / (2.0 * std::f64::consts::PI).sqrt();
     (z, du / pdf)
 }
+
+/// The unit coordinate u of the physical value x of dimension `d` (not clamped).
+pub fn dimension_to_unit(d: &Dimension, x: f64) -> f64 {
+    let [lo, hi] = d.range;
+    match d.distribution {
+        Distribution::Uniform => (x - lo) / (hi - lo),
+        Distribution::LogUniform => (x / lo).ln() / (hi / lo).ln(),
+    }
+}
+
+/// The physical value of the unit coordinate u of dimension `d`.
+pub fn dimension_from_unit(d: &Dimension, u: f64) -> f64 {
+    let [lo, hi] = d.range;
+    match d.distribution {
+        Distribution::Uniform => lo + u * (hi - lo),
+        Distribution::LogUniform => lo * (hi / lo).powf(u),
+    }
+}
