@@ -5,7 +5,10 @@
 use crate::space::{Dimension, Distribution, normal_quantile};
 
 /// u is clamped to [U_EDGE, 1 - U_EDGE] before Phi^-1 (|z| <= 4.75): the range edges themselves
-/// stay inside the domain (z = +-infinity otherwise). The training sets reach |z| ~ 4.2.
+/// stay inside the domain (z = +-infinity otherwise). The training sets reach |z| ~ 4.2-4.6, so
+/// the last values of a range are extrapolated (issue 24: +122% at 10 V); the support guard
+/// ([`super::Coverage`], `Surrogate::check_support`) refuses them in `predict`. Unchanged: the
+/// shipped models were trained with it.
 pub const U_EDGE: f64 = 1e-6;
 
 /// z = Phi^-1(clamp(u)).
