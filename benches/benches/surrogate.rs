@@ -41,6 +41,7 @@ fn model(recipe: &str) -> Surrogate {
         threads: 1,
         test_figures: Figures::of(&[1.0], &[1.0]),
         detector: None,
+        coverage: None,
         sigma_p: 0.01,
     };
     Surrogate::new(info, Predictor::Networks(nets)).expect("valid model")

@@ -207,6 +207,49 @@ pub fn evaluate(o: &EvaluateOptions, json: bool, plot: Option<&Path>) -> Result<
         f.abs_rms_pf,
         100.0 * model.sigma_p()
     );
+    println!(
+        "edges: |relative error| of the rows in the lowest / highest {:.0}% of each input's u \
+         (support: where >= {} training rows lie beyond{})",
+        100.0 * hpge_surrogate::job::EDGE_FRACTION,
+        hpge_surrogate::model::support_rows(model.info.training.n),
+        if model.coverage_recorded() {
+            ""
+        } else {
+            ", estimated from the training-row count"
+        }
+    );
+    println!(
+        "  {:<10} {:>6} {:>9} {:>9} {:>9} | {:>6} {:>9} {:>9} {:>9} | support",
+        "input", "n low", "median", "q90", "max", "n high", "median", "q90", "max"
+    );
+    println!(
+        "  {:<10} {:>6} {:>8.4}% {:>8.4}% {:>8.4}% | {:>6} {:>8.4}% {:>8.4}% {:>8.4}% | all rows",
+        "(all)",
+        f.n,
+        100.0 * f.abs_rel_q50,
+        100.0 * f.abs_rel_q90,
+        100.0 * f.abs_rel_max,
+        f.n,
+        100.0 * f.abs_rel_q50,
+        100.0 * f.abs_rel_q90,
+        100.0 * f.abs_rel_max
+    );
+    for e in &ev.edges {
+        println!(
+            "  {:<10} {:>6} {:>8.4}% {:>8.4}% {:>8.4}% | {:>6} {:>8.4}% {:>8.4}% {:>8.4}% | [{:.6}, {:.6}]",
+            e.name,
+            e.low.n,
+            100.0 * e.low.abs_rel_q50,
+            100.0 * e.low.abs_rel_q90,
+            100.0 * e.low.abs_rel_max,
+            e.high.n,
+            100.0 * e.high.abs_rel_q50,
+            100.0 * e.high.abs_rel_q90,
+            100.0 * e.high.abs_rel_max,
+            e.support[0],
+            e.support[1]
+        );
+    }
     println!("worst samples:");
     for w in &ev.worst {
         let inputs: Vec<String> = w
@@ -246,6 +289,17 @@ pub fn predict(o: &PredictOptions, json: bool) -> Result<()> {
     let params = parse_params(&model, &o.params).map_err(|e| anyhow::anyhow!("--params: {e}"))?;
     let voltages = &o.voltages.0;
     let u = model.voltages(voltages)?;
+    // The support guard (issue 24): inside the training range but where the training rows thin
+    // out the surrogate extrapolates; refuse unless asked to extrapolate.
+    model.check_params(&params)?;
+    if let Err(e) = model.check_support(&params, voltages) {
+        if !o.extrapolate {
+            return Err(anyhow::anyhow!(
+                "{e}; pass --extrapolate to predict there anyway"
+            ));
+        }
+        eprintln!("warning: {e}; predicting anyway (--extrapolate)");
+    }
     let n = voltages.len();
     let mut c = vec![0.0; n];
     let mut spread = vec![0.0; n];

@@ -51,6 +51,30 @@ pub enum Error {
         /// Upper end of the range.
         hi: f64,
     },
+    /// A prediction was asked inside the training space but where the training rows thin out
+    /// (fewer than `rows` of them lie further out in this dimension): the surrogate extrapolates
+    /// there and can be far off (issue 24). `predict --extrapolate` allows it.
+    #[error(
+        "`{name}` = {value} is outside the range the surrogate's training rows support, \
+         [{lo}, {hi}] (fewer than {rows} training rows lie beyond it, so the surrogate \
+         extrapolates there and can be far off; the training range is [{range_lo}, {range_hi}])"
+    )]
+    OutsideSupport {
+        /// Dimension name.
+        name: String,
+        /// The value asked for.
+        value: f64,
+        /// Lower end of the supported range.
+        lo: f64,
+        /// Upper end of the supported range.
+        hi: f64,
+        /// The number of training rows that must lie beyond a supported value.
+        rows: usize,
+        /// Lower end of the training space's range.
+        range_lo: f64,
+        /// Upper end of the training space's range.
+        range_hi: f64,
+    },
     /// Training failed (a non-finite loss, a singular fit, a candle error).
     #[error("training failed: {message}")]
     Training {
@@ -137,6 +161,7 @@ impl Error {
         match self {
             Error::Solver(e) => e.is_recoverable(),
             Error::OutsideDomain { .. } => true,
+            Error::OutsideSupport { .. } => false,
             Error::Io { .. }
             | Error::Parse { .. }
             | Error::Invalid { .. }

@@ -6,7 +6,7 @@ use std::path::Path;
 
 use serde::Serialize;
 
-use crate::model::{DataSet, Figures, Surrogate};
+use crate::model::{DataSet, Figures, Surrogate, dimension_from_unit, quantile};
 use crate::{Error, Result};
 
 /// One of the worst samples (largest |relative error|).
@@ -22,6 +22,93 @@ pub struct Worst {
     pub c12_surrogate_pf: f64,
     /// (c_p - c_s)/c_s.
     pub rel: f64,
+}
+
+/// The fraction of u at each end of an input that counts as its edge in [`EdgeFigures`].
+pub const EDGE_FRACTION: f64 = 0.05;
+
+/// |relative error| of the rows at one edge of one input.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct EdgeStats {
+    /// The edge's physical range [lo, hi] (u in [0, 0.05] or [0.95, 1]).
+    pub range: [f64; 2],
+    /// Rows at this edge.
+    pub n: usize,
+    /// Median of |relative error| (NaN without rows).
+    pub abs_rel_q50: f64,
+    /// 90% quantile of |relative error|.
+    pub abs_rel_q90: f64,
+    /// Largest |relative error|.
+    pub abs_rel_max: f64,
+    /// Mean of the relative error (its sign: over- or underestimate).
+    pub rel_mean: f64,
+}
+
+impl EdgeStats {
+    fn of(range: [f64; 2], rel: &[f64]) -> Self {
+        let mut abs: Vec<f64> = rel.iter().map(|r| r.abs()).collect();
+        abs.sort_by(f64::total_cmp);
+        let n = rel.len();
+        EdgeStats {
+            range,
+            n,
+            abs_rel_q50: quantile(&abs, 0.5),
+            abs_rel_q90: quantile(&abs, 0.9),
+            abs_rel_max: abs.last().copied().unwrap_or(f64::NAN),
+            rel_mean: if n == 0 {
+                f64::NAN
+            } else {
+                rel.iter().sum::<f64>() / n as f64
+            },
+        }
+    }
+}
+
+/// The accuracy at the two edges of one input (issue 24): the rows in the lowest and highest
+/// [`EDGE_FRACTION`] of its u, beside the whole set's figures.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct EdgeFigures {
+    /// Input name (network order).
+    pub name: String,
+    /// Rows with u <= 0.05.
+    pub low: EdgeStats,
+    /// Rows with u >= 0.95.
+    pub high: EdgeStats,
+    /// The range the model's training rows support ([`Surrogate::support`]).
+    pub support: [f64; 2],
+}
+
+/// Edge figures of every input of a data set with predictions `pred`.
+pub fn edge_figures(model: &Surrogate, data: &DataSet, pred: &[f64]) -> Vec<EdgeFigures> {
+    let space = &model.info.space;
+    let order = crate::model::network_order(space).unwrap_or_default();
+    let rel: Vec<f64> = pred
+        .iter()
+        .zip(&data.c12_pf)
+        .map(|(p, t)| (p - t) / t)
+        .collect();
+    order
+        .iter()
+        .enumerate()
+        .map(|(k, &j)| {
+            let d = &space.dimensions[j];
+            let pick = |keep: &dyn Fn(f64) -> bool| -> Vec<f64> {
+                (0..data.len())
+                    .filter(|&i| keep(data.unit_row(i)[k]))
+                    .map(|i| rel[i])
+                    .collect()
+            };
+            let low = pick(&|u| u <= EDGE_FRACTION);
+            let high = pick(&|u| u >= 1.0 - EDGE_FRACTION);
+            let edge = |a: f64, b: f64| [dimension_from_unit(d, a), dimension_from_unit(d, b)];
+            EdgeFigures {
+                name: d.name.clone(),
+                low: EdgeStats::of(edge(0.0, EDGE_FRACTION), &low),
+                high: EdgeStats::of(edge(1.0 - EDGE_FRACTION, 1.0), &high),
+                support: model.support(k),
+            }
+        })
+        .collect()
 }
 
 /// A model's accuracy on a data set.
@@ -41,6 +128,8 @@ pub struct Evaluation {
     pub worst: Vec<Worst>,
     /// The model's c12 (pF) of every sample (for plots).
     pub predictions: Vec<f64>,
+    /// The accuracy at the edges of every input (network order).
+    pub edges: Vec<EdgeFigures>,
 }
 
 /// `evaluate --json`: the issue's fields first, then the rest (the field order is the JSON's).
@@ -82,6 +171,9 @@ pub struct EvaluationJson<'a> {
     pub worst: &'a [Worst],
     /// This program's version.
     pub program_version: &'static str,
+    /// The accuracy at the edges of every input (issue 24): rows in the lowest and highest 5%
+    /// of its u.
+    pub edges: &'a [EdgeFigures],
 }
 
 /// Reads a data set against the space of `model` (loaded from `model_file`); a refusal names the
@@ -119,6 +211,7 @@ impl Evaluation {
                 rel: rel(i),
             })
             .collect();
+        let edges = edge_figures(model, data, &pred);
         Evaluation {
             figures,
             excluded: data.excluded,
@@ -127,6 +220,7 @@ impl Evaluation {
             sigma_p: model.sigma_p(),
             worst,
             predictions: pred,
+            edges,
         }
     }
 
@@ -152,6 +246,7 @@ impl Evaluation {
             sigma_p: self.sigma_p,
             worst: &self.worst,
             program_version: env!("CARGO_PKG_VERSION"),
+            edges: &self.edges,
         }
     }
 }

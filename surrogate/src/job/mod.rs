@@ -15,7 +15,10 @@ mod train;
 mod tests;
 
 pub use checkpoint::{curves_path, partial_dir, resume_members, save_member, write_curves};
-pub use evaluate::{Evaluation, EvaluationJson, Worst, read_for_model};
+pub use evaluate::{
+    EDGE_FRACTION, EdgeFigures, EdgeStats, Evaluation, EvaluationJson, Worst, edge_figures,
+    read_for_model,
+};
 pub use options::{DEFAULT_SHARD, DEFAULT_WORST, EvaluateOptions, GenerateOptions, PredictOptions};
 pub use params::parse_params;
 pub use train::{

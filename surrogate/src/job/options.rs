@@ -125,6 +125,12 @@ pub struct PredictOptions {
     /// Also give dc12/dp for every parameter (exact derivative of the network).
     #[cfg_attr(feature = "clap", arg(long))]
     pub jacobian: bool,
+    /// Predict also where the training rows thin out (fewer than 50 of them lie beyond the value
+    /// in its dimension, e.g. below 13.4 V or above 2996.6 V of the shipped models' bias): the
+    /// surrogate extrapolates there and can be off by tens of percent (+122% at 10 V). Without it
+    /// such points are refused (exit 2); with it they are predicted and a warning is printed.
+    #[cfg_attr(feature = "clap", arg(long))]
+    pub extrapolate: bool,
 }
 
 #[cfg(test)]

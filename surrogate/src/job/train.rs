@@ -10,9 +10,9 @@ use hpge_solver::FieldSettings;
 use super::checkpoint::{curves_path, partial_dir, resume_members, save_member, write_curves};
 use crate::generate::ExactSolver;
 use crate::model::{
-    DataInfo, DataSet, DetectorInfo, EpochRecord, FORMAT, FORMAT_VERSION, Figures, Member,
-    ModelInfo, OutputTransform, Polynomial, Predictor, Recipe, Surrogate, Trained, monomials,
-    network_order, output_transform, train_resuming, unit_to_z,
+    Coverage, DataInfo, DataSet, DetectorInfo, EpochRecord, FORMAT, FORMAT_VERSION, Figures,
+    Member, ModelInfo, OutputTransform, Polynomial, Predictor, Recipe, Surrogate, Trained,
+    monomials, network_order, output_transform, train_resuming, unit_to_z,
 };
 use crate::space::ParameterSpace;
 use crate::{Error, Result};
@@ -298,6 +298,7 @@ impl TrainJob {
             .map(|&j| space.dimensions[j].name.clone())
             .collect();
         let log_output = recipe.is_none_or(|r| r.log_output);
+        let coverage = Some(Coverage::of(train, &inputs));
         Ok(ModelInfo {
             format: FORMAT.into(),
             format_version: FORMAT_VERSION,
@@ -318,6 +319,7 @@ impl TrainJob {
                 Some(d) => Some(detector_info(space, d)?),
                 None => None,
             },
+            coverage,
             sigma_p: f64::NAN,
         })
     }

@@ -1,6 +1,7 @@
 //! The surrogate of c12(p, U_B) (paper, section 7): data sets, recipes, candle-nn training, the
 //! plain f64 prediction path with its Jacobian, model files and accuracy figures.
 
+mod coverage;
 mod dataset;
 mod file;
 mod gelu;
@@ -15,6 +16,7 @@ mod transform;
 #[cfg(test)]
 mod tests;
 
+pub use coverage::{Coverage, SUPPORT_ROWS, support_rows};
 pub use dataset::{DataSet, network_order};
 pub use metrics::{Figures, gaussian_fit, quantile};
 pub use network::{Dense, Network};
@@ -27,4 +29,4 @@ pub use train::{
     EpochRecord, Member, Trained, candle_outputs, initial_network, output_transform, train,
     train_resuming,
 };
-pub use transform::{U_EDGE, physical_to_z, unit_to_z};
+pub use transform::{U_EDGE, dimension_from_unit, dimension_to_unit, physical_to_z, unit_to_z};

@@ -5,12 +5,13 @@
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use super::coverage::{Coverage, support_rows};
 use super::dataset::{DataSet, network_order};
 use super::metrics::Figures;
 use super::network::Network;
 use super::polynomial::Polynomial;
 use super::recipe::{OutputTransform, Recipe};
-use super::transform::{physical_to_z, unit_to_z};
+use super::transform::{dimension_from_unit, dimension_to_unit, physical_to_z, unit_to_z};
 use crate::error::{Error, Result};
 use crate::space::{Dimension, ParameterSpace};
 
@@ -91,6 +92,12 @@ pub struct ModelInfo {
     /// against the detector it is given. Absent in files trained without it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub detector: Option<DetectorInfo>,
+    /// Per input (network order), the range of u its training rows support ([`Coverage`],
+    /// issue 24). Absent in files trained before the record existed: [`Surrogate::coverage`]
+    /// then estimates it from the number of training rows. It changes no prediction, only which
+    /// points `predict` accepts without `--extrapolate`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub coverage: Option<Vec<Coverage>>,
     /// sigma_p: the relative surrogate uncertainty inference uses (sigma_c^p = sigma_p c_p, the
     /// paper's eq. CapUncertaintyDNN): the Gaussian sigma on the test set.
     pub sigma_p: f64,
@@ -197,6 +204,70 @@ impl Surrogate {
             let [lo, hi] = self.dims[k].range;
             if !(x >= lo && x <= hi) {
                 return Err(self.outside(k, x));
+            }
+        }
+        Ok(())
+    }
+
+    /// The support of every input (network order): the model file's record, or for a file
+    /// without one the estimate from its training-row count ([`Coverage::estimate`]).
+    pub fn coverage(&self) -> Vec<Coverage> {
+        match &self.info.coverage {
+            Some(c) if c.len() == self.dims.len() => c.clone(),
+            _ => self
+                .dims
+                .iter()
+                .map(|d| Coverage::estimate(&d.name, self.info.training.n))
+                .collect(),
+        }
+    }
+
+    /// Whether the record of the support is the model file's own (else estimated).
+    pub fn coverage_recorded(&self) -> bool {
+        self.info
+            .coverage
+            .as_ref()
+            .is_some_and(|c| c.len() == self.dims.len())
+    }
+
+    /// The supported physical range [lo, hi] of input k (network order; k = n_params is the
+    /// bias).
+    pub fn support(&self, k: usize) -> [f64; 2] {
+        let c = &self.coverage()[k];
+        let d = &self.dims[k];
+        let a = dimension_from_unit(d, c.u_support[0]);
+        let b = dimension_from_unit(d, c.u_support[1]);
+        [a.min(b), a.max(b)]
+    }
+
+    /// The support guard (issue 24): every parameter and voltage inside the range its training
+    /// rows support ([`Self::support`]); [`Error::OutsideSupport`] names the first one outside.
+    /// Values outside the training range itself are the domain guard's ([`Self::check_params`],
+    /// [`Self::voltages`]).
+    pub fn check_support(&self, params: &[f64], volts: &[f64]) -> Result<()> {
+        let cov = self.coverage();
+        let b = self.n_params();
+        let values = params
+            .iter()
+            .enumerate()
+            .take(b)
+            .map(|(k, &x)| (k, x))
+            .chain(volts.iter().map(|&v| (b, v)));
+        for (k, x) in values {
+            let d = &self.dims[k];
+            let u = dimension_to_unit(d, x);
+            let [ulo, uhi] = cov[k].u_support;
+            if !(u >= ulo - 1e-12 && u <= uhi + 1e-12) {
+                let [lo, hi] = self.support(k);
+                return Err(Error::OutsideSupport {
+                    name: d.name.clone(),
+                    value: x,
+                    lo,
+                    hi,
+                    rows: support_rows(cov[k].rows),
+                    range_lo: d.range[0],
+                    range_hi: d.range[1],
+                });
             }
         }
         Ok(())

@@ -4,6 +4,7 @@
 use std::path::PathBuf;
 
 use super::*;
+use crate::Error;
 use crate::space::ParameterSpace;
 
 fn space() -> ParameterSpace {
@@ -159,6 +160,7 @@ fn tiny_training_lowers_the_loss_and_the_file_reloads_identically() {
         threads: 1,
         test_figures: Figures::of(&[1.0], &[1.0]),
         detector: None,
+        coverage: None,
         sigma_p: 0.05,
     };
     let model = Surrogate::new(info, Predictor::Networks(t.members)).unwrap();
@@ -187,6 +189,51 @@ fn tiny_training_lowers_the_loss_and_the_file_reloads_identically() {
     assert!(e.contains("NaN"), "{e}");
     let e = back.curve(&p, &[5.0]).unwrap_err().to_string();
     assert!(e.contains("U_B"), "{e}");
+
+    // The support guard (issue 24): without a record, estimated from the training-row count
+    // (600 rows: 6 must lie beyond, u in [0.01, 0.99]); with one, the 6th-outermost training
+    // rows bound it, and the record survives the file.
+    assert!(!back.coverage_recorded());
+    let [lo, hi] = sp.dimensions[0].range;
+    let est = back.support(0);
+    assert!((est[0] - (lo + 0.01 * (hi - lo))).abs() < 1e-9, "{est:?}");
+    assert!((est[1] - (lo + 0.99 * (hi - lo))).abs() < 1e-9, "{est:?}");
+    let mut covered = model.clone();
+    covered.info.coverage = Some(Coverage::of(&train_set, &covered.info.inputs));
+    let f3 = dir.join("covered.safetensors");
+    covered.save(&f3).unwrap();
+    let covered = Surrogate::load(&f3).unwrap();
+    assert!(covered.coverage_recorded());
+    assert_eq!(covered.predict_set(&test_set), model.predict_set(&test_set));
+    let mut u0: Vec<f64> = (0..train_set.len())
+        .map(|i| train_set.unit_row(i)[0])
+        .collect();
+    u0.sort_by(f64::total_cmp);
+    let c0 = &covered.coverage()[0];
+    // (to the last bits: serde_json's float parsing need not round-trip exactly)
+    let near =
+        |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).abs() < 1e-12 && (a[1] - b[1]).abs() < 1e-12;
+    assert!(near(c0.u_support, [u0[5], u0[u0.len() - 6]]), "{c0:?}");
+    assert!(near(c0.u_extreme, [u0[0], u0[u0.len() - 1]]), "{c0:?}");
+    let [slo, shi] = covered.support(0);
+    covered.check_support(&p, &[1000.0]).unwrap();
+    for x in [lo, slo - 1e-6 * (hi - lo), shi + 1e-6 * (hi - lo), hi] {
+        let e = covered
+            .check_support(&[x, 0.5, 0.1], &[1000.0])
+            .unwrap_err();
+        assert!(
+            matches!(&e, Error::OutsideSupport { name, .. } if name == "p0"),
+            "{e}"
+        );
+        assert!(!e.is_recoverable());
+        // The prediction itself is unchanged: the guard is the caller's.
+        covered.curve(&[x, 0.5, 0.1], &[1000.0]).unwrap();
+    }
+    let e = covered.check_support(&p, &[10.0]).unwrap_err().to_string();
+    assert!(
+        e.contains("U_B") && e.contains("training rows support"),
+        "{e}"
+    );
 
     // A file of another format version.
     let mut other = model.clone();
@@ -241,6 +288,7 @@ fn physical_jacobian_matches_finite_differences() {
         threads: 1,
         test_figures: Figures::of(&[1.0], &[1.0]),
         detector: None,
+        coverage: None,
         sigma_p: 0.01,
     };
     let m = Surrogate::new(
