@@ -19,8 +19,15 @@
 //! proposes active sets, which the caller stops doing after a few iterations, so the plain
 //! method's finite convergence still holds.
 
-use super::round::Bound;
 use super::system::System;
+
+/// State of a bounded unknown.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Bound {
+    Free,
+    Upper,
+    Lower,
+}
 
 /// Bounded unknowns within `depth` edges (in the matrix graph) of a `seed` unknown, excluding
 /// unknowns that are not `bounded` (insulators, floating conductors: a floating conductor's
@@ -175,9 +182,9 @@ mod tests {
     use super::BAND_STEPS;
     use crate::detector::Detector;
     use crate::expr::Parameters;
+    use crate::field::band::Bound;
     use crate::field::depletion::{FastSeed, solve_with_band_steps};
     use crate::field::mesh::Mesh;
-    use crate::field::round::Bound;
     use crate::grid::{Grid, GridSettings};
 
     fn detector(file: &str) -> Detector {

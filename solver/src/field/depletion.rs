@@ -21,9 +21,6 @@ use crate::carrier::Carrier;
 use crate::detector::Detector;
 use crate::error::{Error, Result};
 
-/// Largest number of active-set iterations before giving up.
-pub const MAX_ACTIVE_SET_ITERATIONS: usize = 200;
-
 /// The potential with depletion on one mesh.
 #[derive(Debug, Clone)]
 pub struct PotentialSolution {

@@ -8,22 +8,17 @@
 //! Optim. 13 (2003) 865). The first iterations take the active set that the band relaxation
 //! proposes (`band.rs`); the round ends when a plain step leaves the active set unchanged.
 
+pub(crate) use super::band::Bound;
 use super::band::band_state;
 use super::cholesky::{Factor, Symbolic};
-use super::depletion::MAX_ACTIVE_SET_ITERATIONS;
 use super::pockets::Ties;
 use super::report::Method;
 use super::system::System;
 use crate::carrier::Carrier;
 use crate::error::{Error, Result};
 
-/// State of a bounded unknown.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum Bound {
-    Free,
-    Upper,
-    Lower,
-}
+/// Largest number of active-set iterations in one round before giving up.
+pub(crate) const MAX_ACTIVE_SET_ITERATIONS: usize = 200;
 
 /// A numeric factorisation with the active set it was made for.
 pub(super) struct Factored {
