@@ -160,7 +160,7 @@ def _without_seconds(v):
 
 @pytest.mark.skipif(os.environ.get("HPGE_SKIP_FIT") == "1", reason="HPGE_SKIP_FIT=1")
 def test_discover_equals_the_command_line(cli_json, tmp_path):
-    """A small discovery (B_Z start, the radial extension on the surrogate, ESS 200) with a fixed
+    """A small discovery (B_Z start, the radial extension on the surrogate, ESS 50) with a fixed
     amount of work: without a wall-clock budget (`max_seconds` far beyond the run) every fit stops
     at its convergence targets, so the same seed gives the same summary as `hpge-cv discover`."""
     common = dict(
@@ -169,12 +169,12 @@ def test_discover_equals_the_command_line(cli_json, tmp_path):
         detector=ROOT / "detectors/super-siegfried-k1.toml",
     )
     got = hpge_cv.discover(**common, start_model=str(ROOT / "priors/b-z.toml"), only=["radial"],
-                           seed=5, ess=200.0, max_seconds=1e9, surrogate_only=True,
+                           seed=5, ess=50.0, max_seconds=1e9, surrogate_only=True,
                            progress=False)
     ref = cli_json(
         "discover", "--data", common["data"], "--model", MODEL, "--detector", common["detector"],
         "--start-model", ROOT / "priors/b-z.toml", "--only", "radial", "--seed", "5",
-        "--ess", "200", "--max-seconds", "1e9", "--surrogate-only", "--no-plots",
+        "--ess", "50", "--max-seconds", "1e9", "--surrogate-only", "--no-plots",
         "--out", tmp_path / "discovery", "--json",
     )
     assert got["candidates"] and got["settings"]["fit"]["sample"]["max_seconds"] == 1e9
