@@ -709,15 +709,18 @@ fn fit<'py>(
 ///
 /// Arguments (defaults: the command line's, relative to the working directory): `data`,
 /// `model`, `detector`, `start_model` (a prior file or a name in priors/, default "b-z"),
-/// `only` (catalogue entries, e.g. ["radial"]), `seed`, `ess`, `surrogate_only` (leave out the
-/// exact-solver extensions, which are slow), `out` (a folder: also write `discovery.json`,
-/// `residuals.csv`, `report.md` and the figures there), `progress`.
+/// `only` (catalogue entries, e.g. ["radial"]), `seed`, `ess`, `max_seconds` (sampling budget of
+/// each MCMC fit, s: a fit that reaches it stops at a number of draws that depends on the
+/// machine's speed; pass a large value for results that depend on the seed alone),
+/// `min_ln_bayes` (smallest ln Bayes factor for an extension to be added), `surrogate_only`
+/// (leave out the exact-solver extensions, which are slow), `out` (a folder: also write
+/// `discovery.json`, `residuals.csv`, `report.md` and the figures there), `progress`.
 ///
 /// Returns the summary (`discovery.json`'s object) as a dict. The GIL is released while it runs.
 #[pyfunction]
 #[pyo3(signature = (
     data=None, model=None, detector=None, start_model=None, only=None, seed=None, ess=None,
-    surrogate_only=false, out=None, progress=None
+    max_seconds=None, min_ln_bayes=None, surrogate_only=false, out=None, progress=None
 ))]
 #[allow(clippy::too_many_arguments)]
 fn discover<'py>(
@@ -729,6 +732,8 @@ fn discover<'py>(
     only: Option<Vec<String>>,
     seed: Option<u64>,
     ess: Option<f64>,
+    max_seconds: Option<f64>,
+    min_ln_bayes: Option<f64>,
     surrogate_only: bool,
     out: Option<PathBuf>,
     progress: Option<Bound<'py, PyAny>>,
@@ -755,6 +760,12 @@ fn discover<'py>(
     }
     if let Some(e) = ess {
         o.workflow.ess = e;
+    }
+    if let Some(s) = max_seconds {
+        o.max_seconds = s;
+    }
+    if let Some(b) = min_ln_bayes {
+        o.min_ln_bayes = b;
     }
     o.surrogate_only = surrogate_only;
     o.out = out.clone();

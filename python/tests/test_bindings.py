@@ -147,3 +147,39 @@ def test_fit_equals_the_command_line(cli_json, tmp_path):
     assert got["draws"].ndim == 3 and got["draws"].shape[2] == len(got["names"])
     means = got["draws"].reshape(-1, len(got["names"])).mean(axis=0)
     np.testing.assert_allclose(means, [p["mean"] for p in s["parameters"]], rtol=1e-9)
+
+
+def _without_seconds(v):
+    """A discovery summary without its wall-clock times (the only machine-dependent numbers)."""
+    if isinstance(v, dict):
+        return {k: _without_seconds(x) for k, x in v.items() if k != "seconds"}
+    if isinstance(v, list):
+        return [_without_seconds(x) for x in v]
+    return v
+
+
+@pytest.mark.skipif(
+    os.environ.get("HPGE_DISCOVER_CLI") != "1",
+    reason="slow (the B_Z start fit mixes poorly: R-hat 1.36 after 16000 draws per chain); "
+    "HPGE_DISCOVER_CLI=1 runs it",
+)
+def test_discover_equals_the_command_line(cli_json, tmp_path):
+    """A small discovery (B_Z start, the radial extension on the surrogate, ESS 50) with a fixed
+    amount of work: without a wall-clock budget (`max_seconds` far beyond the run) every fit stops
+    at its convergence targets, so the same seed gives the same summary as `hpge-cv discover`."""
+    common = dict(
+        data=ROOT / "data/super-siegfried-k1/cv.csv",
+        model=MODEL,
+        detector=ROOT / "detectors/super-siegfried-k1.toml",
+    )
+    got = hpge_cv.discover(**common, start_model=str(ROOT / "priors/b-z.toml"), only=["radial"],
+                           seed=5, ess=50.0, max_seconds=1e9, surrogate_only=True,
+                           progress=False)
+    ref = cli_json(
+        "discover", "--data", common["data"], "--model", MODEL, "--detector", common["detector"],
+        "--start-model", ROOT / "priors/b-z.toml", "--only", "radial", "--seed", "5",
+        "--ess", "50", "--max-seconds", "1e9", "--surrogate-only", "--no-plots",
+        "--out", tmp_path / "discovery", "--json",
+    )
+    assert got["candidates"] and got["settings"]["fit"]["sample"]["max_seconds"] == 1e9
+    assert _without_seconds(got) == _without_seconds(ref)

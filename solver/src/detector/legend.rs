@@ -13,12 +13,17 @@
 //!   narrower lower part), `extra.top_cylinder` (`radius_in_mm`, `height_in_mm`: a narrower upper
 //!   part), `extra.topgroove` (`radius_in_mm`, `depth_in_mm`: a wider recess around the borehole);
 //!   `extra.crack` breaks the cylindrical symmetry and is left out (a note in the file says so).
-//! - `production.impcc`: the impurity profile along the axis, acceptor densities in 1e9 cm^-3
-//!   (p-type: hpge-cv's signed density is minus them) against the distance d (mm) from the p+
-//!   contact's face (z = 0): either `function_pars` {`z0`, `gradient` (per mm), `quadratic` (per
-//!   mm^2)}, value(d) = z0 + gradient d + quadratic d^2, or the tables `dist_from_contact_in_mm`
-//!   and `value_in_1e9e_cm3` (piecewise linear, constant beyond the ends). Without it the density
-//!   is [`LegendOptions::default_impurity_cm3`] and the file says so.
+//! - `production.impcc`: the impurity profile along the axis, net acceptor densities (p-type:
+//!   hpge-cv's signed density is minus them) against the distance d from the p+ contact's face
+//!   (z = 0). In the collaboration's format (legend-testdata): the table `array`
+//!   (`dist_from_contact_in_mm`, `value_in_1e9e/cm3`: 1e9 cm^-3; piecewise linear, constant
+//!   beyond the ends), else `function_pars` (`z0_in_1e10e/cm3`, `gradient_in_1e10e/cm4`,
+//!   `quadratic_in_1e10e/cm5`: value(d) = z0 + gradient d + quadratic d^2 in 1e10 cm^-3 with d in
+//!   cm). hpge-cv's short form: `function_pars` {`z0`, `gradient` (per mm), `quadratic` (per
+//!   mm^2)} in 1e9 cm^-3, or the tables `dist_from_contact_in_mm` and `value_in_1e9e_cm3`
+//!   directly under `impcc`. Without a profile, or with one that is zero everywhere (a
+//!   placeholder, as in the public test records), the density is
+//!   [`LegendOptions::default_impurity_cm3`] and the file says so.
 //! - `characterization`: the n+ dead-layer thickness (the first of `*.fccd_in_mm` (a number or
 //!   `{value}`) and `*.dl_thickness_in_mm` found in its sub-tables), else
 //!   [`LegendOptions::n_plus_thickness_mm`]; the depletion voltage (`*.depletion_voltage_in_V`) is
@@ -554,20 +559,33 @@ fn n_plus_thickness(rd: &Reader<'_>, v: &Value, o: &LegendOptions) -> Result<(f6
 }
 
 /// The impurity model's TOML lines (without the table header) and where they came from.
+///
+/// `production.impcc` in the collaboration's format (legend-testdata's diode records): the table
+/// `array` (`dist_from_contact_in_mm`, `value_in_1e9e/cm3`: 1e9 cm^-3) and `function_pars`
+/// (`z0_in_1e10e/cm3`, `gradient_in_1e10e/cm4`, `quadratic_in_1e10e/cm5`: 1e10 cm^-3 and per cm,
+/// per cm^2, the units in the names), the table first where both are given (the measured values;
+/// LegendGeSim.jl fits those too). hpge-cv's short form (detectors/legend/): `function_pars`
+/// {`z0`, `gradient`, `quadratic`} in 1e9 cm^-3 per mm, per mm^2, or the tables
+/// `dist_from_contact_in_mm` and `value_in_1e9e_cm3` directly under `impcc`. A profile that is
+/// zero everywhere is a placeholder (the public test records' are): the default density then,
+/// and the file says so.
 fn impurity(
     rd: &Reader<'_>,
     v: &Value,
     height_mm: f64,
     o: &LegendOptions,
 ) -> Result<(String, String)> {
-    let Some(imp) = v.get("production").and_then(|p| p.get("impcc")) else {
-        return Ok((
+    let default = |why: String| {
+        (
             format!(
                 "model = \"constant\"\nzeta_cm3 = {:e}\n",
                 o.default_impurity_cm3
             ),
-            "the default: the record has no production.impcc".to_string(),
-        ));
+            format!("the default ({why})"),
+        )
+    };
+    let Some(imp) = v.get("production").and_then(|p| p.get("impcc")) else {
+        return Ok(default("the record has no production.impcc".into()));
     };
     let num = |x: Option<&Value>, key: &str| -> Result<f64> {
         let x = x.ok_or_else(|| rd.err(key, "missing"))?;
@@ -575,59 +593,146 @@ fn impurity(
             .filter(|f| f.is_finite())
             .ok_or_else(|| rd.err(key, format!("must be a finite number, got {x}")))
     };
-    if let Some(f) = imp.get("function_pars") {
+    let mut placeholders: Vec<String> = Vec::new();
+    // 1. LEGEND's measured table.
+    if let Some(t) = imp.get("array").filter(|t| !t.is_null()) {
+        let k = "production.impcc.array";
+        // The key as legend-testdata spells it; the crystal records' spelling too.
+        let value_key =
+            if t.get("value_in_1e9e/cm3").is_none() && t.get("value_in_1e9e_cm3").is_some() {
+                "value_in_1e9e_cm3"
+            } else {
+                "value_in_1e9e/cm3"
+            };
+        if let Some(r) = table(rd, t, k, value_key, 1e9, &mut placeholders)? {
+            return Ok(r);
+        }
+    }
+    // 2. A polynomial in the distance from the contact.
+    if let Some(f) = imp.get("function_pars").filter(|f| !f.is_null()) {
         let k = "production.impcc.function_pars";
-        let a = num(f.get("z0"), &format!("{k}.z0"))?;
-        let b = num(f.get("gradient"), &format!("{k}.gradient"))?;
-        let c = match f.get("quadratic") {
-            None | Some(Value::Null) => 0.0,
-            x => num(x, &format!("{k}.quadratic"))?,
+        let legend = ["z0_in_1e10e/cm3", "gradient_in_1e10e/cm4"]
+            .iter()
+            .any(|n| f.get(*n).is_some());
+        // (key of z0, gradient, quadratic), cm^-3 per unit, mm per length unit of the key.
+        let (keys, unit, length_mm) = if legend {
+            (
+                [
+                    "z0_in_1e10e/cm3",
+                    "gradient_in_1e10e/cm4",
+                    "quadratic_in_1e10e/cm5",
+                ],
+                1e10,
+                10.0,
+            )
+        } else {
+            (["z0", "gradient", "quadratic"], 1e9, 1.0)
         };
-        let zeta = |d: f64| -(a + b * d + c * d * d) * 1e9;
-        if c == 0.0 {
+        let a = num(f.get(keys[0]), &format!("{k}.{}", keys[0]))?;
+        let b = num(f.get(keys[1]), &format!("{k}.{}", keys[1]))?;
+        let c = match f.get(keys[2]) {
+            None | Some(Value::Null) => 0.0,
+            x => num(x, &format!("{k}.{}", keys[2]))?,
+        };
+        if a == 0.0 && b == 0.0 && c == 0.0 {
+            placeholders.push(k.to_string());
+        } else {
+            let zeta = |d_mm: f64| {
+                let d = d_mm / length_mm;
+                -(a + b * d + c * d * d) * unit
+            };
+            if c == 0.0 {
+                return Ok((
+                    format!(
+                        "model = \"linear-z\"\nbottom_cm3 = {:e}\ntop_cm3 = {:e}\n",
+                        zeta(0.0),
+                        zeta(height_mm)
+                    ),
+                    format!("{k} (linear)"),
+                ));
+            }
+            // The quadratic on 81 points: linear interpolation is within quadratic h^2 / 8 of it.
+            let n = 80;
+            let z: Vec<f64> = (0..=n).map(|i| height_mm * i as f64 / n as f64).collect();
+            let values: Vec<f64> = z.iter().map(|&d| zeta(d)).collect();
             return Ok((
-                format!(
-                    "model = \"linear-z\"\nbottom_cm3 = {:e}\ntop_cm3 = {:e}\n",
-                    zeta(0.0),
-                    zeta(height_mm)
-                ),
-                format!("{k} (linear)"),
+                z_table(&z, &values),
+                format!("{k} (quadratic, on 81 points)"),
             ));
         }
-        // The quadratic on 81 points: linear interpolation is within quadratic h^2 / 8 of it.
-        let n = 80;
-        let z: Vec<f64> = (0..=n).map(|i| height_mm * i as f64 / n as f64).collect();
-        let values: Vec<f64> = z.iter().map(|&d| zeta(d)).collect();
-        return Ok((
-            z_table(&z, &values),
-            format!("{k} (quadratic, on 81 points)"),
+    }
+    // 3. hpge-cv's short form of the table.
+    if imp.get("dist_from_contact_in_mm").is_some() || imp.get("value_in_1e9e_cm3").is_some() {
+        let k = "production.impcc";
+        if let Some(r) = table(rd, imp, k, "value_in_1e9e_cm3", 1e9, &mut placeholders)? {
+            return Ok(r);
+        }
+    }
+    if placeholders.is_empty() {
+        return Err(rd.err(
+            "production.impcc",
+            "has no profile: give `array` (`dist_from_contact_in_mm`, `value_in_1e9e/cm3`) or `function_pars` (`z0_in_1e10e/cm3`, `gradient_in_1e10e/cm4`, `quadratic_in_1e10e/cm5`)",
         ));
     }
-    let dk = "production.impcc.dist_from_contact_in_mm";
-    let vk = "production.impcc.value_in_1e9e_cm3";
-    let list = |key: &str| -> Result<Vec<f64>> {
-        let x = rd
-            .get(v, key)
-            .ok_or_else(|| rd.err(key, "missing (give `function_pars` or both tables)"))?;
+    Ok(default(format!(
+        "the record's {} zero everywhere, a placeholder",
+        match placeholders.as_slice() {
+            [one] => format!("{one} is"),
+            many => format!("{} are", many.join(" and ")),
+        }
+    )))
+}
+
+/// A table of densities against the distance from the contact (`dist_from_contact_in_mm` and
+/// `value_key`, in `unit` cm^-3) under `t` (at `k` in the record): the model, or `None` with `k`
+/// added to `placeholders` when every value is zero.
+fn table(
+    rd: &Reader<'_>,
+    t: &Value,
+    k: &str,
+    value_key: &str,
+    unit: f64,
+    placeholders: &mut Vec<String>,
+) -> Result<Option<(String, String)>> {
+    let dk = format!("{k}.dist_from_contact_in_mm");
+    let vk = format!("{k}.{value_key}");
+    let list = |x: Option<&Value>, key: &str| -> Result<Vec<f64>> {
+        let x = x.ok_or_else(|| {
+            rd.err(
+                key,
+                "missing (give `function_pars` or both the distances and the values)",
+            )
+        })?;
         let a = x
             .as_array()
             .ok_or_else(|| rd.err(key, format!("must be a list of numbers, got {x}")))?;
         a.iter()
             .enumerate()
-            .map(|(i, y)| num(Some(y), &format!("{key}[{i}]")))
+            .map(|(i, y)| {
+                y.as_f64().filter(|f| f.is_finite()).ok_or_else(|| {
+                    rd.err(
+                        &format!("{key}[{i}]"),
+                        format!("must be a finite number, got {y}"),
+                    )
+                })
+            })
             .collect()
     };
-    let d = list(dk)?;
-    let val = list(vk)?;
+    let d = list(t.get("dist_from_contact_in_mm"), &dk)?;
+    let val = list(t.get(value_key), &vk)?;
     if d.len() != val.len() || d.is_empty() {
         return Err(rd.err(
-            vk,
+            &vk,
             format!(
                 "has {} values for {} distances (need the same number, at least one)",
                 val.len(),
                 d.len()
             ),
         ));
+    }
+    if val.iter().all(|x| *x == 0.0) {
+        placeholders.push(k.to_string());
+        return Ok(None);
     }
     for i in 1..d.len() {
         if d[i] <= d[i - 1] {
@@ -637,14 +742,14 @@ fn impurity(
             ));
         }
     }
-    let values: Vec<f64> = val.iter().map(|x| -x * 1e9).collect();
+    let values: Vec<f64> = val.iter().map(|x| -x * unit).collect();
     if d.len() == 1 {
-        return Ok((
+        return Ok(Some((
             format!("model = \"constant\"\nzeta_cm3 = {:e}\n", values[0]),
-            "production.impcc (one value)".to_string(),
-        ));
+            format!("{k} (one value)"),
+        )));
     }
-    Ok((z_table(&d, &values), "production.impcc tables".to_string()))
+    Ok(Some((z_table(&d, &values), format!("{k} tables"))))
 }
 
 fn z_table(z: &[f64], values: &[f64]) -> String {
@@ -846,6 +951,76 @@ mod tests {
         let m = det.semiconductor.impurity();
         assert!((m.density_cm3(20.0, 0.0) + 1.0e9).abs() < 1.0);
         assert!((m.density_cm3(20.0, 80.0) + 1.8e9).abs() < 1.0);
+    }
+
+    /// The density (cm^-3) of a record with `impcc` at r = 20 mm, z = `z_mm`, and the source line.
+    fn density_of(impcc: Value, z_mm: &[f64]) -> (Vec<f64>, String) {
+        let o = LegendOptions::default();
+        let mut v = icpc();
+        v["production"]["impcc"] = impcc;
+        let d = diode(&v, Path::new("T1.json"), &o).unwrap();
+        let text = to_toml(&d, Path::new("T1.json"), &o);
+        let det =
+            crate::Detector::from_toml_str(&text, Path::new("T1.toml"), &crate::Parameters::new())
+                .unwrap();
+        let m = det.semiconductor.impurity();
+        (
+            z_mm.iter().map(|&z| m.density_cm3(20.0, z)).collect(),
+            d.impurity_toml.1,
+        )
+    }
+
+    #[test]
+    fn legend_impcc_keys_carry_their_units() {
+        // legend-testdata's layout: `array` in 1e9 cm^-3 (taken first), `function_pars` in
+        // 1e10 cm^-3 with the distance in cm.
+        let (n, src) = density_of(
+            serde_json::json!({
+                "array": {"dist_from_contact_in_mm": [0.0, 80.0], "value_in_1e9e/cm3": [11.0, 8.0]},
+                "function_pars": {"z0_in_1e10e/cm3": 5.0, "gradient_in_1e10e/cm4": 0.0}
+            }),
+            &[0.0, 40.0, 80.0],
+        );
+        assert_eq!(src, "production.impcc.array tables");
+        for (got, want) in n.iter().zip([-11.0e9, -9.5e9, -8.0e9]) {
+            assert!((got - want).abs() < 1.0, "{got} {want}");
+        }
+        let (n, src) = density_of(
+            serde_json::json!({
+                "function_pars": {"z0_in_1e10e/cm3": 1.2, "gradient_in_1e10e/cm4": -0.1,
+                                  "quadratic_in_1e10e/cm5": 0.01}
+            }),
+            &[0.0, 40.0, 80.0],
+        );
+        assert!(src.starts_with("production.impcc.function_pars"), "{src}");
+        // 1.2 - 0.1 d + 0.01 d^2 (1e10 cm^-3, d in cm): 1.2, 0.96, 1.04 at 0, 4, 8 cm.
+        for (got, want) in n.iter().zip([-1.2e10, -0.96e10, -1.04e10]) {
+            assert!((got - want).abs() < 1e-3 * want.abs(), "{got} {want}");
+        }
+    }
+
+    #[test]
+    fn zero_profiles_are_placeholders() {
+        // V99000A in legend-testdata: zeros everywhere, distances [0, 0].
+        let (n, src) = density_of(
+            serde_json::json!({
+                "array": {"value_in_1e9e/cm3": [0.0, 0.0], "dist_from_contact_in_mm": [0.0, 0.0]},
+                "function_pars": {"z0_in_1e10e/cm3": 0, "gradient_in_1e10e/cm4": 0,
+                                  "quadratic_in_1e10e/cm5": 0}
+            }),
+            &[0.0, 80.0],
+        );
+        assert_eq!(n, vec![-1.0e10, -1.0e10]);
+        assert!(
+            src.contains("placeholder")
+                && src.contains("production.impcc.array and production.impcc.function_pars"),
+            "{src}"
+        );
+        let o = LegendOptions::default();
+        let mut v = icpc();
+        v["production"]["impcc"] = serde_json::json!({"comment": "nothing"});
+        let e = diode(&v, Path::new("D.json"), &o).unwrap_err().to_string();
+        assert!(e.contains("production.impcc") && e.contains("array"), "{e}");
     }
 
     #[test]
