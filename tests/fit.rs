@@ -154,6 +154,11 @@ fn exact_check_reweights_a_few_draws() {
     assert!(c["pareto_k"].is_number() || c["pareto_k"].is_null());
     assert_eq!(c["parameters"].as_array().unwrap().len(), 3);
     assert!(c["max_rel_diff_at_mode"].as_f64().unwrap() < 0.5);
+    // Solved to the check's own accuracy (the likelihood's 1% solver term), and recorded.
+    assert_eq!(
+        c["solver_tolerance"].as_f64(),
+        Some(hpge_inference::fit::EXACT_CHECK_TOLERANCE)
+    );
 }
 
 #[test]

@@ -74,8 +74,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         println!("  pocket: {k:?}");
     }
     println!(
-        "U_B {bias} V  c12 {:.4} pF  grid {}x{}  undepleted {}  {:.2} s",
+        "U_B {bias} V  c12 {:.4} pF  err {:.2e}  adaptive passes {}  grid {}x{}  undepleted {}  {:.2} s",
         p.c12_pf,
+        p.accuracy.c12_err_pf / p.c12_pf,
+        p.accuracy.passes,
         p.mesh.grid.nr(),
         p.mesh.grid.nz(),
         p.undepleted_nodes,

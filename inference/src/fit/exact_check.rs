@@ -54,6 +54,10 @@ pub struct ExactCheck {
     pub pass: bool,
     /// Wall time, s.
     pub seconds: f64,
+    /// Target relative error of c12 of the exact solves (the adaptive grid's tolerance), where
+    /// the caller knows it (a fit records its exact solver's).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub solver_tolerance: Option<f64>,
 }
 
 /// Runs the check on at most `n` draws (evenly thinned) and at the global mode `mode`. A solve
@@ -149,5 +153,6 @@ pub fn exact_check(
         chi2_exact_at_mode: chi2_exact,
         max_abs_shift_sd,
         seconds: start.elapsed().as_secs_f64(),
+        solver_tolerance: None,
     })
 }

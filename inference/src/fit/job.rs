@@ -61,7 +61,8 @@ pub fn file_hash(path: &Path) -> String {
 
 impl FitJob {
     /// Reads and checks data, model, prior and detector against each other; `grid` sets the
-    /// exact solver's grid and accuracy on top of the detector file's `[grid]` table.
+    /// exact solver's grid and accuracy on top of the detector file's `[grid]` table (without
+    /// either, the grid's defaults at the tolerance [`super::options::EXACT_CHECK_TOLERANCE`]).
     ///
     /// # Errors
     /// Raw pulser data instead of a curve ([`Error::Format`]), a model trained for another
@@ -94,7 +95,10 @@ impl FitJob {
         let det_context = || format!("--detector {}", detector.display());
         let det = Detector::from_file(detector, &Parameters::new())
             .map_err(|e| Error::from(e).context(det_context()))?;
-        let settings = grid.apply(&FieldSettings::default(), &det)?;
+        // The check's own accuracy unless the detector's [grid] table or --tolerance sets one.
+        let mut base = FieldSettings::default();
+        base.grid.tolerance = super::options::EXACT_CHECK_TOLERANCE;
+        let settings = grid.apply(&base, &det)?;
         let exact = ExactSolver::new(surrogate.info.space.clone(), detector, settings)
             .map_err(|e| Error::from(e).context(det_context()))?;
         let mut warnings = Vec::new();
@@ -184,7 +188,7 @@ impl FitJob {
         progress: &(dyn Fn(usize, usize) + Sync),
     ) -> Result<()> {
         let exact = ExactModel::new(self.exact.clone(), &self.data.voltage_v)?;
-        let check = exact_check(
+        let mut check = exact_check(
             &self.surrogate,
             &exact,
             &self.prior,
@@ -194,6 +198,7 @@ impl FitJob {
             draws,
             progress,
         )?;
+        check.solver_tolerance = Some(self.exact.settings.grid.tolerance);
         result.summary.seconds += check.seconds;
         result.summary.exact_check = Some(check);
         Ok(())

@@ -13,7 +13,7 @@ use crate::field::FieldSettings;
 #[cfg_attr(feature = "clap", derive(clap::Args))]
 pub struct GridOverrides {
     /// Target relative error of c12 for the adaptive grid (the detector's [grid] table, else
-    /// 0.002 = 0.2%).
+    /// 0.002 = 0.2%; for the exact solver of `fit` and `discover`, else 0.01 = 1%).
     #[cfg_attr(
         feature = "clap",
         arg(long, value_name = "REL", allow_hyphen_values = true)
