@@ -34,6 +34,9 @@ fn b_z_fit_writes_every_output() {
         assert!(!v[key].is_null(), "{key} missing: {v}");
     }
     assert_eq!(v["ndf"], 57);
+    // The share of draws where the surrogate extrapolates (issue 24's support), recorded.
+    let outside = v["posterior_outside_support"].as_f64().unwrap();
+    assert!((0.0..=1.0).contains(&outside), "{outside}");
     let params = v["parameters"].as_array().unwrap();
     let names: Vec<&str> = params.iter().map(|p| p["name"].as_str().unwrap()).collect();
     assert_eq!(names, ["d_li_mm", "y_bot", "y_top"]);

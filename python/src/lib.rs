@@ -604,7 +604,8 @@ fn measure<'py>(
 /// ("metropolis" or "nuts"), `likelihood` ("paper" or "covariance"), `chains`, `ess`, `rhat`,
 /// `max_seconds` (s), `exact_check` (re-weight `exact_draws` draws with the field solver; off by
 /// default here, on in the command line), `out` (a folder: also write every file and figure
-/// `hpge-cv fit --out` writes), `progress`.
+/// `hpge-cv fit --out` writes), `progress`, `extrapolate` (fit a curve with voltages outside the
+/// surrogate's support, as `--extrapolate`).
 ///
 /// Returns a dict: `summary` (the `summary.json` object as a dict), `names` (parameters),
 /// `draws` (array [chain, draw, parameter] in the prior's units), `ln_posterior` ([chain, draw]),
@@ -613,7 +614,7 @@ fn measure<'py>(
 #[pyo3(signature = (
     data=None, model=None, prior=None, detector=None, seed=None, sampler=None, likelihood=None,
     chains=None, ess=None, rhat=None, max_seconds=None, exact_check=false, exact_draws=None,
-    out=None, progress=None
+    out=None, progress=None, extrapolate=false
 ))]
 #[allow(clippy::too_many_arguments)]
 fn fit<'py>(
@@ -633,6 +634,7 @@ fn fit<'py>(
     exact_draws: Option<usize>,
     out: Option<PathBuf>,
     progress: Option<Bound<'py, PyAny>>,
+    extrapolate: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let d = FitOptions::default();
     let o = FitOptions {
@@ -650,6 +652,7 @@ fn fit<'py>(
         ess: ess.unwrap_or(d.ess),
         rhat: rhat.unwrap_or(d.rhat),
         max_seconds: max_seconds.unwrap_or(d.max_seconds),
+        extrapolate,
         ..d
     };
     let progress = progress_arg(progress, "fit")?;
@@ -663,6 +666,13 @@ fn fit<'py>(
         py.detach(|| -> Result<_, hpge_inference::Error> {
             o.sampler_kind()?;
             let job = FitJob::from_files(&o.files(), o.noise()?, &o.grid)?;
+            if o.extrapolate {
+                if let Err(e) = job.check_voltage_support("; fitting anyway (extrapolate=True)") {
+                    eprintln!("hpge_cv: warning: {e}");
+                }
+            } else {
+                job.check_voltage_support("; pass extrapolate=True to fit there anyway")?;
+            }
             let settings = o.settings()?;
             let mut fit = job.run(&settings, &|s| {
                 if let Progress::Stderr(_) = progress {

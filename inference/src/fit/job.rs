@@ -171,7 +171,41 @@ impl FitJob {
     /// See [`FitJob::posterior`] and [`fit`].
     pub fn run(&self, settings: &FitSettings, progress: &(dyn Fn(&Status) + Sync)) -> Result<Fit> {
         let posterior = self.posterior()?;
-        fit(&posterior, settings, self.inputs.clone(), progress)
+        let mut result = fit(&posterior, settings, self.inputs.clone(), progress)?;
+        result.summary.posterior_outside_support = Some(self.outside_support(&result.samples));
+        Ok(result)
+    }
+
+    /// The share of `samples`' draws with an input outside the surrogate's support (where fewer
+    /// than `SUPPORT_ROWS` training rows lie beyond it, issue 24): there the surrogate
+    /// extrapolates, and the posterior rests on its least accurate predictions.
+    pub fn outside_support(&self, samples: &crate::sampler::Samples) -> f64 {
+        let all = samples.all();
+        if all.is_empty() {
+            return 0.0;
+        }
+        let mut x = vec![0.0; self.prior.input_names.len()];
+        let outside = all
+            .iter()
+            .filter(|theta| {
+                self.prior.expand(theta, &mut x);
+                self.surrogate.surrogate.check_support(&x, &[]).is_err()
+            })
+            .count();
+        outside as f64 / all.len() as f64
+    }
+
+    /// The support guard for the data (issue 24): every voltage of the measured curve where the
+    /// surrogate's training rows support it (the shipped models: 13.4-2996.6 V). `hint` is
+    /// appended to the message (e.g. how to fit there anyway).
+    ///
+    /// # Errors
+    /// [`Error::Format`] naming the data file and the first voltage outside, with the support.
+    pub fn check_voltage_support(&self, hint: &str) -> Result<()> {
+        self.surrogate
+            .surrogate
+            .check_support(&[], &self.data.voltage_v)
+            .map_err(|e| Error::format(&self.files.data, format!("{e}{hint}")))
     }
 
     /// Re-weights `draws` thinned draws of `result` with the exact field solver

@@ -76,6 +76,11 @@ pub struct FitOptions {
     /// Skip the exact-solver re-weighting check.
     #[cfg_attr(feature = "clap", arg(long))]
     pub no_exact_check: bool,
+    /// Fit a curve with voltages where the surrogate's training rows thin out (outside its
+    /// support, e.g. below 13.4 V for the shipped models, where it is off by tens of percent);
+    /// without it such a curve is refused. The fit then warns.
+    #[cfg_attr(feature = "clap", arg(long))]
+    pub extrapolate: bool,
     /// Posterior draws re-weighted with the exact solver (each a curve at the data's voltages,
     /// a few seconds of one core at the check's tolerance).
     #[cfg_attr(feature = "clap", arg(long, default_value_t = DEFAULT_EXACT_DRAWS))]
@@ -123,6 +128,7 @@ impl Default for FitOptions {
             sampler: SamplerKind::default().as_str().into(),
             seed: DEFAULT_SEED,
             no_exact_check: false,
+            extrapolate: false,
             exact_draws: DEFAULT_EXACT_DRAWS,
             likelihood: NoiseKind::default().as_str().into(),
             chains: DEFAULT_CHAINS,

@@ -187,6 +187,7 @@ pub fn fit(
         modes,
         local_modes: samples.local_modes.clone(),
         exact_check: None,
+        posterior_outside_support: None,
         program_version: env!("CARGO_PKG_VERSION").into(),
         inputs,
         likelihood: settings.noise,

@@ -74,6 +74,10 @@ pub struct FitSummary {
     /// The exact-solver check (absent with --no-exact-check).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub exact_check: Option<ExactCheck>,
+    /// Share of the posterior draws with an input where the surrogate's training rows thin out
+    /// (outside its support, issue 24: there it extrapolates); absent where not computed.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub posterior_outside_support: Option<f64>,
     /// hpge-cv version.
     pub program_version: String,
     /// Inputs: the data, model and prior files (with hashes where known).

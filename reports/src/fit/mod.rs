@@ -58,7 +58,14 @@ pub fn run_fit(o: &FitOptions, observer: &dyn FitObserver) -> Result<FitRun> {
     // Every check before the output folder is made: a refused fit leaves nothing behind.
     let settings = o.settings()?;
     let noise = o.noise()?;
-    let job = FitJob::from_files(&o.files(), noise, &o.grid)?;
+    let mut job = FitJob::from_files(&o.files(), noise, &o.grid)?;
+    if o.extrapolate {
+        if let Err(e) = job.check_voltage_support("; fitting anyway (--extrapolate)") {
+            job.warnings.push(e.to_string());
+        }
+    } else {
+        job.check_voltage_support("; pass --extrapolate to fit there anyway")?;
+    }
     let truth = match &o.truth {
         Some(p) => Some(read_truth(p, &job.prior)?),
         None => None,

@@ -191,6 +191,18 @@ pub fn write_report(
         "chi^2 / ndf at the global mode: {:.1} / {} (with the likelihood's sigma, which includes the 3% measurement, 1% + 1 pF solver and sigma_p surrogate terms); max |pull| {:.2}. The median of the posterior predictive of c_p - c_m, in units of sigma_c, reaches {:.2} below 1000 V and {:.2} from 1000 V on (the paper's B_Z misfit sits below 1000 V).\n",
         sm.chi2, sm.ndf, sm.max_abs_pull, lo, hi
     );
+    if let Some(f) = sm.posterior_outside_support {
+        let _ = writeln!(
+            r,
+            "Surrogate support: {:.1}% of the posterior draws have an input where the training rows thin out (outside the surrogate's support, where it extrapolates; `hpge-cv predict` refuses such points){}.\n",
+            100.0 * f,
+            if f > 0.0 && sm.exact_check.is_some() {
+                "; the exact-solver check below says what that costs"
+            } else {
+                ""
+            }
+        );
+    }
     if let Some(c) = &sm.exact_check {
         let _ = writeln!(r, "## Exact-solver check\n");
         let _ = writeln!(
