@@ -109,6 +109,14 @@ def test_errors_are_hpge_errors_naming_the_input(tmp_path):
     with pytest.raises(hpge_cv.HpgeError, match="no-prior.toml"):
         hpge_cv.fit(prior=tmp_path / "no-prior.toml", data=ROOT / "data/super-siegfried-k1/cv.csv",
                     model=MODEL, detector=ROOT / "detectors/super-siegfried-k1.toml")
+    # A curve starting below the surrogate's support (13.4 V for the shipped models) is refused
+    # before sampling, as `hpge-cv fit` refuses it without --extrapolate.
+    low = tmp_path / "low.csv"
+    text = (ROOT / "data/super-siegfried-k1/cv.csv").read_text()
+    low.write_text(text.replace("\n25,432.5719352039185,", "\n11,432.5719352039185,"))
+    with pytest.raises(hpge_cv.HpgeError, match="low.csv.*extrapolate=True"):
+        hpge_cv.fit(data=low, model=MODEL, prior=ROOT / "priors/b-z.toml",
+                    detector=ROOT / "detectors/super-siegfried-k1.toml", progress=False)
 
 
 def test_measure_equals_the_shipped_curve():
