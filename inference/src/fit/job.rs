@@ -19,6 +19,19 @@ use crate::sampler::Status;
 use crate::{Error, Result};
 use hpge_measurement::{CvData, Data, load_data};
 
+/// Target relative error of c12 of the exact solver of a fit job (the exact-solver check of
+/// `fit`, the exact fits and checks of `discover`, the exact-solver data of `validate coverage
+/// --exact` and `validate discovery`, whose 3% noise dwarfs it; the adaptive grid's tolerance)
+/// where neither
+/// `--tolerance` nor the detector's `[grid]` table sets one: 1%, the
+/// field-solver uncertainty f_s the likelihood already carries (paper, eq. 7), so the check
+/// solves to the accuracy the likelihood assumes of a solver. The grid's estimate is an upper
+/// bound (|c12_h - c12_H| over two coarsenings): on the shipped fit's posterior draws the curves
+/// solved at 1% differ from those solved at the solver's default 0.2% by at most 0.36% (rms
+/// 0.08%), a tenth of the likelihood's sigma of about 3.3% per point, at a fifth to a tenth of
+/// the cost (reports/solver-performance.md, "The exact check of a fit").
+pub const EXACT_CHECK_TOLERANCE: f64 = 0.01;
+
 /// The four input files of a fit.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct FitFiles {
@@ -62,7 +75,7 @@ pub fn file_hash(path: &Path) -> String {
 impl FitJob {
     /// Reads and checks data, model, prior and detector against each other; `grid` sets the
     /// exact solver's grid and accuracy on top of the detector file's `[grid]` table (without
-    /// either, the grid's defaults at the tolerance [`super::options::EXACT_CHECK_TOLERANCE`]).
+    /// either, the grid's defaults at the tolerance [`EXACT_CHECK_TOLERANCE`]).
     ///
     /// # Errors
     /// Raw pulser data instead of a curve ([`Error::Format`]), a model trained for another
@@ -97,7 +110,7 @@ impl FitJob {
             .map_err(|e| Error::from(e).context(det_context()))?;
         // The check's own accuracy unless the detector's [grid] table or --tolerance sets one.
         let mut base = FieldSettings::default();
-        base.grid.tolerance = super::options::EXACT_CHECK_TOLERANCE;
+        base.grid.tolerance = EXACT_CHECK_TOLERANCE;
         let settings = grid.apply(&base, &det)?;
         let exact = ExactSolver::new(surrogate.info.space.clone(), detector, settings)
             .map_err(|e| Error::from(e).context(det_context()))?;

@@ -12,11 +12,10 @@ mod truth;
 mod zeta;
 
 pub use exact_check::{ExactCheck, ParameterShift, exact_check};
-pub use job::{FitFiles, FitJob, file_hash};
+pub use job::{EXACT_CHECK_TOLERANCE, FitFiles, FitJob, file_hash};
 pub use options::{
     DEFAULT_DATA, DEFAULT_DETECTOR, DEFAULT_EXACT_DRAWS, DEFAULT_MODEL, DEFAULT_PRIOR,
-    EXACT_CHECK_TOLERANCE, FIT_MAX_SECONDS, FitOptions, check_positive, noise_settings,
-    sampler_kind,
+    FIT_MAX_SECONDS, FitOptions, check_positive, noise_settings, sampler_kind,
 };
 pub(crate) use predictive::thin_indices;
 pub use predictive::{Predictive, predictive};

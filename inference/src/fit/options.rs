@@ -25,18 +25,6 @@ pub const DEFAULT_PRIOR: &str = "priors/b-rz.toml";
 pub const DEFAULT_DETECTOR: &str = "detectors/super-siegfried-k1.toml";
 /// Posterior draws a fit re-weights with the exact solver.
 pub const DEFAULT_EXACT_DRAWS: usize = 100;
-/// Target relative error of c12 of the exact solver of a fit job (the exact-solver check of
-/// `fit`, the exact fits and checks of `discover`, the exact-solver data of `validate coverage
-/// --exact` and `validate discovery`, whose 3% noise dwarfs it; the adaptive grid's tolerance)
-/// where neither
-/// `--tolerance` nor the detector's `[grid]` table sets one: 1%, the
-/// field-solver uncertainty f_s the likelihood already carries (paper, eq. 7), so the check
-/// solves to the accuracy the likelihood assumes of a solver. The grid's estimate is an upper
-/// bound (|c12_h - c12_H| over two coarsenings): on the shipped fit's posterior draws the curves
-/// solved at 1% differ from those solved at the solver's default 0.2% by at most 0.36% (rms
-/// 0.08%), a tenth of the likelihood's sigma of about 3.3% per point, at a fifth to a tenth of
-/// the cost (reports/solver-performance.md, "The exact check of a fit").
-pub const EXACT_CHECK_TOLERANCE: f64 = 0.01;
 /// Sampling budget (s) of a fit on the command line (`fit`, and each MCMC fit of `discover`):
 /// five minutes, so that a fit that cannot reach its targets returns (unconverged, exit code 3)
 /// while a user waits; the shipped fit converges in about 30 s. Half the library's budget
