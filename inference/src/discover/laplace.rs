@@ -33,9 +33,12 @@ pub struct LaplaceSettings {
     /// Stop after this many curve evaluations (an exact-solver curve costs ~1-2 s; a geometry
     /// parameter the grid resolves in steps can make the optimiser reject step after step).
     pub max_evaluations: usize,
-    /// Forward-difference step of parameter j: this fraction of its support's width (1e-2: the
-    /// exact solver's curve is smooth on that scale; its discretisation noise is ~1e-5
-    /// relative).
+    /// Forward-difference step of parameter j: this fraction of its support's width (1e-2).
+    /// The exact solver's curve is smooth on that scale where x and x + h are solved on the same
+    /// grids: at the fit job's 1% tolerance they almost always are (dc12/dd_Li at the stand-in
+    /// truth equals the fixed grid's); at 0.2% an adaptive pass that differs between the two
+    /// makes jumps of ~0.1% of c12, and the derivative can be off by its own size
+    /// (`validation/examples/fd_noise.rs`, reports/solver-performance.md).
     pub fd_step: f64,
 }
 
