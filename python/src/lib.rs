@@ -666,12 +666,8 @@ fn fit<'py>(
         py.detach(|| -> Result<_, hpge_inference::Error> {
             o.sampler_kind()?;
             let job = FitJob::from_files(&o.files(), o.noise()?, &o.grid)?;
-            if o.extrapolate {
-                if let Err(e) = job.check_voltage_support("; fitting anyway (extrapolate=True)") {
-                    eprintln!("hpge_cv: warning: {e}");
-                }
-            } else {
-                job.check_voltage_support("; pass extrapolate=True to fit there anyway")?;
+            if let Some(w) = job.voltage_support_guard(o.extrapolate, "extrapolate=True")? {
+                eprintln!("hpge_cv: warning: {w}");
             }
             let settings = o.settings()?;
             let mut fit = job.run(&settings, &|s| {

@@ -6,7 +6,7 @@
 //! (the shipped data, model, prior and detector).
 
 use hpge_inference::fit::{
-    DEFAULT_DATA, DEFAULT_DETECTOR, DEFAULT_MODEL, DEFAULT_PRIOR, FitFiles, FitJob,
+    DEFAULT_DATA, DEFAULT_DETECTOR, DEFAULT_MODEL, DEFAULT_PRIOR, FitFiles, FitJob, thin_indices,
 };
 use hpge_solver::GridOverrides;
 use hpge_solver::field::{Continuation, cv_curve_with};
@@ -48,14 +48,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 .collect()
         })
         .collect();
-    let stride = (draws.len() / n).max(1);
     let nx = job.prior.input_names.len();
     let volts = &job.data.voltage_v;
     let mut total = 0.0;
-    for (i, theta) in draws
-        .iter()
-        .step_by(stride)
-        .take(n)
+    for (i, theta) in thin_indices(draws.len(), n)
+        .into_iter()
+        .map(|k| &draws[k])
         .enumerate()
         .skip(first)
         .take(count)

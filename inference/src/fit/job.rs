@@ -19,11 +19,10 @@ use crate::sampler::Status;
 use crate::{Error, Result};
 use hpge_measurement::{CvData, Data, load_data};
 
-/// Target relative error of c12 of the exact solver of a fit job (the exact-solver check of
-/// `fit`, the exact fits and checks of `discover`, the exact-solver data of `validate coverage
-/// --exact` and `validate discovery`, whose 3% noise dwarfs it; the adaptive grid's tolerance)
-/// where neither
-/// `--tolerance` nor the detector's `[grid]` table sets one: 1%, the
+/// Target relative error of c12 (the adaptive grid's tolerance) of the exact solver of a fit
+/// job, where neither `--tolerance` nor the detector's `[grid]` table sets one: the exact-solver
+/// check of `fit`, the exact fits and checks of `discover`, and the exact-solver data of
+/// `validate coverage --exact` and `validate discovery` (whose 3% noise dwarfs it). 1%, the
 /// field-solver uncertainty f_s the likelihood already carries (paper, eq. 7), so the check
 /// solves to the accuracy the likelihood assumes of a solver. The grid's estimate is an upper
 /// bound (|c12_h - c12_H| over two coarsenings): on the shipped fit's posterior draws the curves
@@ -209,16 +208,29 @@ impl FitJob {
     }
 
     /// The support guard for the data (issue 24): every voltage of the measured curve where the
-    /// surrogate's training rows support it (the shipped models: 13.4-2996.6 V). `hint` is
-    /// appended to the message (e.g. how to fit there anyway).
+    /// surrogate's training rows support it (the shipped models: 13.4-2996.6 V). Outside, the
+    /// fit is refused unless `extrapolate`, in which case the warning is returned; `flag` is how
+    /// the caller's user asks to extrapolate (`--extrapolate`, `extrapolate=True`).
     ///
     /// # Errors
-    /// [`Error::Format`] naming the data file and the first voltage outside, with the support.
-    pub fn check_voltage_support(&self, hint: &str) -> Result<()> {
-        self.surrogate
+    /// [`Error::Format`] naming the data file, the first voltage outside and the support.
+    pub fn voltage_support_guard(&self, extrapolate: bool, flag: &str) -> Result<Option<String>> {
+        let Err(e) = self
+            .surrogate
             .surrogate
             .check_support(&[], &self.data.voltage_v)
-            .map_err(|e| Error::format(&self.files.data, format!("{e}{hint}")))
+        else {
+            return Ok(None);
+        };
+        let file = self.files.data.display();
+        if extrapolate {
+            Ok(Some(format!("{file}: {e}; fitting anyway ({flag})")))
+        } else {
+            Err(Error::format(
+                &self.files.data,
+                format!("{e}; pass {flag} to fit there anyway"),
+            ))
+        }
     }
 
     /// Re-weights `draws` thinned draws of `result` with the exact field solver

@@ -17,7 +17,7 @@ pub use options::{
     DEFAULT_DATA, DEFAULT_DETECTOR, DEFAULT_EXACT_DRAWS, DEFAULT_MODEL, DEFAULT_PRIOR,
     FIT_MAX_SECONDS, FitOptions, check_positive, noise_settings, sampler_kind,
 };
-pub(crate) use predictive::thin_indices;
+pub use predictive::thin_indices;
 pub use predictive::{Predictive, predictive};
 pub use run::{Fit, FitSettings, draw_range, fit};
 pub use summary::{FitSummary, LEVELS, ModeSummary, ParameterSummary};

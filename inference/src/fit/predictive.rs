@@ -37,8 +37,9 @@ fn quantile(sorted: &[f64], q: f64) -> f64 {
     sorted[i] + (h - i as f64) * (sorted[j] - sorted[i])
 }
 
-/// Evenly spaced indices of at most `n` of `total` draws.
-pub(crate) fn thin_indices(total: usize, n: usize) -> Vec<usize> {
+/// Evenly spaced indices of at most `n` of `total` draws (the draws the exact-solver check, the
+/// posterior predictive and discover's fits use).
+pub fn thin_indices(total: usize, n: usize) -> Vec<usize> {
     let n = n.min(total).max(1);
     (0..n).map(|i| i * total / n).collect()
 }

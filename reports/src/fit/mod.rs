@@ -59,12 +59,8 @@ pub fn run_fit(o: &FitOptions, observer: &dyn FitObserver) -> Result<FitRun> {
     let settings = o.settings()?;
     let noise = o.noise()?;
     let mut job = FitJob::from_files(&o.files(), noise, &o.grid)?;
-    if o.extrapolate {
-        if let Err(e) = job.check_voltage_support("; fitting anyway (--extrapolate)") {
-            job.warnings.push(e.to_string());
-        }
-    } else {
-        job.check_voltage_support("; pass --extrapolate to fit there anyway")?;
+    if let Some(w) = job.voltage_support_guard(o.extrapolate, "--extrapolate")? {
+        job.warnings.push(w);
     }
     let truth = match &o.truth {
         Some(p) => Some(read_truth(p, &job.prior)?),
