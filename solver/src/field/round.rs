@@ -180,10 +180,11 @@ impl Round<'_> {
                     _ => sys.val[sys.diag_pos[u]] * xa[u],
                 })
                 .collect();
-            let x0 = factor.solve(&rhs);
-            // One response per pocket with active members: its active unknowns at 1 V.
+            // One response per pocket with active members: its active unknowns at 1 V. All
+            // right-hand sides in one solve (the factor read once).
             let act: Vec<usize> = (0..pockets.len()).filter(|&p| active_in[p]).collect();
-            let mut ys = Vec::with_capacity(act.len());
+            let mut rhss = Vec::with_capacity(1 + act.len());
+            rhss.push(rhs);
             for &p in &act {
                 let e: Vec<f64> = (0..n)
                     .map(|u| {
@@ -201,8 +202,11 @@ impl Round<'_> {
                         _ => sys.val[sys.diag_pos[u]] * e[u],
                     })
                     .collect();
-                ys.push(factor.solve(&r));
+                rhss.push(r);
             }
+            let cols: Vec<&[f64]> = rhss.iter().map(Vec::as_slice).collect();
+            let mut ys = factor.solve_many(&cols);
+            let x0 = ys.remove(0);
             // l_a = x(s_a) = x0(s_a) + sum_b l_b y_b(s_a) for the active pockets.
             let at = |v: &[f64], s: Saddle| match s {
                 Saddle::Unknown(k) => v[k],

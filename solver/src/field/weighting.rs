@@ -224,17 +224,25 @@ pub fn weighting_potentials(
     } else {
         None
     };
-    let mut w = Vec::with_capacity(nc);
-    let mut owned = Vec::with_capacity(nc);
-    for k in 0..nc {
-        let mine: Vec<bool> = own.iter().map(|o| *o == Some(Owner::Contact(k))).collect();
-        let fixed: Vec<f64> = mine.iter().map(|&m| if m { 1.0 } else { 0.0 }).collect();
-        let x = match &llt {
-            Some(llt) => llt.solve(&sys.rhs_for_fixed(mesh, &fixed)),
-            None => Vec::new(),
-        };
-        w.push(sys.to_nodes_with(&x, &fixed));
-        owned.push(mine);
-    }
+    let owned: Vec<Vec<bool>> = (0..nc)
+        .map(|k| own.iter().map(|o| *o == Some(Owner::Contact(k))).collect())
+        .collect();
+    let fixed: Vec<Vec<f64>> = owned
+        .iter()
+        .map(|mine| mine.iter().map(|&m| f64::from(u8::from(m))).collect())
+        .collect();
+    // Every contact's right-hand side in one solve (the factor read once).
+    let xs = match &llt {
+        Some(llt) => {
+            let rhs: Vec<Vec<f64>> = fixed.iter().map(|f| sys.rhs_for_fixed(mesh, f)).collect();
+            llt.solve_many(&rhs.iter().map(Vec::as_slice).collect::<Vec<_>>())
+        }
+        None => vec![Vec::new(); nc],
+    };
+    let w = xs
+        .iter()
+        .zip(&fixed)
+        .map(|(x, f)| sys.to_nodes_with(x, f))
+        .collect();
     Ok(WeightingPotentials { w, owned })
 }

@@ -112,14 +112,29 @@ pub(crate) fn flood(
     let mut in_depression = vec![false; nn];
     let mut pour = vec![None; nn];
     let mut heap = BinaryHeap::new();
+    // The smallest entry pushed so far for each node not yet done (level, from): a larger one
+    // can never be the first popped for that node, so it is not pushed. The same entries pop
+    // first as without the filter (the answer is unchanged); the heap holds about one entry
+    // per node instead of up to four (`BinaryHeap::pop` was 9% of a pocket point, `perf`).
+    let mut pending: Vec<(f64, usize)> = vec![(f64::INFINITY, usize::MAX); nn];
+    let mut push = |heap: &mut BinaryHeap<Reverse<Entry>>, e: Entry| {
+        let best = &mut pending[e.node];
+        if e.level.total_cmp(&best.0).then(e.from.cmp(&best.1)) == Ordering::Less {
+            *best = (e.level, e.from);
+            heap.push(Reverse(e));
+        }
+    };
     for d in (0..nn).filter(|&d| is_drain(mesh, phi_v, d, drain_v, tol_v)) {
         for m in neighbours(nr, nz, d) {
             if semi(m) && mesh.edge_conducts(d, m) {
-                heap.push(Reverse(Entry {
-                    level: v(d).max(v(m)),
-                    node: m,
-                    from: d,
-                }));
+                push(
+                    &mut heap,
+                    Entry {
+                        level: v(d).max(v(m)),
+                        node: m,
+                        from: d,
+                    },
+                );
             }
         }
     }
@@ -140,11 +155,14 @@ pub(crate) fn flood(
         }
         for m in neighbours(nr, nz, node) {
             if !done[m] && semi(m) && mesh.edge_conducts(node, m) {
-                heap.push(Reverse(Entry {
-                    level: level.max(v(m)),
-                    node: m,
-                    from: node,
-                }));
+                push(
+                    &mut heap,
+                    Entry {
+                        level: level.max(v(m)),
+                        node: m,
+                        from: node,
+                    },
+                );
             }
         }
     }
