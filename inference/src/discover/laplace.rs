@@ -11,9 +11,9 @@
 //! -ln p, prior rows included),
 //!   ln Z ~ ln p(theta*) + ln L(theta*) + (d/2) ln(2 pi) - (1/2) ln det H,
 //! and the posterior ~ N(theta*, H^-1). Models without a Jacobian (the exact solver) get forward
-//! differences, their columns computed in parallel.
+//! differences from [`crate::CvModel::curves_near`]: the exact solver solves the steps on the
+//! grids of theta's curve, so the differences are smooth in theta.
 
-use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::numerics::Cholesky;
@@ -102,26 +102,26 @@ fn curve_and_jacobian(
         }
         return Ok((c, jt));
     }
-    posterior.model.curve(&x, &mut c)?;
-    let columns: Vec<Result<(usize, f64, Vec<f64>)>> = (0..d)
-        .into_par_iter()
-        .map(|j| {
-            let s = prior.parameters[j].support;
-            let mut h = fd_step * (s[1] - s[0]);
-            if theta[j] + h > s[1] {
-                h = -h;
-            }
-            let mut t = theta.to_vec();
-            t[j] += h;
-            let mut xj = vec![0.0; nx];
-            prior.expand(&t, &mut xj);
-            let mut cj = vec![0.0; nv];
-            posterior.model.curve(&xj, &mut cj)?;
-            Ok((j, h, cj))
-        })
-        .collect();
-    for col in columns {
-        let (j, h, cj) = col?;
+    // Forward differences: the steps' curves from the model's nearby-curve method (the exact
+    // solver solves them on x's grids, so a grid change cannot masquerade as a derivative).
+    let mut steps = Vec::with_capacity(d);
+    let mut xs = Vec::with_capacity(d);
+    for j in 0..d {
+        let s = prior.parameters[j].support;
+        let mut h = fd_step * (s[1] - s[0]);
+        if theta[j] + h > s[1] {
+            h = -h;
+        }
+        let mut t = theta.to_vec();
+        t[j] += h;
+        let mut xj = vec![0.0; nx];
+        prior.expand(&t, &mut xj);
+        steps.push(h);
+        xs.push(xj);
+    }
+    let (c0, near) = posterior.model.curves_near(&x, &xs)?;
+    c.copy_from_slice(&c0);
+    for (j, (h, cj)) in steps.iter().zip(&near).enumerate() {
         for k in 0..nv {
             jt[k * d + j] = (cj[k] - c[k]) / h;
         }

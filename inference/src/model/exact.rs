@@ -1,6 +1,8 @@
 //! The exact field solver as a [`CvModel`] (slow: about a second per 60-point curve on two
 //! cores; used to check a surrogate posterior, never to sample one).
 
+use hpge_solver::Detector;
+use hpge_solver::field::{Continuation, cv_curves_near};
 use hpge_surrogate::ExactSolver;
 
 use super::CvModel;
@@ -95,4 +97,45 @@ impl CvModel for ExactModel {
     fn describe(&self) -> String {
         format!("exact solver ({})", self.solver.detector_file.display())
     }
+
+    /// The nearby curves on `x`'s grids ([`near_curves`]).
+    fn curves_near(&self, x: &[f64], near: &[Vec<f64>]) -> Result<(Vec<f64>, Vec<Vec<f64>>)> {
+        check_domain(&self.names, &self.domain, x)?;
+        for xn in near {
+            check_domain(&self.names, &self.domain, xn)?;
+        }
+        let det = self.solver.detector(x)?;
+        let dets = near
+            .iter()
+            .map(|xn| self.solver.detector(xn))
+            .collect::<hpge_surrogate::Result<Vec<_>>>()?;
+        near_curves(&det, &dets, self)
+    }
+}
+
+/// c12 of `det` along `model`'s voltages and of every detector of `near` on its grids
+/// (`hpge_solver::field::cv_curves_near`, seeded continuation as [`ExactSolver::curve`]).
+pub(crate) fn near_curves(
+    det: &Detector,
+    near: &[Detector],
+    model: &ExactModel,
+) -> Result<(Vec<f64>, Vec<Vec<f64>>)> {
+    let nc = cv_curves_near(
+        det,
+        near,
+        &model.volts,
+        &model.solver.settings,
+        Continuation::Seeded,
+    )
+    .map_err(|e| Error::Surrogate(e.into()))?;
+    if nc.base.points.len() != model.volts.len() {
+        return Err(Error::Argument {
+            name: "voltages".into(),
+            message: "the voltages must be positive, increasing and distinct".into(),
+        });
+    }
+    Ok((
+        nc.base.points.iter().map(|p| p.c12_pf).collect(),
+        nc.near_pf,
+    ))
 }

@@ -6,7 +6,7 @@ mod exact;
 mod surrogate;
 
 pub use exact::ExactModel;
-pub(crate) use exact::check_domain;
+pub(crate) use exact::{check_domain, near_curves};
 pub use surrogate::SurrogateModel;
 
 use crate::Result;
@@ -35,4 +35,23 @@ pub trait CvModel: Send + Sync {
     fn curve_jacobian(&self, x: &[f64], c_pf: &mut [f64], jac: &mut [f64]) -> Result<()>;
     /// A short description for reports (file, recipe, ...).
     fn describe(&self) -> String;
+    /// c12 (pF) at `x` and at every point of `near` (points close to `x`: forward-difference
+    /// steps), as (c(x), [c(near_0), ...]). By default each curve is its own
+    /// [`CvModel::curve`] (the nearby ones in parallel). The exact solver overrides it: the
+    /// nearby curves are solved on `x`'s grids (`hpge_solver::field::cv_curves_near`), so their
+    /// differences from c(x) are those of one discretisation, not of two adaptive grids.
+    fn curves_near(&self, x: &[f64], near: &[Vec<f64>]) -> Result<(Vec<f64>, Vec<Vec<f64>>)> {
+        use rayon::prelude::*;
+        let nv = self.voltages().len();
+        let mut c = vec![0.0; nv];
+        self.curve(x, &mut c)?;
+        let others = near
+            .par_iter()
+            .map(|xn| {
+                let mut cn = vec![0.0; nv];
+                self.curve(xn, &mut cn).map(|()| cn)
+            })
+            .collect::<Result<Vec<_>>>()?;
+        Ok((c, others))
+    }
 }

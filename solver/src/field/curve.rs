@@ -9,6 +9,7 @@ use super::point::{Seed, solve_point_with};
 use super::settings::FieldSettings;
 use crate::detector::Detector;
 use crate::error::{Error, Result};
+use crate::grid::Grid;
 
 /// One point of a C-V curve.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -107,6 +108,22 @@ pub fn cv_curve_with(
     continuation: Continuation,
     progress: impl Fn(usize, usize) + Sync,
 ) -> Result<CvCurve> {
+    Ok(curve_keeping(det, volts, settings, continuation, false, progress)?.0)
+}
+
+/// The final grid and potential (V, one value per node) of one point of a curve.
+pub(crate) type KeptPoint = (Grid, Vec<f64>);
+
+/// [`cv_curve_with`], also returning every point's final grid and potential where `keep` is
+/// set (empty otherwise): what [`super::near`] solves nearby parameter points on.
+pub(crate) fn curve_keeping(
+    det: &Detector,
+    volts: &[f64],
+    settings: &FieldSettings,
+    continuation: Continuation,
+    keep: bool,
+    progress: impl Fn(usize, usize) + Sync,
+) -> Result<(CvCurve, Vec<KeptPoint>)> {
     use rayon::prelude::*;
     use std::sync::atomic::{AtomicUsize, Ordering};
     let volts = normalise_voltages(volts)?;
@@ -115,9 +132,9 @@ pub fn cv_curve_with(
         .max(1);
     let size = volts.len().div_ceil(chunks);
     let done = AtomicUsize::new(0);
-    // Each chunk returns its points and the mesh of its first fully depleted point (for the
-    // full-depletion voltage).
-    type Part = (Vec<CvPoint>, Option<Mesh>);
+    // Each chunk returns its points, the mesh of its first fully depleted point (for the
+    // full-depletion voltage) and the kept grids and potentials.
+    type Part = (Vec<CvPoint>, Option<Mesh>, Vec<KeptPoint>);
     let parts: Vec<Result<Part>> = volts
         .par_chunks(size)
         .map(|chunk| {
@@ -125,6 +142,7 @@ pub fn cv_curve_with(
             let mut prev: Option<Seed> = None;
             let mut depleted_mesh: Option<Mesh> = None;
             let mut depleted_stage = None;
+            let mut kept = Vec::new();
             for (k, &v) in chunk.iter().enumerate() {
                 let start = std::time::Instant::now();
                 let p = solve_point_with(det, v, settings, prev.as_ref(), &mut depleted_stage)?;
@@ -147,20 +165,25 @@ pub fn cv_curve_with(
                 if depleted_mesh.is_none() && p.fully_depleted() {
                     depleted_mesh = Some(p.mesh.clone());
                 }
+                if keep {
+                    kept.push((p.mesh.grid.clone(), p.potential.phi_v.clone()));
+                }
                 if continuation == Continuation::Seeded {
                     prev = Some(p.seed(scale));
                 }
                 progress(done.fetch_add(1, Ordering::Relaxed) + 1, volts.len());
             }
-            Ok((points, depleted_mesh))
+            Ok((points, depleted_mesh, kept))
         })
         .collect();
     let mut points = Vec::with_capacity(volts.len());
     let mut depleted_mesh = None;
+    let mut kept = Vec::new();
     for part in parts {
-        let (pts, mesh) = part?;
+        let (pts, mesh, k) = part?;
         points.extend(pts);
         depleted_mesh = depleted_mesh.or(mesh);
+        kept.extend(k);
     }
     // The first chunk with a fully depleted point holds the first such point overall.
     let depletion_voltage_v = match (points.iter().position(|p| p.fully_depleted), depleted_mesh) {
@@ -170,10 +193,13 @@ pub fn cv_curve_with(
         }
         _ => None,
     };
-    Ok(CvCurve {
-        points,
-        depletion_voltage_v,
-    })
+    Ok((
+        CvCurve {
+            points,
+            depletion_voltage_v,
+        },
+        kept,
+    ))
 }
 
 /// Fewest voltages per parallel chunk (the first point of a chunk has no seed).

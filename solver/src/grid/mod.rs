@@ -2,6 +2,7 @@
 //! spacing ratio, refinement where neighbouring potential differences are large.
 
 mod axis;
+mod deform;
 mod overrides;
 mod settings;
 mod tensor;

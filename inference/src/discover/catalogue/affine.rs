@@ -95,6 +95,24 @@ impl CvModel for Affine {
         self.inner.has_jacobian()
     }
 
+    /// The inner model's nearby curves (a step in `a` alone reuses c_inner(x)), then the
+    /// shift or scale of each point.
+    fn curves_near(&self, x: &[f64], near: &[Vec<f64>]) -> Result<(Vec<f64>, Vec<Vec<f64>>)> {
+        let n = x.len() - 1;
+        let moved: Vec<usize> = (0..near.len())
+            .filter(|&k| near[k][..n] != x[..n])
+            .collect();
+        let inner_near: Vec<Vec<f64>> = moved.iter().map(|&k| near[k][..n].to_vec()).collect();
+        let (c_inner, solved) = self.inner.curves_near(&x[..n], &inner_near)?;
+        let apply =
+            |c: &[f64], a: f64| -> Vec<f64> { c.iter().map(|&v| self.apply(v, a)).collect() };
+        let mut out: Vec<Vec<f64>> = near.iter().map(|xn| apply(&c_inner, xn[n])).collect();
+        for (&k, c) in moved.iter().zip(&solved) {
+            out[k] = apply(c, near[k][n]);
+        }
+        Ok((apply(&c_inner, x[n]), out))
+    }
+
     /// Shift: dc_k/dx_j = dc_inner,k/dx_j, dc_k/da = 1. Scale: dc_k/dx_j = a dc_inner,k/dx_j,
     /// dc_k/da = c_inner,k.
     fn curve_jacobian(&self, x: &[f64], c_pf: &mut [f64], jac: &mut [f64]) -> Result<()> {

@@ -6,7 +6,7 @@
 use hpge_solver::{Detector, cv_curve};
 use hpge_surrogate::ExactSolver;
 
-use crate::model::{CvModel, ExactModel, check_domain};
+use crate::model::{CvModel, ExactModel, check_domain, near_curves};
 use crate::{Error, Result};
 
 /// Applies an extension's values (`extra`, in the order of [`ExactVariant`]'s added inputs) to a
@@ -103,5 +103,19 @@ impl CvModel for ExactVariant {
 
     fn describe(&self) -> String {
         format!("{} with {}", self.base.describe(), self.label)
+    }
+
+    /// The nearby curves on `x`'s grids, as [`ExactModel`] solves them.
+    fn curves_near(&self, x: &[f64], near: &[Vec<f64>]) -> Result<(Vec<f64>, Vec<Vec<f64>>)> {
+        check_domain(&self.names, &self.domain, x)?;
+        for xn in near {
+            check_domain(&self.names, &self.domain, xn)?;
+        }
+        let det = self.detector(x)?;
+        let dets = near
+            .iter()
+            .map(|xn| self.detector(xn))
+            .collect::<Result<Vec<_>>>()?;
+        near_curves(&det, &dets, &self.base)
     }
 }
