@@ -1,14 +1,16 @@
 //! Field solver: one c12 point and the 60-point C-V curve (25..2975 V, step 50) of
 //! super-siegfried-k1 with the manufacturer impurity model and d_Li = 1 mm, default settings
 //! (adaptive to the default tolerance, 0.2%), both potential methods. The target for `fast`: the
-//! curve in <= 3 s on the 2-core machine (issue 18). Then every shipped detector type at its
-//! three biases of the accuracy table (undepleted, pinch-off window, depleted;
-//! `hpge_validation::accuracy_cases`) at the default tolerance.
+//! curve in <= 3 s on the 2-core machine (issue 18). The curve with one forward-difference step
+//! on its grids (`field::cv_curves_near`) against two adaptive curves. Then every shipped
+//! detector type at its three biases of the accuracy table (undepleted, pinch-off window,
+//! depleted; `hpge_validation::accuracy_cases`) at the default tolerance.
 
 use std::hint::black_box;
 use std::time::Duration;
 
 use criterion::Criterion;
+use hpge_solver::field::{Continuation, cv_curves_near};
 use hpge_solver::{Detector, FieldSettings, Method, Parameters, cv_curve, solve_point};
 use hpge_validation::{accuracy_cases, repo_path};
 
@@ -35,6 +37,33 @@ pub fn bench(c: &mut Criterion) {
             b.iter(|| cv_curve(&det, black_box(&volts), &s, |_, _| {}).expect("solves"))
         });
     }
+    // A forward-difference step of `discover`'s exact quick fits: the curve and the curve at
+    // d_Li + 0.048 mm (1% of the paper's prior range) on its grids (`field::cv_curves_near`),
+    // against the two curves solved adaptively.
+    let mut stepped = Parameters::new();
+    stepped.set("d_li_mm", 1.048);
+    let near = Detector::from_file(&repo_path("detectors/super-siegfried-k1.toml"), &stepped)
+        .expect("shipped detector loads");
+    let s = FieldSettings::default();
+    g.bench_function("curve_60_and_step/near", |b| {
+        b.iter(|| {
+            cv_curves_near(
+                &det,
+                std::slice::from_ref(&near),
+                black_box(&volts),
+                &s,
+                Continuation::Seeded,
+            )
+            .expect("solves")
+        })
+    });
+    g.bench_function("curve_60_and_step/adaptive", |b| {
+        b.iter(|| {
+            let c0 = cv_curve(&det, black_box(&volts), &s, |_, _| {}).expect("solves");
+            let c1 = cv_curve(&near, black_box(&volts), &s, |_, _| {}).expect("solves");
+            (c0, c1)
+        })
+    });
     g.finish();
     let mut g = c.benchmark_group("detector_types");
     g.sample_size(10).measurement_time(Duration::from_secs(30));
