@@ -237,6 +237,23 @@ mod tests {
                 let want = 0.5 * t * (n as f64 + 1.0 - t);
                 assert!((xk - want).abs() < 1e-9 * want, "{k}: {xk} vs {want}");
             }
+            // Several right-hand sides at once: each column as its own solve (to round-off),
+            // the constant one the parabola above, a unit load the discrete Green's function.
+            let mut unit = vec![0.0; n];
+            unit[17] = 1.0;
+            let ramp: Vec<f64> = (0..n).map(|k| k as f64).collect();
+            let many = f.solve_many(&[&vec![1.0; n], &unit, &ramp]);
+            assert_eq!(many.len(), 3);
+            for (col, rhs) in many.iter().zip([vec![1.0; n], unit.clone(), ramp.clone()]) {
+                let one = f.solve(&rhs);
+                for (a, b) in col.iter().zip(&one) {
+                    assert!((a - b).abs() <= 1e-12 * b.abs().max(1.0), "{a} vs {b}");
+                }
+            }
+            // G(k, 17) = (k + 1)(n - 17) / (n + 1) for k <= 17.
+            let g = (n as f64 - 17.0) / (n as f64 + 1.0);
+            assert!((many[1][3] - 4.0 * g).abs() < 1e-12, "{}", many[1][3]);
+            assert!(f.solve_many(&[]).is_empty());
         }
     }
 }
