@@ -34,11 +34,13 @@ pub struct LaplaceSettings {
     /// parameter the grid resolves in steps can make the optimiser reject step after step).
     pub max_evaluations: usize,
     /// Forward-difference step of parameter j: this fraction of its support's width (1e-2).
-    /// The exact solver's curve is smooth on that scale where x and x + h are solved on the same
-    /// grids: at the fit job's 1% tolerance they almost always are (dc12/dd_Li at the stand-in
-    /// truth equals the fixed grid's); at 0.2% an adaptive pass that differs between the two
-    /// makes jumps of ~0.1% of c12, and the derivative can be off by its own size
-    /// (`validation/examples/fd_noise.rs`, reports/solver-performance.md).
+    /// The exact models solve x + h on the grids of x ([`crate::CvModel::curves_near`]), so a
+    /// grid that differs between the two (at 0.2% an adaptive pass can, a jump of ~0.1% of c12
+    /// and a derivative off by its own size, `validation/examples/fd_noise.rs`) cannot show up
+    /// as a derivative: on the base grids the impurity knots' differences agree between h and
+    /// h/2 (`validation/tests/near_derivatives.rs`). Left: a geometry step can move a cell's
+    /// centre across a slanted boundary (d_Li near Super-Siegfried's borehole cone: jumps of
+    /// 1e-3 of c12 near full depletion; reports/solver-performance.md).
     pub fd_step: f64,
 }
 
