@@ -158,10 +158,30 @@ fn exact_check_reweights_a_few_draws() {
     assert_eq!(c["parameters"].as_array().unwrap().len(), 3);
     assert!(c["max_rel_diff_at_mode"].as_f64().unwrap() < 0.5);
     // Solved to the check's own accuracy (the likelihood's 1% solver term), and recorded.
-    assert_eq!(
-        c["solver_tolerance"].as_f64(),
-        Some(hpge_inference::fit::EXACT_CHECK_TOLERANCE)
-    );
+    let tol = hpge_inference::fit::EXACT_CHECK_TOLERANCE;
+    assert_eq!(c["solver_tolerance"].as_f64(), Some(tol));
+    // By default the draws are solved on the mode's grids, and a few also on their own: the two
+    // agree within the grids' tolerance.
+    assert_eq!(c["grids"], "mode");
+    let g = &c["grid_check"];
+    assert_eq!(g["draws"], hpge_inference::fit::DEFAULT_GRID_CHECK as u64);
+    assert!(g["max_rel_diff"].as_f64().unwrap() < 2.0 * tol, "{g}");
+    assert!(g["max_abs_delta_ln_l"].as_f64().unwrap().is_finite());
+}
+
+#[test]
+fn exact_check_on_own_grids_on_request() {
+    let d = temp("fit-exact-own");
+    let o = d.join("x");
+    let stdout = ok(&run(&fit_args(
+        o.to_str().unwrap(),
+        &["--no-plots", "--exact-draws", "4", "--exact-grids", "own"],
+    )));
+    let v: serde_json::Value = serde_json::from_str(stdout.trim()).unwrap();
+    let c = &v["exact_check"];
+    assert_eq!(c["draws"], 4);
+    assert_eq!(c["grids"], "own");
+    assert!(c["grid_check"].is_null());
 }
 
 #[test]
@@ -176,6 +196,10 @@ fn bad_input_is_refused_clearly() {
     bad(
         &run(&["fit", "--likelihood", "student", "--out", o]),
         &["student"],
+    );
+    bad(
+        &run(&["fit", "--exact-grids", "nearest", "--out", o]),
+        &["--exact-grids", "nearest"],
     );
     bad(
         &run(&["fit", "--data", "nope.csv", "--out", o]),

@@ -97,7 +97,10 @@ pub mod summary;
 
 pub use discover::{DiscoverInputs, DiscoverSettings, Discovery, Progress, discover};
 pub use error::{Error, Result};
-pub use fit::{Fit, FitFiles, FitJob, FitOptions, FitSettings, exact_check, fit};
+pub use fit::{
+    ExactCheckSettings, ExactGrids, Fit, FitFiles, FitJob, FitOptions, FitSettings, exact_check,
+    fit,
+};
 pub use hpge_measurement::CvData;
 pub use model::{CvModel, ExactModel, SurrogateModel};
 pub use posterior::{Likelihood, NoiseSettings, Posterior};

@@ -148,3 +148,43 @@ fn a_prior_outside_the_models_domain_is_refused() {
         assert!(e.contains(needle), "`{needle}` not in: {e}");
     }
 }
+
+/// The exact model's nearby curves (what the exact-solver check solves its draws with): a draw
+/// outside the domain is its own recoverable error, not the call's; the others are solved on the
+/// base point's grids and agree with their own adaptive curves within the solver tolerance (1%
+/// at the check's default), and the base curve is the model's own curve.
+#[test]
+fn exact_nearby_curves_keep_each_draw_apart_and_agree_with_own_grids() {
+    let o = shipped("priors/b-rz.toml");
+    let job = FitJob::from_files(&o.files(), o.noise().unwrap(), &o.grid).unwrap();
+    let volts = [225.0, 1025.0, 2525.0];
+    let exact = hpge_inference::ExactModel::new(job.exact.clone(), &volts).unwrap();
+    let x = vec![3.0, 0.66, 0.62, 0.57, -0.3, 0.54, 0.58, 0.47, -0.2];
+    let mut near = x.clone();
+    near[1] += 0.02;
+    near[4] += 0.2;
+    let mut outside = x.clone();
+    outside[0] = 99.0;
+    let reached = std::sync::atomic::AtomicUsize::new(0);
+    let (c0, others) = exact
+        .curves_near(&x, &[near.clone(), outside], &|done, total| {
+            assert!(done <= total && total == 3);
+            reached.fetch_max(done, std::sync::atomic::Ordering::Relaxed);
+        })
+        .unwrap();
+    assert_eq!(reached.into_inner(), 3, "the progress reaches every curve");
+    let mut own = vec![0.0; volts.len()];
+    exact.curve(&x, &mut own).unwrap();
+    assert_eq!(c0, own);
+    let e = others[1].as_ref().unwrap_err();
+    assert!(e.is_recoverable(), "{e}");
+    let on_base = others[0].as_ref().unwrap();
+    exact.curve(&near, &mut own).unwrap();
+    let tol = job.exact.settings.grid.tolerance;
+    for (a, b) in on_base.iter().zip(&own) {
+        assert!(
+            ((a - b) / b).abs() < 2.0 * tol,
+            "{a} on the base grids, {b} on its own"
+        );
+    }
+}

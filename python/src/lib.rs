@@ -681,7 +681,7 @@ fn fit<'py>(
                 }
             })?;
             if !o.no_exact_check {
-                job.check_exact(&mut fit, o.exact_draws, &|done, total| {
+                job.check_exact(&mut fit, &o.exact_check()?, &|done, total| {
                     progress.report(done, total)
                 })?;
             }

@@ -121,7 +121,8 @@ fn curve_and_jacobian(
         steps.push(h);
         xs.push(xj);
     }
-    let (c0, near) = posterior.model.curves_near(&x, &xs)?;
+    let (c0, near) = posterior.model.curves_near(&x, &xs, &|_, _| {})?;
+    let near = near.into_iter().collect::<Result<Vec<_>>>()?;
     c.copy_from_slice(&c0);
     for (j, (h, cj)) in steps.iter().zip(&near).enumerate() {
         for k in 0..nv {

@@ -5,11 +5,24 @@
 //! (PSIS, Vehtari et al. 2024): k-hat < 0.7 means the re-weighted estimates are reliable, and
 //! the shift of each mean, (E_w[theta] - E[theta]) / sd[theta], says how far the surrogate moved
 //! the posterior.
+//!
+//! Where the exact curves are solved ([`ExactGrids`]): by default every draw is solved on the
+//! global mode's final grids (`hpge_solver::field::cv_curves_near_each`: the mode's adaptive
+//! curve first, then each draw once per voltage on those grids, carried along with the geometry,
+//! seeded by the mode's potentials, without refinement). The draws of a posterior lie close to
+//! each other, so one refined grid serves them all; their likelihoods then differ by the physics
+//! alone, not by which refinement pass each draw's own grid happened to stop at (up to the
+//! solver tolerance, 1% at the check's default, in c12), and the check costs one potential solve
+//! and one weighting stage per point instead of the adaptive passes and the error estimate's
+//! two coarsened grids. A few draws ([`ExactCheckSettings::grid_check`]) are also solved on
+//! their own adaptive grids, and the difference is reported ([`GridCheck`]).
 
 use std::time::Instant;
 
 use rayon::prelude::*;
 use serde::Serialize;
+
+use crate::Error;
 
 use super::predictive::thin_indices;
 use crate::Result;
@@ -19,6 +32,84 @@ use crate::prior::Prior;
 use crate::rejection::unless_rejected;
 use crate::sampler::Samples;
 use crate::summary::psis;
+
+/// Where the check solves the exact curves of the draws.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ExactGrids {
+    /// On the global mode's final grids (see the module text): the default.
+    #[default]
+    Mode,
+    /// Each draw on its own adaptive grids (a full `ExactModel::curve` per draw).
+    Own,
+}
+
+impl ExactGrids {
+    /// The name on the command line and in the summary.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Self::Mode => "mode",
+            Self::Own => "own",
+        }
+    }
+
+    /// Parses `mode` or `own`.
+    ///
+    /// # Errors
+    /// [`Error::BadOption`] naming `--exact-grids` and the value.
+    pub fn parse(name: &str) -> crate::Result<Self> {
+        match name {
+            "mode" => Ok(Self::Mode),
+            "own" => Ok(Self::Own),
+            other => Err(Error::BadOption {
+                option: format!("--exact-grids {other}"),
+                message: "expected mode (every draw on the mode's grids) or own (each draw on its own adaptive grids)".into(),
+            }),
+        }
+    }
+}
+
+/// Draws of the check also solved on their own grids when the others share the mode's
+/// ([`ExactGrids::Mode`]): four, enough to see the size of the grids' difference at a few
+/// percent of the check's cost.
+pub const DEFAULT_GRID_CHECK: usize = 4;
+
+/// How the exact-solver check runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ExactCheckSettings {
+    /// Draws re-weighted (evenly thinned), at least 1.
+    pub draws: usize,
+    /// Where their exact curves are solved.
+    pub grids: ExactGrids,
+    /// With [`ExactGrids::Mode`]: how many of the draws (evenly spread) are solved on their own
+    /// adaptive grids too, for [`GridCheck`] (0: none).
+    pub grid_check: usize,
+}
+
+impl Default for ExactCheckSettings {
+    fn default() -> Self {
+        Self {
+            draws: super::options::DEFAULT_EXACT_DRAWS,
+            grids: ExactGrids::default(),
+            grid_check: DEFAULT_GRID_CHECK,
+        }
+    }
+}
+
+/// The draws solved both on the mode's grids and on their own: how much the choice of grid
+/// moves the check's inputs.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct GridCheck {
+    /// Draws solved both ways (those whose both solves succeeded).
+    pub draws: usize,
+    /// Largest |c_own - c_mode| / c_own over those draws and the voltages.
+    pub max_rel_diff: f64,
+    /// Largest |ln L_own - ln L_mode| (exact likelihood) over those draws: what the choice
+    /// changes in an importance log-ratio.
+    pub max_abs_delta_ln_l: f64,
+    /// Wall time of the own-grid solves, s.
+    pub seconds: f64,
+}
 
 /// One parameter's shift.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -54,15 +145,22 @@ pub struct ExactCheck {
     pub pass: bool,
     /// Wall time, s.
     pub seconds: f64,
+    /// Where the draws' exact curves were solved.
+    pub grids: ExactGrids,
+    /// With [`ExactGrids::Mode`] and a grid check: the own-grid comparison.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub grid_check: Option<GridCheck>,
     /// Target relative error of c12 of the exact solves (the adaptive grid's tolerance), where
     /// the caller knows it (a fit records its exact solver's).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub solver_tolerance: Option<f64>,
 }
 
-/// Runs the check on at most `n` draws (evenly thinned) and at the global mode `mode`. A solve
-/// that fails recoverably gives its draw weight 0 (a surrogate curve that fails, NaN); any
-/// other model error is returned.
+/// Runs the check on at most `settings.draws` draws (evenly thinned) and at the global mode
+/// `mode`, their exact curves solved where `settings.grids` says. A solve that fails
+/// recoverably gives its draw weight 0 (a surrogate curve that fails, NaN); any other model
+/// error is returned. With [`ExactGrids::Mode`], a mode whose own curve fails recoverably sends
+/// every draw to its own grids.
 #[allow(clippy::too_many_arguments)]
 pub fn exact_check(
     surrogate: &dyn CvModel,
@@ -71,42 +169,93 @@ pub fn exact_check(
     likelihood: &Likelihood,
     samples: &Samples,
     mode: &[f64],
-    n: usize,
+    settings: &ExactCheckSettings,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<ExactCheck> {
     let start = Instant::now();
     let exact_like = likelihood.with_sigma_rel(exact.sigma_rel());
     let all = samples.all();
-    let idx = thin_indices(all.len(), n);
+    let idx = thin_indices(all.len(), settings.draws);
     let nv = likelihood.len();
     let nx = prior.input_names.len();
-    let done = std::sync::atomic::AtomicUsize::new(0);
-    let total = idx.len() + 1;
-    let eval = |model: &dyn CvModel, theta: &[f64]| -> Result<Vec<f64>> {
+    let expand = |theta: &[f64]| -> Vec<f64> {
         let mut x = vec![0.0; nx];
         prior.expand(theta, &mut x);
+        x
+    };
+    let eval = |model: &dyn CvModel, theta: &[f64]| -> Result<Vec<f64>> {
         let mut c = vec![0.0; nv];
-        model.curve(&x, &mut c)?;
+        model.curve(&expand(theta), &mut c)?;
         Ok(c)
     };
     let mut points: Vec<&[f64]> = idx.iter().map(|&i| all[i]).collect();
     points.push(mode);
-    let results: Vec<(f64, Option<Vec<f64>>, Vec<f64>)> = points
+    let surrogate_curves: Vec<Vec<f64>> = points
         .par_iter()
-        .map(|theta| -> Result<_> {
-            let cs = unless_rejected(eval(surrogate, theta))?.unwrap_or_else(|| vec![f64::NAN; nv]);
-            let ce = unless_rejected(eval(exact, theta))?;
+        .map(|theta| {
+            Ok(unless_rejected(eval(surrogate, theta))?.unwrap_or_else(|| vec![f64::NAN; nv]))
+        })
+        .collect::<Result<_>>()?;
+    let own = |pts: &[&[f64]],
+               progress: &(dyn Fn(usize, usize) + Sync)|
+     -> Result<Vec<Option<Vec<f64>>>> {
+        let done = std::sync::atomic::AtomicUsize::new(0);
+        pts.par_iter()
+            .map(|theta| {
+                let c = unless_rejected(eval(exact, theta));
+                progress(
+                    done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1,
+                    pts.len(),
+                );
+                c
+            })
+            .collect()
+    };
+    let mut grids = settings.grids;
+    let mut exact_curves = None;
+    if grids == ExactGrids::Mode {
+        let xs: Vec<Vec<f64>> = points[..points.len() - 1]
+            .iter()
+            .map(|t| expand(t))
+            .collect();
+        // The mode's curve first (progress 1 of n + 1), then the draws.
+        match unless_rejected(exact.curves_near(&expand(mode), &xs, progress))? {
+            Some((c_mode, near)) => {
+                let mut v = near
+                    .into_iter()
+                    .map(unless_rejected)
+                    .collect::<Result<Vec<_>>>()?;
+                v.push(Some(c_mode));
+                exact_curves = Some(v);
+            }
+            None => grids = ExactGrids::Own,
+        }
+    }
+    let exact_curves = match exact_curves {
+        Some(v) => v,
+        None => own(&points, progress)?,
+    };
+    let grid_check = match grids {
+        ExactGrids::Mode if settings.grid_check > 0 => Some(grid_check(
+            &idx,
+            settings.grid_check,
+            &exact_curves,
+            &|k| own(&[points[k]], &|_, _| {}).map(|mut v| v.remove(0)),
+            &exact_like,
+        )?),
+        _ => None,
+    };
+    let results: Vec<(f64, Option<Vec<f64>>, Vec<f64>)> = exact_curves
+        .into_iter()
+        .zip(surrogate_curves)
+        .map(|(ce, cs)| {
             let lr = match &ce {
                 Some(c) => exact_like.ln_likelihood(c, None) - likelihood.ln_likelihood(&cs, None),
                 None => f64::NEG_INFINITY,
             };
-            progress(
-                done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1,
-                total,
-            );
-            Ok((lr, ce, cs))
+            (lr, ce, cs)
         })
-        .collect::<Result<_>>()?;
+        .collect();
     let (at_mode, draws) = results.split_last().expect("the mode is always there");
     let failed = draws.iter().filter(|r| r.1.is_none()).count();
     let log_ratios: Vec<f64> = draws
@@ -153,6 +302,45 @@ pub fn exact_check(
         chi2_exact_at_mode: chi2_exact,
         max_abs_shift_sd,
         seconds: start.elapsed().as_secs_f64(),
+        grids,
+        grid_check,
         solver_tolerance: None,
+    })
+}
+
+/// Solves `count` of the draws (evenly spread over the thinned `idx`) on their own grids with
+/// `solve_own(k)` and compares them with `on_mode[k]`, their curves on the mode's grids.
+fn grid_check(
+    idx: &[usize],
+    count: usize,
+    on_mode: &[Option<Vec<f64>>],
+    solve_own: &(dyn Fn(usize) -> Result<Option<Vec<f64>>> + Sync),
+    exact_like: &Likelihood,
+) -> Result<GridCheck> {
+    let start = Instant::now();
+    let n = idx.len();
+    let mut picks: Vec<usize> = (0..count.min(n)).map(|j| j * n / count.min(n)).collect();
+    picks.dedup();
+    let own: Vec<Option<Vec<f64>>> = picks
+        .par_iter()
+        .map(|&k| solve_own(k))
+        .collect::<Result<_>>()?;
+    let (mut draws, mut max_rel, mut max_dl) = (0, 0.0f64, 0.0f64);
+    for (&k, o) in picks.iter().zip(&own) {
+        let (Some(o), Some(m)) = (o, &on_mode[k]) else {
+            continue;
+        };
+        draws += 1;
+        for (a, b) in o.iter().zip(m) {
+            max_rel = max_rel.max(((a - b) / a).abs());
+        }
+        let dl = exact_like.ln_likelihood(o, None) - exact_like.ln_likelihood(m, None);
+        max_dl = max_dl.max(dl.abs());
+    }
+    Ok(GridCheck {
+        draws,
+        max_rel_diff: max_rel,
+        max_abs_delta_ln_l: max_dl,
+        seconds: start.elapsed().as_secs_f64(),
     })
 }

@@ -9,7 +9,7 @@ use hpge_solver::{Detector, FieldSettings, GridOverrides, Parameters};
 use hpge_surrogate::hash::fnv1a;
 use hpge_surrogate::{ExactSolver, Surrogate};
 
-use super::exact_check::exact_check;
+use super::exact_check::{ExactCheckSettings, exact_check};
 use super::run::{Fit, FitSettings, fit};
 use super::zeta::{ZetaAtMode, zeta_at_mode};
 use crate::model::{CvModel, ExactModel, SurrogateModel};
@@ -233,7 +233,7 @@ impl FitJob {
         }
     }
 
-    /// Re-weights `draws` thinned draws of `result` with the exact field solver
+    /// Re-weights `settings.draws` thinned draws of `result` with the exact field solver
     /// ([`exact_check`]: PSIS, Pareto k-hat, mean shifts) and records the check and its time in
     /// the summary; `progress` sees (curves done, curves in all).
     ///
@@ -243,7 +243,7 @@ impl FitJob {
     pub fn check_exact(
         &self,
         result: &mut Fit,
-        draws: usize,
+        settings: &ExactCheckSettings,
         progress: &(dyn Fn(usize, usize) + Sync),
     ) -> Result<()> {
         let exact = ExactModel::new(self.exact.clone(), &self.data.voltage_v)?;
@@ -254,7 +254,7 @@ impl FitJob {
             &self.likelihood,
             &result.samples,
             &result.mode,
-            draws,
+            settings,
             progress,
         )?;
         check.solver_tolerance = Some(self.exact.settings.grid.tolerance);

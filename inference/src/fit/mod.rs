@@ -11,7 +11,10 @@ mod summary;
 mod truth;
 mod zeta;
 
-pub use exact_check::{ExactCheck, ParameterShift, exact_check};
+pub use exact_check::{
+    DEFAULT_GRID_CHECK, ExactCheck, ExactCheckSettings, ExactGrids, GridCheck, ParameterShift,
+    exact_check,
+};
 pub use job::{EXACT_CHECK_TOLERANCE, FitFiles, FitJob, file_hash};
 pub use options::{
     DEFAULT_DATA, DEFAULT_DETECTOR, DEFAULT_EXACT_DRAWS, DEFAULT_MODEL, DEFAULT_PRIOR,

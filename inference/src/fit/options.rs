@@ -6,6 +6,7 @@ use std::path::PathBuf;
 
 use hpge_solver::GridOverrides;
 
+use super::exact_check::{DEFAULT_GRID_CHECK, ExactCheckSettings, ExactGrids};
 use super::job::FitFiles;
 use super::run::FitSettings;
 use crate::posterior::{NoiseKind, NoiseSettings};
@@ -73,6 +74,15 @@ pub struct FitOptions {
     /// a few seconds of one core at the check's tolerance).
     #[cfg_attr(feature = "clap", arg(long, default_value_t = DEFAULT_EXACT_DRAWS))]
     pub exact_draws: usize,
+    /// Where the check solves the draws' exact curves: mode (every draw on the global mode's
+    /// refined grids, carried with the geometry; a few draws also on their own grids to show the
+    /// difference) or own (each draw on its own adaptive grids, several times slower).
+    #[cfg_attr(feature = "clap", arg(long, default_value = ExactGrids::default().as_str()))]
+    pub exact_grids: String,
+    /// With --exact-grids mode: draws also solved on their own adaptive grids to measure the
+    /// grids' difference (0: none).
+    #[cfg_attr(feature = "clap", arg(long, default_value_t = DEFAULT_GRID_CHECK))]
+    pub exact_grid_check: usize,
     /// Likelihood: paper (independent, 3% measurement term) or covariance (the measured
     /// covariance instead of the 3% term).
     #[cfg_attr(feature = "clap", arg(long, default_value = NoiseKind::default().as_str()))]
@@ -118,6 +128,8 @@ impl Default for FitOptions {
             no_exact_check: false,
             extrapolate: false,
             exact_draws: DEFAULT_EXACT_DRAWS,
+            exact_grids: ExactGrids::default().as_str().into(),
+            exact_grid_check: DEFAULT_GRID_CHECK,
             likelihood: NoiseKind::default().as_str().into(),
             chains: DEFAULT_CHAINS,
             ess: DEFAULT_ESS_MIN,
@@ -169,6 +181,19 @@ impl FitOptions {
         noise_settings(&self.likelihood)
     }
 
+    /// The exact-solver check's settings (`--exact-draws`, `--exact-grids`,
+    /// `--exact-grid-check`).
+    ///
+    /// # Errors
+    /// [`Error::BadOption`] for an unknown `--exact-grids`.
+    pub fn exact_check(&self) -> Result<ExactCheckSettings> {
+        Ok(ExactCheckSettings {
+            draws: self.exact_draws,
+            grids: ExactGrids::parse(&self.exact_grids)?,
+            grid_check: self.exact_grid_check,
+        })
+    }
+
     /// Checks the numbers a user gives, naming the flag: `--max-seconds` and `--ess` must be
     /// positive and finite, `--exact-draws` at least 1 (unless `--no-exact-check`), and the
     /// sampler and likelihood known names.
@@ -178,6 +203,7 @@ impl FitOptions {
     pub fn validate(&self) -> Result<()> {
         self.sampler_kind()?;
         self.noise()?;
+        self.exact_check()?;
         if self.chains < 2 {
             return Err(Error::BadOption {
                 option: format!("--chains {}", self.chains),

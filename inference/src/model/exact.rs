@@ -2,10 +2,10 @@
 //! cores; used to check a surrogate posterior, never to sample one).
 
 use hpge_solver::Detector;
-use hpge_solver::field::{Continuation, cv_curves_near};
+use hpge_solver::field::{Continuation, cv_curves_near_each};
 use hpge_surrogate::ExactSolver;
 
-use super::CvModel;
+use super::{CvModel, NearCurves};
 use crate::{Error, Result};
 
 /// The exact solver at the points of a parameter space, bound to the measured voltages.
@@ -99,33 +99,47 @@ impl CvModel for ExactModel {
     }
 
     /// The nearby curves on `x`'s grids ([`near_curves`]).
-    fn curves_near(&self, x: &[f64], near: &[Vec<f64>]) -> Result<(Vec<f64>, Vec<Vec<f64>>)> {
+    fn curves_near(
+        &self,
+        x: &[f64],
+        near: &[Vec<f64>],
+        progress: &(dyn Fn(usize, usize) + Sync),
+    ) -> Result<NearCurves> {
         check_domain(&self.names, &self.domain, x)?;
-        for xn in near {
-            check_domain(&self.names, &self.domain, xn)?;
-        }
         let det = self.solver.detector(x)?;
         let dets = near
             .iter()
-            .map(|xn| self.solver.detector(xn))
-            .collect::<hpge_surrogate::Result<Vec<_>>>()?;
-        near_curves(&det, &dets, self)
+            .map(|xn| {
+                check_domain(&self.names, &self.domain, xn)?;
+                Ok(self.solver.detector(xn)?)
+            })
+            .collect();
+        near_curves(&det, dets, self, progress)
     }
 }
 
 /// c12 of `det` along `model`'s voltages and of every detector of `near` on its grids
-/// (`hpge_solver::field::cv_curves_near`, seeded continuation as [`ExactSolver::curve`]).
+/// (`hpge_solver::field::cv_curves_near_each`, seeded continuation as [`ExactSolver::curve`]);
+/// a nearby entry that is already an error (outside the domain) stays one.
 pub(crate) fn near_curves(
     det: &Detector,
-    near: &[Detector],
+    near: Vec<Result<Detector>>,
     model: &ExactModel,
-) -> Result<(Vec<f64>, Vec<Vec<f64>>)> {
-    let nc = cv_curves_near(
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Result<NearCurves> {
+    let ok: Vec<Detector> = near
+        .iter()
+        .filter_map(|d| d.as_ref().ok().cloned())
+        .collect();
+    let total = near.len() + 1;
+    let skipped = total - 1 - ok.len();
+    let nc = cv_curves_near_each(
         det,
-        near,
+        &ok,
         &model.volts,
         &model.solver.settings,
         Continuation::Seeded,
+        |done, _| progress(done + skipped, total),
     )
     .map_err(|e| Error::Surrogate(e.into()))?;
     if nc.base.points.len() != model.volts.len() {
@@ -134,8 +148,16 @@ pub(crate) fn near_curves(
             message: "the voltages must be positive, increasing and distinct".into(),
         });
     }
-    Ok((
-        nc.base.points.iter().map(|p| p.c12_pf).collect(),
-        nc.near_pf,
-    ))
+    let mut solved = nc.near_pf.into_iter();
+    let others = near
+        .into_iter()
+        .map(|d| match d {
+            Ok(_) => solved
+                .next()
+                .expect("one solved curve per detector")
+                .map_err(|e| Error::Surrogate(e.into())),
+            Err(e) => Err(e),
+        })
+        .collect();
+    Ok((nc.base.points.iter().map(|p| p.c12_pf).collect(), others))
 }

@@ -11,6 +11,9 @@ pub use surrogate::SurrogateModel;
 
 use crate::Result;
 
+/// c(x) and each nearby point's curve or its error ([`CvModel::curves_near`]).
+pub type NearCurves = (Vec<f64>, Vec<Result<Vec<f64>>>);
+
 /// A model of c12 along a fixed list of bias voltages.
 ///
 /// Inputs are the model's own parameters in physical units (for the paper's surrogate: d_Li in
@@ -36,22 +39,38 @@ pub trait CvModel: Send + Sync {
     /// A short description for reports (file, recipe, ...).
     fn describe(&self) -> String;
     /// c12 (pF) at `x` and at every point of `near` (points close to `x`: forward-difference
-    /// steps), as (c(x), [c(near_0), ...]). By default each curve is its own
+    /// steps, draws of a narrow posterior), as (c(x), [c(near_0), ...]); a nearby point whose
+    /// curve fails is its entry's error, not the call's. By default each curve is its own
     /// [`CvModel::curve`] (the nearby ones in parallel). The exact solver overrides it: the
-    /// nearby curves are solved on `x`'s grids (`hpge_solver::field::cv_curves_near`), so their
-    /// differences from c(x) are those of one discretisation, not of two adaptive grids.
-    fn curves_near(&self, x: &[f64], near: &[Vec<f64>]) -> Result<(Vec<f64>, Vec<Vec<f64>>)> {
+    /// nearby curves are solved on `x`'s grids (`hpge_solver::field::cv_curves_near_each`), so
+    /// their differences from c(x) are those of one discretisation, not of two adaptive grids.
+    /// `progress(done, total)` counts curves, `x`'s included.
+    ///
+    /// # Errors
+    /// The curve at `x` fails.
+    fn curves_near(
+        &self,
+        x: &[f64],
+        near: &[Vec<f64>],
+        progress: &(dyn Fn(usize, usize) + Sync),
+    ) -> Result<NearCurves> {
         use rayon::prelude::*;
+        use std::sync::atomic::{AtomicUsize, Ordering};
         let nv = self.voltages().len();
         let mut c = vec![0.0; nv];
         self.curve(x, &mut c)?;
+        let total = near.len() + 1;
+        progress(1, total);
+        let done = AtomicUsize::new(1);
         let others = near
             .par_iter()
             .map(|xn| {
                 let mut cn = vec![0.0; nv];
-                self.curve(xn, &mut cn).map(|()| cn)
+                let r = self.curve(xn, &mut cn).map(|()| cn);
+                progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);
+                r
             })
-            .collect::<Result<Vec<_>>>()?;
+            .collect();
         Ok((c, others))
     }
 }

@@ -7,7 +7,9 @@ mod report;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use hpge_inference::fit::{FitJob, FitOptions, TruthRecord, outputs, read_truth, truth_records};
+use hpge_inference::fit::{
+    ExactGrids, FitJob, FitOptions, TruthRecord, outputs, read_truth, truth_records,
+};
 use hpge_inference::{Fit, FitSettings, Status};
 
 pub use report::write_report;
@@ -78,7 +80,7 @@ pub fn run_fit(o: &FitOptions, observer: &dyn FitObserver) -> Result<FitRun> {
     observer.sampling_done();
     if !o.no_exact_check {
         observer.exact_start(o.exact_draws);
-        job.check_exact(&mut fit, o.exact_draws, &|done, total| {
+        job.check_exact(&mut fit, &o.exact_check()?, &|done, total| {
             observer.exact_progress(done, total)
         })?;
         observer.exact_done();
@@ -228,8 +230,9 @@ pub fn summary_text(fit: &Fit, out: &Path) -> String {
     if let Some(c) = &s.exact_check {
         let _ = writeln!(
             t,
-            "exact check ({} draws, {:.1} s): Pareto k {:.2}, largest mean shift {:.2} sd, |c_exact - c_surrogate|/c at the mode <= {:.2}%: {}",
+            "exact check ({} draws on {}, {:.1} s): Pareto k {:.2}, largest mean shift {:.2} sd, |c_exact - c_surrogate|/c at the mode <= {:.2}%: {}",
             c.draws,
+            grids_text(c),
             c.seconds,
             c.pareto_k,
             c.max_abs_shift_sd,
@@ -239,4 +242,18 @@ pub fn summary_text(fit: &Fit, out: &Path) -> String {
     }
     let _ = writeln!(t, "outputs in {}", out.display());
     t
+}
+
+/// Where the check solved its draws, in words, with the grid check's numbers.
+pub(crate) fn grids_text(c: &hpge_inference::fit::ExactCheck) -> String {
+    match (&c.grids, &c.grid_check) {
+        (ExactGrids::Own, _) => "their own grids".into(),
+        (ExactGrids::Mode, None) => "the mode's grids".into(),
+        (ExactGrids::Mode, Some(g)) => format!(
+            "the mode's grids; {} also on their own: c12 within {:.2}%, ln L within {:.2}",
+            g.draws,
+            100.0 * g.max_rel_diff,
+            g.max_abs_delta_ln_l
+        ),
+    }
 }

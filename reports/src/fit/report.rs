@@ -207,11 +207,12 @@ pub fn write_report(
         let _ = writeln!(r, "## Exact-solver check\n");
         let _ = writeln!(
             r,
-            "{} posterior draws re-weighted with the exact field solver{} ({} failed solves) in {:.1} s: Pareto k-hat {:.2} ({}), weights' ESS {:.0}; |c_exact - c_surrogate| / c_exact at the global mode up to {:.2}%; chi^2 of the exact curve at the mode {:.1}. **{}**.\n",
+            "{} posterior draws re-weighted with the exact field solver{}, solved on {} ({} failed solves) in {:.1} s: Pareto k-hat {:.2} ({}), weights' ESS {:.0}; |c_exact - c_surrogate| / c_exact at the global mode up to {:.2}%; chi^2 of the exact curve at the mode {:.1}. **{}**.\n",
             c.draws,
             c.solver_tolerance
                 .map(|t| format!(" at a tolerance of {}% of c12", 100.0 * t))
                 .unwrap_or_default(),
+            super::grids_text(c),
             c.failed,
             c.seconds,
             c.pareto_k,

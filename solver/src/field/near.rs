@@ -36,11 +36,28 @@ pub struct NearCurves {
     pub regridded: usize,
 }
 
+/// A base curve and, for each nearby detector, its c12 at the same voltages or the error that
+/// stopped its solve (one failed nearby detector does not stop the others).
+#[derive(Debug)]
+pub struct NearEach {
+    /// The base detector's curve, solved as [`super::cv_curve_with`] solves it.
+    pub base: CvCurve,
+    /// c12 (pF) of each nearby detector at the base curve's voltages, solved on the base's
+    /// final grids; the first failed point's error where a solve failed.
+    pub near_pf: Vec<Result<Vec<f64>>>,
+    /// Nearby points solved on their own adaptive grids (geometry ticks not matched).
+    pub regridded: usize,
+}
+
 /// Solves `det` at `volts` (as [`super::cv_curve_with`] with `continuation`), then every
 /// detector of `near` at the same voltages on the base points' final grids, deformed with the
 /// geometry (see the module text). The nearby detectors should differ from `det` by a small
 /// change of parameters (a forward-difference step): each is solved without refinement, so its
 /// c12 carries the base grid's discretisation error, not its own grid's.
+///
+/// # Errors
+/// The base curve's first failure, or the first failure of any nearby detector
+/// ([`cv_curves_near_each`] keeps them apart).
 pub fn cv_curves_near(
     det: &Detector,
     near: &[Detector],
@@ -48,7 +65,33 @@ pub fn cv_curves_near(
     settings: &FieldSettings,
     continuation: Continuation,
 ) -> Result<NearCurves> {
+    let each = cv_curves_near_each(det, near, volts, settings, continuation, |_, _| {})?;
+    Ok(NearCurves {
+        base: each.base,
+        near_pf: each.near_pf.into_iter().collect::<Result<_>>()?,
+        regridded: each.regridded,
+    })
+}
+
+/// [`cv_curves_near`] with each nearby detector's outcome on its own: a nearby solve that fails
+/// is its entry's error, not the call's. `progress(done, total)` counts curves (the base first,
+/// then each nearby detector as it finishes), from any thread.
+///
+/// # Errors
+/// The base curve's failure (there are no grids to solve the others on without it).
+pub fn cv_curves_near_each(
+    det: &Detector,
+    near: &[Detector],
+    volts: &[f64],
+    settings: &FieldSettings,
+    continuation: Continuation,
+    progress: impl Fn(usize, usize) + Sync,
+) -> Result<NearEach> {
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    let total = near.len() + 1;
     let (base, kept) = curve_keeping(det, volts, settings, continuation, true, |_, _| {})?;
+    progress(1, total);
+    let done = AtomicUsize::new(1);
     let from = det.ticks();
     let solved: Vec<Result<(Vec<f64>, usize)>> = near
         .par_iter()
@@ -67,6 +110,7 @@ pub fn cv_curves_near(
                     }
                 })
                 .collect();
+            progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);
             let mut c = Vec::with_capacity(points.len());
             let mut regridded = 0;
             for p in points {
@@ -77,14 +121,17 @@ pub fn cv_curves_near(
             Ok((c, regridded))
         })
         .collect();
-    let mut near_pf = Vec::with_capacity(near.len());
     let mut regridded = 0;
-    for s in solved {
-        let (c, r) = s?;
-        near_pf.push(c);
-        regridded += r;
-    }
-    Ok(NearCurves {
+    let near_pf = solved
+        .into_iter()
+        .map(|s| {
+            s.map(|(c, r)| {
+                regridded += r;
+                c
+            })
+        })
+        .collect();
+    Ok(NearEach {
         base,
         near_pf,
         regridded,

@@ -4,7 +4,7 @@
 use std::sync::Arc;
 
 use crate::Result;
-use crate::model::CvModel;
+use crate::model::{CvModel, NearCurves};
 
 /// How the extra input a acts on the inner curve (a closed set).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -97,18 +97,24 @@ impl CvModel for Affine {
 
     /// The inner model's nearby curves (a step in `a` alone reuses c_inner(x)), then the
     /// shift or scale of each point.
-    fn curves_near(&self, x: &[f64], near: &[Vec<f64>]) -> Result<(Vec<f64>, Vec<Vec<f64>>)> {
+    fn curves_near(
+        &self,
+        x: &[f64],
+        near: &[Vec<f64>],
+        progress: &(dyn Fn(usize, usize) + Sync),
+    ) -> Result<NearCurves> {
         let n = x.len() - 1;
         let moved: Vec<usize> = (0..near.len())
             .filter(|&k| near[k][..n] != x[..n])
             .collect();
         let inner_near: Vec<Vec<f64>> = moved.iter().map(|&k| near[k][..n].to_vec()).collect();
-        let (c_inner, solved) = self.inner.curves_near(&x[..n], &inner_near)?;
+        let (c_inner, solved) = self.inner.curves_near(&x[..n], &inner_near, progress)?;
         let apply =
             |c: &[f64], a: f64| -> Vec<f64> { c.iter().map(|&v| self.apply(v, a)).collect() };
-        let mut out: Vec<Vec<f64>> = near.iter().map(|xn| apply(&c_inner, xn[n])).collect();
-        for (&k, c) in moved.iter().zip(&solved) {
-            out[k] = apply(c, near[k][n]);
+        let mut out: Vec<Result<Vec<f64>>> =
+            near.iter().map(|xn| Ok(apply(&c_inner, xn[n]))).collect();
+        for (&k, c) in moved.iter().zip(solved) {
+            out[k] = c.map(|c| apply(&c, near[k][n]));
         }
         Ok((apply(&c_inner, x[n]), out))
     }

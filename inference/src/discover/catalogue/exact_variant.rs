@@ -6,7 +6,7 @@
 use hpge_solver::{Detector, cv_curve};
 use hpge_surrogate::ExactSolver;
 
-use crate::model::{CvModel, ExactModel, check_domain, near_curves};
+use crate::model::{CvModel, ExactModel, NearCurves, check_domain, near_curves};
 use crate::{Error, Result};
 
 /// Applies an extension's values (`extra`, in the order of [`ExactVariant`]'s added inputs) to a
@@ -106,16 +106,21 @@ impl CvModel for ExactVariant {
     }
 
     /// The nearby curves on `x`'s grids, as [`ExactModel`] solves them.
-    fn curves_near(&self, x: &[f64], near: &[Vec<f64>]) -> Result<(Vec<f64>, Vec<Vec<f64>>)> {
+    fn curves_near(
+        &self,
+        x: &[f64],
+        near: &[Vec<f64>],
+        progress: &(dyn Fn(usize, usize) + Sync),
+    ) -> Result<NearCurves> {
         check_domain(&self.names, &self.domain, x)?;
-        for xn in near {
-            check_domain(&self.names, &self.domain, xn)?;
-        }
         let det = self.detector(x)?;
         let dets = near
             .iter()
-            .map(|xn| self.detector(xn))
-            .collect::<Result<Vec<_>>>()?;
-        near_curves(&det, &dets, &self.base)
+            .map(|xn| {
+                check_domain(&self.names, &self.domain, xn)?;
+                self.detector(xn)
+            })
+            .collect();
+        near_curves(&det, dets, &self.base, progress)
     }
 }
