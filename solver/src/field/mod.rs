@@ -1,6 +1,8 @@
 //! Field solves: potential with depletion, weighting potentials, capacitance matrix.
 
 mod adaptive;
+#[cfg(test)]
+mod amg;
 mod band;
 mod capacitance;
 mod charge;
