@@ -3,9 +3,9 @@
 //! sparse Cholesky of `cholesky.rs` (`tests::amg_timing`, reports/solver-performance.md).
 //!
 //! **Compiled for the tests only.** Measured on the project's 2-core machine on Super-Siegfried's
-//! field systems from 3x10^3 to 8x10^5 unknowns, a cold solve to 1e-10 costs 1.5-1.8x faer's
+//! field systems from 3x10^3 to 8x10^5 unknowns, a cold solve to 1e-10 costs 1.4-1.8x faer's
 //! symbolic analysis, factorisation and solve together, and an active-set step (1% of the
-//! unknowns change) 2-2.8x a refactorisation and solve, even warm-started; with the previous
+//! unknowns change) 1.9-3.0x a refactorisation and solve, even warm-started; with the previous
 //! hierarchy as the preconditioner of the new matrix the iterations grow from 14 to 274. The
 //! factorisation grows as N^1.2 over that range, not N^1.5, so the O(N) method does not pay in
 //! two dimensions at these sizes; the solver keeps the factorisation.
