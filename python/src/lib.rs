@@ -603,7 +603,8 @@ fn measure<'py>(
 /// CSV), `model` (surrogate), `prior` (TOML), `detector` (TOML), `seed`, `sampler`
 /// ("metropolis" or "nuts"), `likelihood` ("paper" or "covariance"), `chains`, `ess`, `rhat`,
 /// `max_seconds` (s), `exact_check` (re-weight `exact_draws` draws with the field solver; off by
-/// default here, on in the command line), `out` (a folder: also write every file and figure
+/// default here, on in the command line; `exact_grids` "mode" or "own", as `--exact-grids`),
+/// `out` (a folder: also write every file and figure
 /// `hpge-cv fit --out` writes), `progress`, `extrapolate` (fit a curve with voltages outside the
 /// surrogate's support, as `--extrapolate`).
 ///
@@ -614,7 +615,7 @@ fn measure<'py>(
 #[pyo3(signature = (
     data=None, model=None, prior=None, detector=None, seed=None, sampler=None, likelihood=None,
     chains=None, ess=None, rhat=None, max_seconds=None, exact_check=false, exact_draws=None,
-    out=None, progress=None, extrapolate=false
+    out=None, progress=None, extrapolate=false, exact_grids=None
 ))]
 #[allow(clippy::too_many_arguments)]
 fn fit<'py>(
@@ -635,6 +636,7 @@ fn fit<'py>(
     out: Option<PathBuf>,
     progress: Option<Bound<'py, PyAny>>,
     extrapolate: bool,
+    exact_grids: Option<String>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let d = FitOptions::default();
     let o = FitOptions {
@@ -647,6 +649,7 @@ fn fit<'py>(
         seed: seed.unwrap_or(d.seed),
         no_exact_check: !exact_check,
         exact_draws: exact_draws.unwrap_or(d.exact_draws),
+        exact_grids: exact_grids.unwrap_or(d.exact_grids),
         likelihood: likelihood.unwrap_or(d.likelihood),
         chains: chains.unwrap_or(d.chains),
         ess: ess.unwrap_or(d.ess),
