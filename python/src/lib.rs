@@ -603,7 +603,8 @@ fn measure<'py>(
 /// CSV), `model` (surrogate), `prior` (TOML), `detector` (TOML), `seed`, `sampler`
 /// ("metropolis" or "nuts"), `likelihood` ("paper" or "covariance"), `chains`, `ess`, `rhat`,
 /// `max_seconds` (s), `exact_check` (re-weight `exact_draws` draws with the field solver; off by
-/// default here, on in the command line; `exact_grids` "mode" or "own", as `--exact-grids`),
+/// default here, on in the command line; `exact_grids` "mode" or "own" and `exact_grid_check`,
+/// as `--exact-grids` and `--exact-grid-check`),
 /// `out` (a folder: also write every file and figure
 /// `hpge-cv fit --out` writes), `progress`, `extrapolate` (fit a curve with voltages outside the
 /// surrogate's support, as `--extrapolate`).
@@ -615,7 +616,7 @@ fn measure<'py>(
 #[pyo3(signature = (
     data=None, model=None, prior=None, detector=None, seed=None, sampler=None, likelihood=None,
     chains=None, ess=None, rhat=None, max_seconds=None, exact_check=false, exact_draws=None,
-    out=None, progress=None, extrapolate=false, exact_grids=None
+    out=None, progress=None, extrapolate=false, exact_grids=None, exact_grid_check=None
 ))]
 #[allow(clippy::too_many_arguments)]
 fn fit<'py>(
@@ -637,6 +638,7 @@ fn fit<'py>(
     progress: Option<Bound<'py, PyAny>>,
     extrapolate: bool,
     exact_grids: Option<String>,
+    exact_grid_check: Option<usize>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let d = FitOptions::default();
     let o = FitOptions {
@@ -650,6 +652,7 @@ fn fit<'py>(
         no_exact_check: !exact_check,
         exact_draws: exact_draws.unwrap_or(d.exact_draws),
         exact_grids: exact_grids.unwrap_or(d.exact_grids),
+        exact_grid_check: exact_grid_check.unwrap_or(d.exact_grid_check),
         likelihood: likelihood.unwrap_or(d.likelihood),
         chains: chains.unwrap_or(d.chains),
         ess: ess.unwrap_or(d.ess),
