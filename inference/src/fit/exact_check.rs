@@ -22,16 +22,14 @@ use std::time::Instant;
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::Error;
-
 use super::predictive::thin_indices;
-use crate::Result;
 use crate::model::CvModel;
 use crate::posterior::Likelihood;
 use crate::prior::Prior;
 use crate::rejection::unless_rejected;
 use crate::sampler::Samples;
 use crate::summary::psis;
+use crate::{Error, Result};
 
 /// Where the check solves the exact curves of the draws.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
@@ -84,16 +82,6 @@ pub struct ExactCheckSettings {
     /// With [`ExactGrids::Mode`]: how many of the draws (evenly spread) are solved on their own
     /// adaptive grids too, for [`GridCheck`] (0: none).
     pub grid_check: usize,
-}
-
-impl Default for ExactCheckSettings {
-    fn default() -> Self {
-        Self {
-            draws: super::options::DEFAULT_EXACT_DRAWS,
-            grids: ExactGrids::default(),
-            grid_check: DEFAULT_GRID_CHECK,
-        }
-    }
 }
 
 /// The draws solved both on the mode's grids and on their own: how much the choice of grid
@@ -196,21 +184,6 @@ pub fn exact_check(
             Ok(unless_rejected(eval(surrogate, theta))?.unwrap_or_else(|| vec![f64::NAN; nv]))
         })
         .collect::<Result<_>>()?;
-    let own = |pts: &[&[f64]],
-               progress: &(dyn Fn(usize, usize) + Sync)|
-     -> Result<Vec<Option<Vec<f64>>>> {
-        let done = std::sync::atomic::AtomicUsize::new(0);
-        pts.par_iter()
-            .map(|theta| {
-                let c = unless_rejected(eval(exact, theta));
-                progress(
-                    done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1,
-                    pts.len(),
-                );
-                c
-            })
-            .collect()
-    };
     let mut grids = settings.grids;
     let mut exact_curves = None;
     if grids == ExactGrids::Mode {
@@ -233,14 +206,25 @@ pub fn exact_check(
     }
     let exact_curves = match exact_curves {
         Some(v) => v,
-        None => own(&points, progress)?,
+        None => {
+            // Each point on its own adaptive grids.
+            let done = std::sync::atomic::AtomicUsize::new(0);
+            points
+                .par_iter()
+                .map(|theta| {
+                    let c = unless_rejected(eval(exact, theta));
+                    let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                    progress(k + 1, points.len());
+                    c
+                })
+                .collect::<Result<_>>()?
+        }
     };
     let grid_check = match grids {
         ExactGrids::Mode if settings.grid_check > 0 => Some(grid_check(
-            &idx,
             settings.grid_check,
-            &exact_curves,
-            &|k| own(&[points[k]], &|_, _| {}).map(|mut v| v.remove(0)),
+            &exact_curves[..idx.len()],
+            &|k| unless_rejected(eval(exact, points[k])),
             &exact_like,
         )?),
         _ => None,
@@ -308,17 +292,16 @@ pub fn exact_check(
     })
 }
 
-/// Solves `count` of the draws (evenly spread over the thinned `idx`) on their own grids with
-/// `solve_own(k)` and compares them with `on_mode[k]`, their curves on the mode's grids.
+/// Solves `count` of the draws (evenly spread) on their own grids with `solve_own(k)` and
+/// compares them with `on_mode[k]`, their curves on the mode's grids.
 fn grid_check(
-    idx: &[usize],
     count: usize,
     on_mode: &[Option<Vec<f64>>],
     solve_own: &(dyn Fn(usize) -> Result<Option<Vec<f64>>> + Sync),
     exact_like: &Likelihood,
 ) -> Result<GridCheck> {
     let start = Instant::now();
-    let n = idx.len();
+    let n = on_mode.len();
     let mut picks: Vec<usize> = (0..count.min(n)).map(|j| j * n / count.min(n)).collect();
     picks.dedup();
     let own: Vec<Option<Vec<f64>>> = picks

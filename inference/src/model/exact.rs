@@ -105,37 +105,52 @@ impl CvModel for ExactModel {
         near: &[Vec<f64>],
         progress: &(dyn Fn(usize, usize) + Sync),
     ) -> Result<NearCurves> {
-        check_domain(&self.names, &self.domain, x)?;
-        let det = self.solver.detector(x)?;
-        let dets = near
-            .iter()
-            .map(|xn| {
-                check_domain(&self.names, &self.domain, xn)?;
-                Ok(self.solver.detector(xn)?)
-            })
-            .collect();
-        near_curves(&det, dets, self, progress)
+        let detector = |x: &[f64]| Ok(self.solver.detector(x)?);
+        near_curves(
+            self,
+            (&self.names, &self.domain),
+            x,
+            near,
+            &detector,
+            progress,
+        )
     }
 }
 
-/// c12 of `det` along `model`'s voltages and of every detector of `near` on its grids
-/// (`hpge_solver::field::cv_curves_near_each`, seeded continuation as [`ExactSolver::curve`]);
-/// a nearby entry that is already an error (outside the domain) stays one.
+/// c12 along `model`'s voltages of the detector at `x` and of those at every point of `near` on
+/// its grids (`hpge_solver::field::cv_curves_near_each`, seeded continuation as
+/// [`ExactSolver::curve`]); `detector` builds a detector from inputs, which must lie in
+/// `domain` (named `names`). A nearby point outside the domain, or whose detector cannot be
+/// built, is its own entry's error.
 pub(crate) fn near_curves(
-    det: &Detector,
-    near: Vec<Result<Detector>>,
     model: &ExactModel,
+    (names, domain): (&[String], &[[f64; 2]]),
+    x: &[f64],
+    near: &[Vec<f64>],
+    detector: &dyn Fn(&[f64]) -> Result<Detector>,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<NearCurves> {
-    let ok: Vec<Detector> = near
+    check_domain(names, domain, x)?;
+    let det = detector(x)?;
+    // The detectors to solve, and in each entry's place the error that stops it.
+    let mut dets = Vec::with_capacity(near.len());
+    let slots: Vec<Option<Error>> = near
         .iter()
-        .filter_map(|d| d.as_ref().ok().cloned())
+        .map(
+            |xn| match check_domain(names, domain, xn).and_then(|()| detector(xn)) {
+                Ok(d) => {
+                    dets.push(d);
+                    None
+                }
+                Err(e) => Some(e),
+            },
+        )
         .collect();
     let total = near.len() + 1;
-    let skipped = total - 1 - ok.len();
+    let skipped = near.len() - dets.len();
     let nc = cv_curves_near_each(
-        det,
-        &ok,
+        &det,
+        &dets,
         &model.volts,
         &model.solver.settings,
         Continuation::Seeded,
@@ -149,14 +164,14 @@ pub(crate) fn near_curves(
         });
     }
     let mut solved = nc.near_pf.into_iter();
-    let others = near
+    let others = slots
         .into_iter()
-        .map(|d| match d {
-            Ok(_) => solved
+        .map(|slot| match slot {
+            None => solved
                 .next()
                 .expect("one solved curve per detector")
                 .map_err(|e| Error::Surrogate(e.into())),
-            Err(e) => Err(e),
+            Some(e) => Err(e),
         })
         .collect();
     Ok((nc.base.points.iter().map(|p| p.c12_pf).collect(), others))

@@ -199,6 +199,19 @@ pub(crate) fn owners(
     Ok(out)
 }
 
+/// The unknowns of the weighting problem: free where no conductor owns a node, fixed on contacts
+/// and grounded parts (their values per contact come with the right-hand side), one shared
+/// unknown per floating conductor.
+pub(crate) fn weighting_dofs(own: &[Option<Owner>]) -> Vec<Dof> {
+    own.iter()
+        .map(|o| match o {
+            None => Dof::Free,
+            Some(Owner::Contact(_) | Owner::Ground) => Dof::Fixed(0.0),
+            Some(Owner::Floating(g)) => Dof::Group(*g),
+        })
+        .collect()
+}
+
 /// Weighting potentials of all contacts given the undepleted nodes of the potential solve.
 pub fn weighting_potentials(
     mesh: &Mesh,
@@ -209,15 +222,7 @@ pub fn weighting_potentials(
     let own = owners(mesh, det, undepleted, bias_v)?;
     let nc = det.contacts.len();
     // One pattern and one factorisation for all contacts: only the fixed values differ.
-    let dofs: Vec<Dof> = own
-        .iter()
-        .map(|o| match o {
-            None => Dof::Free,
-            Some(Owner::Contact(_) | Owner::Ground) => Dof::Fixed(0.0),
-            Some(Owner::Floating(g)) => Dof::Group(*g),
-        })
-        .collect();
-    let sys = System::assemble(mesh, &dofs, &vec![0.0; mesh.kind.len()]);
+    let sys = System::assemble(mesh, &weighting_dofs(&own), &vec![0.0; mesh.kind.len()]);
     let llt = if sys.n > 0 {
         let sym = sys.symbolic()?;
         Some(sys.factor(&sym, &sys.val)?)

@@ -112,15 +112,8 @@ impl CvModel for ExactVariant {
         near: &[Vec<f64>],
         progress: &(dyn Fn(usize, usize) + Sync),
     ) -> Result<NearCurves> {
-        check_domain(&self.names, &self.domain, x)?;
-        let det = self.detector(x)?;
-        let dets = near
-            .iter()
-            .map(|xn| {
-                check_domain(&self.names, &self.domain, xn)?;
-                self.detector(xn)
-            })
-            .collect();
-        near_curves(&det, dets, &self.base, progress)
+        let detector = |x: &[f64]| self.detector(x);
+        let inputs = (self.names.as_slice(), self.domain.as_slice());
+        near_curves(&self.base, inputs, x, near, &detector, progress)
     }
 }

@@ -8,8 +8,8 @@ use crate::detector::Detector;
 use crate::expr::Parameters;
 use crate::field::Mesh;
 use crate::field::cholesky::Symbolic;
-use crate::field::system::{Dof, System};
-use crate::field::weighting::{Owner, owners};
+use crate::field::system::System;
+use crate::field::weighting::{Owner, owners, weighting_dofs};
 use crate::grid::{Grid, GridSettings};
 
 /// The weighting system of contact `k` of a detector (fully depleted, no undepleted node) on its
@@ -28,15 +28,7 @@ fn weighting_system(name: &str, h_mm: f64, k: usize) -> (System, Vec<f64>) {
     let mesh = Mesh::new(&det, Grid::initial(&det, &s));
     let none = vec![false; mesh.kind.len()];
     let own = owners(&mesh, &det, &none, 1000.0).unwrap();
-    let dofs: Vec<Dof> = own
-        .iter()
-        .map(|o| match o {
-            None => Dof::Free,
-            Some(Owner::Contact(_) | Owner::Ground) => Dof::Fixed(0.0),
-            Some(Owner::Floating(g)) => Dof::Group(*g),
-        })
-        .collect();
-    let sys = System::assemble(&mesh, &dofs, &vec![0.0; mesh.kind.len()]);
+    let sys = System::assemble(&mesh, &weighting_dofs(&own), &vec![0.0; mesh.kind.len()]);
     let fixed: Vec<f64> = own
         .iter()
         .map(|o| f64::from(u8::from(*o == Some(Owner::Contact(k)))))
