@@ -2,7 +2,7 @@
 //!
 //! Every error is printed as one message naming the file, key or value at fault, and the program
 //! exits with code 2 (bad input); it never panics on user input. A fit that did not converge
-//! exits with code 3.
+//! exits with code 3, a fit whose exact-solver check fails after refinement with code 4.
 
 mod cli;
 mod report;
@@ -19,6 +19,10 @@ fn main() -> ExitCode {
         Err(err) if err.downcast_ref::<cli::Unconverged>().is_some() => {
             eprintln!("error: {}", message(&err));
             ExitCode::from(3)
+        }
+        Err(err) if err.downcast_ref::<cli::ExactMismatch>().is_some() => {
+            eprintln!("error: {}", message(&err));
+            ExitCode::from(4)
         }
         Err(err) => {
             eprintln!("error: {}", message(&err));

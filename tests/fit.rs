@@ -147,9 +147,18 @@ fn unconverged_fit_exits_with_3_unless_allowed() {
 fn exact_check_reweights_a_few_draws() {
     let d = temp("fit-exact");
     let o = d.join("x");
+    // One round (no refinement): the check's own mechanics; it may fail (the B_Z surrogate is
+    // far off), which --allow-exact-mismatch lets through with a warning.
     let stdout = ok(&run(&fit_args(
         o.to_str().unwrap(),
-        &["--no-plots", "--exact-draws", "12"],
+        &[
+            "--no-plots",
+            "--exact-draws",
+            "12",
+            "--refine-rounds",
+            "1",
+            "--allow-exact-mismatch",
+        ],
     )));
     let v: serde_json::Value = serde_json::from_str(stdout.trim()).unwrap();
     let c = &v["exact_check"];
@@ -175,13 +184,48 @@ fn exact_check_on_own_grids_on_request() {
     let o = d.join("x");
     let stdout = ok(&run(&fit_args(
         o.to_str().unwrap(),
-        &["--no-plots", "--exact-draws", "4", "--exact-grids", "own"],
+        &[
+            "--no-plots",
+            "--exact-draws",
+            "4",
+            "--exact-grids",
+            "own",
+            "--refine-rounds",
+            "1",
+            "--allow-exact-mismatch",
+        ],
     )));
     let v: serde_json::Value = serde_json::from_str(stdout.trim()).unwrap();
     let c = &v["exact_check"];
     assert_eq!(c["draws"], 4);
     assert_eq!(c["grids"], "own");
     assert!(c["grid_check"].is_null());
+}
+
+#[test]
+fn a_failing_exact_check_exits_with_4_unless_allowed() {
+    // The B_Z surrogate's posterior is far from the exact one (Pareto k-hat above 7 on the
+    // shipped data): without refinement its check fails, and the fit exits with 4 after
+    // writing its outputs.
+    let d = temp("fit-exact-fail");
+    let o = d.join("x");
+    let args = fit_args(
+        o.to_str().unwrap(),
+        &["--no-plots", "--exact-draws", "12", "--refine-rounds", "1"],
+    );
+    fails_with(
+        &run(&args),
+        4,
+        &["exact-solver check failed", "--allow-exact-mismatch"],
+    );
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(o.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(v["exact_check"]["pass"], false);
+    assert_eq!(v["refinement"].as_array().unwrap().len(), 1);
+    bad(
+        &run(&fit_args(o.to_str().unwrap(), &["--refine-rounds", "0"])),
+        &["--refine-rounds 0"],
+    );
 }
 
 #[test]

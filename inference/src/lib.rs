@@ -91,6 +91,7 @@ pub mod model;
 pub mod numerics;
 pub mod posterior;
 pub mod prior;
+pub mod refine;
 mod rejection;
 pub mod sampler;
 pub mod summary;

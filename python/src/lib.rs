@@ -604,7 +604,8 @@ fn measure<'py>(
 /// ("metropolis" or "nuts"), `likelihood` ("paper" or "covariance"), `chains`, `ess`, `rhat`,
 /// `max_seconds` (s), `exact_check` (re-weight `exact_draws` draws with the field solver; off by
 /// default here, on in the command line; `exact_grids` "mode" or "own" and `exact_grid_check`,
-/// as `--exact-grids` and `--exact-grid-check`),
+/// as `--exact-grids` and `--exact-grid-check`; while the check fails, up to `refine_rounds`
+/// rounds of posterior-adaptive refinement, as `--refine-rounds`),
 /// `out` (a folder: also write every file and figure
 /// `hpge-cv fit --out` writes), `progress`, `extrapolate` (fit a curve with voltages outside the
 /// surrogate's support, as `--extrapolate`).
@@ -616,7 +617,8 @@ fn measure<'py>(
 #[pyo3(signature = (
     data=None, model=None, prior=None, detector=None, seed=None, sampler=None, likelihood=None,
     chains=None, ess=None, rhat=None, max_seconds=None, exact_check=false, exact_draws=None,
-    out=None, progress=None, extrapolate=false, exact_grids=None, exact_grid_check=None
+    out=None, progress=None, extrapolate=false, exact_grids=None, exact_grid_check=None,
+    refine_rounds=None
 ))]
 #[allow(clippy::too_many_arguments)]
 fn fit<'py>(
@@ -639,6 +641,7 @@ fn fit<'py>(
     extrapolate: bool,
     exact_grids: Option<String>,
     exact_grid_check: Option<usize>,
+    refine_rounds: Option<usize>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let d = FitOptions::default();
     let o = FitOptions {
@@ -653,6 +656,7 @@ fn fit<'py>(
         exact_draws: exact_draws.unwrap_or(d.exact_draws),
         exact_grids: exact_grids.unwrap_or(d.exact_grids),
         exact_grid_check: exact_grid_check.unwrap_or(d.exact_grid_check),
+        refine_rounds: refine_rounds.unwrap_or(d.refine_rounds),
         likelihood: likelihood.unwrap_or(d.likelihood),
         chains: chains.unwrap_or(d.chains),
         ess: ess.unwrap_or(d.ess),
@@ -676,7 +680,7 @@ fn fit<'py>(
                 eprintln!("hpge_cv: warning: {w}");
             }
             let settings = o.settings()?;
-            let mut fit = job.run(&settings, &|s| {
+            let sampling = |s: &hpge_inference::Status| {
                 if let Progress::Stderr(_) = progress {
                     eprintln!(
                         "hpge_cv: fit [{:6.1} s] {:?}: R-hat {:.4}, min ESS {:.0}, acceptance {:.2}",
@@ -685,12 +689,33 @@ fn fit<'py>(
                 } else {
                     progress.report(s.draws, 0);
                 }
-            })?;
-            if !o.no_exact_check {
-                job.check_exact(&mut fit, &o.exact_check()?, &|done, total| {
-                    progress.report(done, total)
-                })?;
-            }
+            };
+            let fit = if o.no_exact_check {
+                job.run(&settings, &sampling)?
+            } else {
+                job.run_refined(
+                    &settings,
+                    &o.exact_check()?,
+                    &o.refine(),
+                    hpge_inference::fit::RefineProgress {
+                        sampling: &sampling,
+                        sampled: &|_| {},
+                        exact: &|done, total| progress.report(done, total),
+                        round: &|r| {
+                            if let Progress::Stderr(_) = progress {
+                                eprintln!(
+                                    "hpge_cv: refinement round {}: k-hat {:.2}, largest shift {:.2} sd, {}",
+                                    r.round,
+                                    r.pareto_k,
+                                    r.max_abs_shift_sd,
+                                    if r.pass { "pass" } else { "fail" }
+                                );
+                            }
+                        },
+                    },
+                )?
+                .fit
+            };
             let summary = outputs::summary_json(&fit, None)?;
             Ok((fit, summary))
         })

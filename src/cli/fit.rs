@@ -5,7 +5,7 @@ use std::path::Path;
 
 use anyhow::Result;
 use hpge_inference::fit::FitSummary;
-use hpge_inference::fit::{FitFiles, FitJob};
+use hpge_inference::fit::{FitFiles, FitJob, RefineRound};
 use hpge_inference::sampler::Phase;
 use hpge_inference::{CvModel, FitSettings, Status};
 use hpge_reports::fit::{FitObserver, FitRun, run_fit, summary_text};
@@ -17,6 +17,13 @@ use indicatif::{ProgressBar, ProgressStyle};
     "the fit did not converge ({0}); the outputs are written, but treat them with care. Run longer (--max-seconds), or pass --allow-unconverged"
 )]
 pub struct Unconverged(pub String);
+
+/// A fit whose exact-solver check still fails after refinement (exit code 4).
+#[derive(Debug, thiserror::Error)]
+#[error(
+    "the exact-solver check failed ({0}); the outputs are written, but the surrogate's posterior is not the exact solver's. Refine longer (--refine-rounds), check more draws (--exact-draws), or pass --allow-exact-mismatch"
+)]
+pub struct ExactMismatch(pub String);
 
 pub use hpge_inference::fit::FitOptions;
 
@@ -112,9 +119,12 @@ impl FitObserver for Display {
         }
     }
     fn sampling(&self, status: &Status) {
-        if let Ok(g) = self.sampling.lock()
-            && let Some((_, f)) = g.as_ref()
-        {
+        if let Ok(mut g) = self.sampling.lock() {
+            // A refinement round samples again: a new spinner.
+            let (_, f) = g.get_or_insert_with(|| {
+                let (bar, f) = progress_printer(false);
+                (bar, Box::new(f))
+            });
             f(status);
         }
     }
@@ -149,6 +159,28 @@ impl FitObserver for Display {
             pb.finish_and_clear();
         }
     }
+    fn round_done(&self, r: &RefineRound) {
+        eprintln!("{}", round_text(r));
+    }
+}
+
+/// One line per refinement round.
+fn round_text(r: &RefineRound) -> String {
+    let model = if r.round == 0 {
+        "surrogate".to_string()
+    } else {
+        format!("surrogate corrected by {} exact curves", r.training_curves)
+    };
+    format!(
+        "round {} ({model}): exact check k-hat {:.2}, largest mean shift {:.2} sd, {:.2}% off at the mode: {} (sampling {:.1} s, exact check {:.1} s)",
+        r.round,
+        r.pareto_k,
+        r.max_abs_shift_sd,
+        100.0 * r.max_rel_diff_at_mode,
+        if r.pass { "pass" } else { "fail" },
+        r.sampling_seconds,
+        r.exact_seconds
+    )
 }
 
 /// Runs `fit` ([`hpge_reports::fit::run_fit`]) with progress on stderr: `print_json` prints
@@ -172,6 +204,20 @@ pub fn run(o: &FitOptions, print_json: bool, allow_unconverged: bool) -> Result<
             eprintln!("warning: the fit did not converge ({msg})");
         } else {
             return Err(Unconverged(msg).into());
+        }
+    }
+    if let Some(c) = &sm.exact_check
+        && !c.pass
+    {
+        let rounds = sm.refinement.as_ref().map_or(1, Vec::len);
+        let msg = format!(
+            "Pareto k-hat {:.2}, largest mean shift {:.2} sd after {rounds} round(s)",
+            c.pareto_k, c.max_abs_shift_sd
+        );
+        if o.allow_exact_mismatch {
+            eprintln!("warning: the exact-solver check failed ({msg})");
+        } else {
+            return Err(ExactMismatch(msg).into());
         }
     }
     Ok(())
@@ -230,6 +276,9 @@ impl FitObserver for ReportDisplay {
     }
     fn exact_done(&self) {
         self.0.exact_done();
+    }
+    fn round_done(&self, r: &RefineRound) {
+        self.0.round_done(r);
     }
     fn finished(&self, run: &FitRun) {
         print!("{}", summary_text(&run.fit, &run.out));

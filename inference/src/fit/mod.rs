@@ -6,14 +6,15 @@ mod job;
 mod options;
 pub mod outputs;
 mod predictive;
+mod refine;
 mod run;
 mod summary;
 mod truth;
 mod zeta;
 
 pub use exact_check::{
-    DEFAULT_GRID_CHECK, ExactCheck, ExactCheckSettings, ExactGrids, GridCheck, ParameterShift,
-    exact_check,
+    DEFAULT_GRID_CHECK, ExactCheck, ExactCheckSettings, ExactGrids, GridCheck, K_HAT_LIMIT,
+    ParameterShift, SHIFT_LIMIT_SD, add_grid_check, exact_check,
 };
 pub use job::{EXACT_CHECK_TOLERANCE, FitFiles, FitJob, file_hash};
 pub use options::{
@@ -22,6 +23,10 @@ pub use options::{
 };
 pub use predictive::thin_indices;
 pub use predictive::{Predictive, predictive};
+pub use refine::{
+    DEFAULT_HYPER_EVALS, DEFAULT_REFINE_ROUNDS, RefineInputs, RefineProgress, RefineRound,
+    RefineSettings, RefinedFit, refine_fit,
+};
 pub use run::{Fit, FitSettings, draw_range, fit};
 pub use summary::{FitSummary, LEVELS, ModeSummary, ParameterSummary};
 pub use truth::{TruthRecord, read_truth, truth_records};

@@ -8,6 +8,7 @@ use hpge_solver::GridOverrides;
 
 use super::exact_check::{DEFAULT_GRID_CHECK, ExactCheckSettings, ExactGrids};
 use super::job::FitFiles;
+use super::refine::{DEFAULT_REFINE_ROUNDS, RefineSettings};
 use super::run::FitSettings;
 use crate::posterior::{NoiseKind, NoiseSettings};
 use crate::sampler::{
@@ -83,6 +84,16 @@ pub struct FitOptions {
     /// grids' difference (0: none).
     #[cfg_attr(feature = "clap", arg(long, default_value_t = DEFAULT_GRID_CHECK))]
     pub exact_grid_check: usize,
+    /// Rounds of posterior-adaptive refinement at most, the first (plain surrogate) included:
+    /// while the exact check fails, its exact curves teach a model of the surrogate's error
+    /// (a Gaussian process at the voltages) and the fit samples again with the corrected
+    /// surrogate, whose uncertainty enters the likelihood point by point (1: no refinement).
+    #[cfg_attr(feature = "clap", arg(long, default_value_t = DEFAULT_REFINE_ROUNDS))]
+    pub refine_rounds: usize,
+    /// Exit with 0 even when the exact-solver check fails after refinement (otherwise exit
+    /// code 4).
+    #[cfg_attr(feature = "clap", arg(long))]
+    pub allow_exact_mismatch: bool,
     /// Likelihood: paper (independent, 3% measurement term) or covariance (the measured
     /// covariance instead of the 3% term).
     #[cfg_attr(feature = "clap", arg(long, default_value = NoiseKind::default().as_str()))]
@@ -130,6 +141,8 @@ impl Default for FitOptions {
             exact_draws: DEFAULT_EXACT_DRAWS,
             exact_grids: ExactGrids::default().as_str().into(),
             exact_grid_check: DEFAULT_GRID_CHECK,
+            refine_rounds: DEFAULT_REFINE_ROUNDS,
+            allow_exact_mismatch: false,
             likelihood: NoiseKind::default().as_str().into(),
             chains: DEFAULT_CHAINS,
             ess: DEFAULT_ESS_MIN,
@@ -194,9 +207,17 @@ impl FitOptions {
         })
     }
 
+    /// The refinement's settings (`--refine-rounds`).
+    pub fn refine(&self) -> RefineSettings {
+        RefineSettings {
+            max_rounds: self.refine_rounds,
+            ..RefineSettings::default()
+        }
+    }
+
     /// Checks the numbers a user gives, naming the flag: `--max-seconds` and `--ess` must be
-    /// positive and finite, `--exact-draws` at least 1 (unless `--no-exact-check`), and the
-    /// sampler and likelihood known names.
+    /// positive and finite, `--exact-draws` at least 1 (unless `--no-exact-check`),
+    /// `--refine-rounds` at least 1, and the sampler and likelihood known names.
     ///
     /// # Errors
     /// [`Error::BadOption`] naming the flag and its value.
@@ -216,6 +237,12 @@ impl FitOptions {
             return Err(Error::BadOption {
                 option: format!("--rhat {}", self.rhat),
                 message: "the R-hat target must be a number above 1 (e.g. 1.01)".into(),
+            });
+        }
+        if self.refine_rounds == 0 {
+            return Err(Error::BadOption {
+                option: "--refine-rounds 0".into(),
+                message: "at least 1 round (the plain surrogate's); 1 means no refinement".into(),
             });
         }
         if self.exact_draws == 0 && !self.no_exact_check {

@@ -103,3 +103,77 @@ pub fn write_summary(path: &Path, json: &serde_json::Value) -> Result<()> {
     })?;
     write_text(path, &(text + "\n"))
 }
+
+/// The file name of the error model a refined fit writes beside its summary.
+pub const ERROR_MODEL_FILE: &str = "error-model.json";
+
+/// A refined fit's model of the surrogate's error (`error-model.json`): the exact curves it was
+/// taught, as log-ratios ln(c_exact / c_surrogate) at the data's voltages, and its
+/// hyperparameters, from which [`ErrorModelFile::correction`] rebuilds it exactly. It belongs
+/// to this data set and this surrogate (both named with their hashes); the shipped model is
+/// never changed.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct ErrorModelFile {
+    /// hpge-cv version.
+    pub program_version: String,
+    /// What this is, in words.
+    pub description: String,
+    /// The fit's inputs (data, model, prior, detector, with hashes).
+    pub inputs: std::collections::BTreeMap<String, String>,
+    /// The surrogate's input names (the columns of `x`).
+    pub input_names: Vec<String>,
+    /// The voltages (V) of the columns of `log_ratio`.
+    pub voltages_v: Vec<f64>,
+    /// The Gaussian process's hyperparameters.
+    pub hyper: crate::refine::GpHyper,
+    /// Model inputs of the exact curves.
+    pub x: Vec<Vec<f64>>,
+    /// ln(c_exact / c_surrogate) of each curve at each voltage.
+    pub log_ratio: Vec<Vec<f64>>,
+}
+
+impl ErrorModelFile {
+    /// The file of `job`'s refined fit: its `training` points and the `correction` fitted to
+    /// them (None: no correction, hyperparameters empty).
+    pub fn new(
+        job: &super::FitJob,
+        training: &[(Vec<f64>, Vec<f64>)],
+        correction: Option<&crate::refine::GpCorrection>,
+    ) -> Self {
+        use crate::model::CvModel as _;
+        Self {
+            program_version: env!("CARGO_PKG_VERSION").into(),
+            description: "Gaussian-process model of ln(c_exact / c_surrogate) at the data's voltages, taught by the exact curves of the fit's refinement rounds (hpge_inference::refine)".into(),
+            inputs: job.inputs.clone(),
+            input_names: job.surrogate.inputs(),
+            voltages_v: job.data.voltage_v.clone(),
+            hyper: correction.map_or_else(
+                || crate::refine::GpHyper {
+                    lengths: Vec::new(),
+                    sf: 0.0,
+                    sn: 0.0,
+                },
+                |c| c.hyper.clone(),
+            ),
+            x: training.iter().map(|t| t.0.clone()).collect(),
+            log_ratio: training.iter().map(|t| t.1.clone()).collect(),
+        }
+    }
+
+    /// The error model rebuilt from the points and hyperparameters.
+    ///
+    /// # Errors
+    /// As [`crate::refine::GpCorrection::with_hyper`].
+    pub fn correction(&self) -> Result<crate::refine::GpCorrection> {
+        crate::refine::GpCorrection::with_hyper(&self.x, &self.log_ratio, self.hyper.clone())
+    }
+}
+
+/// Writes `error-model.json` (pretty, newline-terminated).
+pub fn write_error_model(path: &Path, file: &ErrorModelFile) -> Result<()> {
+    let text = serde_json::to_string_pretty(file).map_err(|e| Error::Numerical {
+        what: "the error model as JSON".into(),
+        message: e.to_string(),
+    })?;
+    write_text(path, &(text + "\n"))
+}

@@ -5,7 +5,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::Result;
-use crate::posterior::Posterior;
+use crate::posterior::{Evaluation, Posterior};
 use crate::rejection::unless_rejected;
 use crate::sampler::Samples;
 
@@ -44,15 +44,17 @@ pub fn thin_indices(total: usize, n: usize) -> Vec<usize> {
     (0..n).map(|i| i * total / n).collect()
 }
 
-/// The predictive from at most `n` draws, with the mode's curve `c_mode`. A draw whose curve
+/// The predictive from at most `n` draws, with the evaluation at the mode `mode` (its curve, and
+/// its model variance for sigma_c). A draw whose curve
 /// fails recoverably is left out; any other model error is returned.
 pub fn predictive(
     posterior: &Posterior,
     samples: &Samples,
     n: usize,
-    c_mode: &[f64],
+    mode: &Evaluation,
     levels: &[f64],
 ) -> Result<Predictive> {
+    let c_mode = &mode.c_p;
     let all = samples.all();
     let idx = thin_indices(all.len(), n);
     let curves: Vec<Vec<f64>> = idx
@@ -83,7 +85,7 @@ pub fn predictive(
         voltage_v: posterior.model.voltages().to_vec(),
         c_m_pf: c_m.clone(),
         c_mode_pf: c_mode.to_vec(),
-        sigma_pf: posterior.likelihood.sigma(c_mode),
+        sigma_pf: posterior.likelihood.sigma_var(c_mode, &mode.var_rel),
         median_pf: median,
         bands_pf: bands,
         draws: curves.len(),

@@ -119,10 +119,12 @@ pub fn fit(
     let mut mode = vec![0.0; d];
     prior.from_unconstrained(&z_mode, &mut mode);
     let at_mode = posterior.evaluate(&mode)?;
-    let chi2 = posterior.likelihood.chi2(&at_mode.c_p);
+    let chi2 = posterior
+        .likelihood
+        .chi2_var(&at_mode.c_p, &at_mode.var_rel);
     let max_abs_pull = posterior
         .likelihood
-        .pulls(&at_mode.c_p)
+        .pulls_var(&at_mode.c_p, &at_mode.var_rel)
         .iter()
         .fold(0.0f64, |m, p| m.max(p.abs()));
     let mut parameters = Vec::with_capacity(d);
@@ -175,7 +177,7 @@ pub fn fit(
         posterior,
         &samples,
         settings.predictive_draws,
-        &at_mode.c_p,
+        &at_mode,
         &LEVELS,
     )?;
     let summary = FitSummary {
@@ -187,6 +189,7 @@ pub fn fit(
         modes,
         local_modes: samples.local_modes.clone(),
         exact_check: None,
+        refinement: None,
         posterior_outside_support: None,
         program_version: env!("CARGO_PKG_VERSION").into(),
         inputs,

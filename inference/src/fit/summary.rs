@@ -5,7 +5,7 @@ use std::collections::BTreeMap;
 
 use serde::Serialize;
 
-use super::ExactCheck;
+use super::{ExactCheck, RefineRound};
 use crate::posterior::NoiseSettings;
 use crate::prior::PriorDistribution;
 use crate::sampler::{LocalMode, SampleSettings, SamplerStop};
@@ -71,9 +71,14 @@ pub struct FitSummary {
     pub modes: Vec<ModeSummary>,
     /// The local maxima found before sampling (Metropolis' mode search), best weight first.
     pub local_modes: Vec<LocalMode>,
-    /// The exact-solver check (absent with --no-exact-check).
+    /// The exact-solver check (absent with --no-exact-check); after refinement, the last
+    /// round's.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub exact_check: Option<ExactCheck>,
+    /// The rounds of posterior-adaptive refinement, the plain surrogate's first (absent with
+    /// --no-exact-check).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub refinement: Option<Vec<RefineRound>>,
     /// Share of the posterior draws with an input where the surrogate's training rows thin out
     /// (outside its support, issue 24: there it extrapolates); absent where not computed.
     #[serde(skip_serializing_if = "Option::is_none")]

@@ -36,6 +36,29 @@ pub trait CvModel: Send + Sync {
     fn has_jacobian(&self) -> bool;
     /// c12 (pF) and dc_k/dx_j (row-major, voltages x inputs).
     fn curve_jacobian(&self, x: &[f64], c_pf: &mut [f64], jac: &mut [f64]) -> Result<()>;
+    /// Whether the model's relative uncertainty varies with the inputs and the voltage
+    /// ([`CvModel::curve_variance`]); false: the constant [`CvModel::sigma_rel`] everywhere.
+    fn has_point_variance(&self) -> bool {
+        false
+    }
+    /// The squared relative uncertainty sigma_p,k(x)^2 of each point (the paper's eq. 13 with a
+    /// sigma_p per point), and with `jac` d sigma_p,k^2 / dx_j (row-major, voltages x inputs).
+    /// By default sigma_rel^2 everywhere, with zero derivatives.
+    ///
+    /// # Errors
+    /// As [`CvModel::curve`].
+    fn curve_variance(
+        &self,
+        _x: &[f64],
+        var_rel: &mut [f64],
+        jac: Option<&mut [f64]>,
+    ) -> Result<()> {
+        var_rel.fill(self.sigma_rel().powi(2));
+        if let Some(j) = jac {
+            j.fill(0.0);
+        }
+        Ok(())
+    }
     /// A short description for reports (file, recipe, ...).
     fn describe(&self) -> String;
     /// c12 (pF) at `x` and at every point of `near` (points close to `x`: forward-difference

@@ -44,6 +44,19 @@ impl Cholesky {
         (0..self.n).map(|i| 2.0 * self.l[i * self.n + i].ln()).sum()
     }
 
+    /// y = L^-1 b (forward substitution; |y|^2 = b^T A^-1 b, the stable form of a quadratic
+    /// form when A is ill-conditioned).
+    pub fn solve_lower(&self, b: &[f64]) -> Vec<f64> {
+        let n = self.n;
+        let mut y = b.to_vec();
+        for i in 0..n {
+            let row = &self.l[i * n..i * n + i];
+            let s = y[i] - row.iter().zip(&y[..i]).map(|(a, b)| a * b).sum::<f64>();
+            y[i] = s / self.l[i * n + i];
+        }
+        y
+    }
+
     /// x = A^-1 b.
     pub fn solve(&self, b: &[f64]) -> Vec<f64> {
         let n = self.n;

@@ -26,6 +26,9 @@ pub struct Evaluation {
     pub ln_likelihood: f64,
     /// The predicted curve, pF.
     pub c_p: Vec<f64>,
+    /// The model's squared relative uncertainty at each point, sigma_p,k^2
+    /// (`CvModel::curve_variance`).
+    pub var_rel: Vec<f64>,
 }
 
 impl std::fmt::Debug for Posterior<'_> {
@@ -83,22 +86,31 @@ impl<'a> Posterior<'a> {
     /// returned for the caller to treat as a rejection.
     pub fn evaluate(&self, theta: &[f64]) -> Result<Evaluation> {
         let lp = self.prior.ln_density(theta);
-        let mut c_p = vec![0.0; self.likelihood.len()];
+        let nv = self.likelihood.len();
+        let mut c_p = vec![0.0; nv];
+        let mut var_rel = vec![self.model.sigma_rel().powi(2); nv];
         if !lp.is_finite() {
             return Ok(Evaluation {
                 ln_posterior: f64::NEG_INFINITY,
                 ln_likelihood: f64::NEG_INFINITY,
                 c_p,
+                var_rel,
             });
         }
         let mut x = vec![0.0; self.prior.input_names.len()];
         self.prior.expand(theta, &mut x);
         self.model.curve(&x, &mut c_p)?;
-        let ll = self.likelihood.ln_likelihood(&c_p, None);
+        if self.model.has_point_variance() {
+            self.model.curve_variance(&x, &mut var_rel, None)?;
+        }
+        let ll = self
+            .likelihood
+            .ln_likelihood_var(&c_p, &var_rel, None, None);
         Ok(Evaluation {
             ln_posterior: lp + ll,
             ln_likelihood: ll,
             c_p,
+            var_rel,
         })
     }
 
@@ -115,7 +127,14 @@ impl<'a> Posterior<'a> {
         match grad {
             None => {
                 self.model.curve(&x, &mut c_p)?;
-                let ll = self.likelihood.ln_likelihood(&c_p, None);
+                let ll = if self.model.has_point_variance() {
+                    let mut var_rel = vec![0.0; nv];
+                    self.model.curve_variance(&x, &mut var_rel, None)?;
+                    self.likelihood
+                        .ln_likelihood_var(&c_p, &var_rel, None, None)
+                } else {
+                    self.likelihood.ln_likelihood(&c_p, None)
+                };
                 let lp = self.prior.ln_density_unconstrained(z, &theta, None, None);
                 Ok((lp + ll, theta))
             }
@@ -124,8 +143,28 @@ impl<'a> Posterior<'a> {
                 let mut jac = vec![0.0; nv * nx];
                 self.model.curve_jacobian(&x, &mut c_p, &mut jac)?;
                 let mut dl_dc = vec![0.0; nv];
-                let ll = self.likelihood.ln_likelihood(&c_p, Some(&mut dl_dc));
                 let mut dl_dx = vec![0.0; nx];
+                let ll = if self.model.has_point_variance() {
+                    let mut var_rel = vec![0.0; nv];
+                    let mut jac_var = vec![0.0; nv * nx];
+                    self.model
+                        .curve_variance(&x, &mut var_rel, Some(&mut jac_var))?;
+                    let mut dl_dv = vec![0.0; nv];
+                    let ll = self.likelihood.ln_likelihood_var(
+                        &c_p,
+                        &var_rel,
+                        Some(&mut dl_dc),
+                        Some(&mut dl_dv),
+                    );
+                    for k in 0..nv {
+                        for j in 0..nx {
+                            dl_dx[j] += dl_dv[k] * jac_var[k * nx + j];
+                        }
+                    }
+                    ll
+                } else {
+                    self.likelihood.ln_likelihood(&c_p, Some(&mut dl_dc))
+                };
                 for k in 0..nv {
                     for j in 0..nx {
                         dl_dx[j] += dl_dc[k] * jac[k * nx + j];

@@ -126,55 +126,83 @@ impl Likelihood {
     }
 
     /// The model-side variance at c_p (pF^2): (f_s c + a_s)^2 + (sigma_p c)^2, plus (f_m c)^2
-    /// for the paper's model.
-    fn variance(&self, c: f64) -> f64 {
+    /// for the paper's model; `s2` is sigma_p^2 (the model's squared relative uncertainty).
+    fn variance(&self, c: f64, s2: f64) -> f64 {
         let n = &self.noise;
         let s = n.solver_rel * c + n.solver_abs_pf;
-        let p = self.sigma_rel_model * c;
         let m = match n.kind {
             NoiseKind::Paper => n.measurement_rel * c,
             NoiseKind::Covariance => 0.0,
         };
-        s * s + p * p + m * m
+        s * s + s2 * c * c + m * m
     }
 
-    /// d variance / dc.
-    fn d_variance(&self, c: f64) -> f64 {
+    /// d variance / dc at sigma_p^2 = `s2`.
+    fn d_variance(&self, c: f64, s2: f64) -> f64 {
         let n = &self.noise;
         let s = n.solver_rel * c + n.solver_abs_pf;
-        let mut d = 2.0 * s * n.solver_rel + 2.0 * self.sigma_rel_model.powi(2) * c;
+        let mut d = 2.0 * s * n.solver_rel + 2.0 * s2 * c;
         if n.kind == NoiseKind::Paper {
             d += 2.0 * n.measurement_rel.powi(2) * c;
         }
         d
     }
 
+    /// The model's constant sigma_p^2 at every point.
+    fn constant_var(&self) -> Vec<f64> {
+        vec![self.sigma_rel_model * self.sigma_rel_model; self.len()]
+    }
+
     /// The standard deviation of each point (pF) at c_p: sqrt of the diagonal of Sigma.
     pub fn sigma(&self, c_p: &[f64]) -> Vec<f64> {
+        self.sigma_var(c_p, &self.constant_var())
+    }
+
+    /// [`Likelihood::sigma`] with the model's own sigma_p,k^2 at each point (`var_rel`, a model
+    /// whose uncertainty varies: `CvModel::curve_variance`) in place of the constant.
+    pub fn sigma_var(&self, c_p: &[f64], var_rel: &[f64]) -> Vec<f64> {
         let n = self.len();
         c_p.iter()
             .enumerate()
             .map(|(k, &c)| {
                 let v = self.covariance.as_ref().map_or(0.0, |m| m[k * n + k]);
-                (self.variance(c) + v).sqrt()
+                (self.variance(c, var_rel[k]) + v).sqrt()
             })
             .collect()
     }
 
     /// ln L(c_p) (see the module docs); with `grad`, also d ln L / d c_p.
     pub fn ln_likelihood(&self, c_p: &[f64], grad: Option<&mut [f64]>) -> f64 {
+        self.ln_likelihood_var(c_p, &self.constant_var(), grad, None)
+    }
+
+    /// ln L(c_p) with the model's sigma_p,k^2 at each point (`var_rel`) in place of the
+    /// constant; with `grad_c`, d ln L / d c_p, with `grad_var`, d ln L / d sigma_p,k^2.
+    pub fn ln_likelihood_var(
+        &self,
+        c_p: &[f64],
+        var_rel: &[f64],
+        grad_c: Option<&mut [f64]>,
+        grad_var: Option<&mut [f64]>,
+    ) -> f64 {
         let n = self.len();
+        let mut gc = grad_c;
+        let mut gv = grad_var;
         match &self.covariance {
             None => {
                 let mut ll = 0.0;
-                let mut g = grad;
                 for k in 0..n {
-                    let var = self.variance(c_p[k]);
+                    let var = self.variance(c_p[k], var_rel[k]);
                     let r = self.c_m[k] - c_p[k];
                     ll -= 0.5 * r * r / var + 0.5 * var.ln() + LN_SQRT_2PI;
-                    if let Some(g) = g.as_deref_mut() {
-                        // d/dc of -r^2/(2v) - ln v / 2, with dr/dc = -1.
-                        g[k] = r / var + 0.5 * (r * r / var - 1.0) / var * self.d_variance(c_p[k]);
+                    // d/dvar of -r^2/(2v) - ln v / 2.
+                    let dl_dv = 0.5 * (r * r / var - 1.0) / var;
+                    if let Some(g) = gc.as_deref_mut() {
+                        // d/dc, with dr/dc = -1.
+                        g[k] = r / var + dl_dv * self.d_variance(c_p[k], var_rel[k]);
+                    }
+                    if let Some(g) = gv.as_deref_mut() {
+                        g[k] = dl_dv * c_p[k] * c_p[k];
                     }
                 }
                 ll
@@ -182,7 +210,7 @@ impl Likelihood {
             Some(vm) => {
                 let mut a = vm.clone();
                 for k in 0..n {
-                    a[k * n + k] += self.variance(c_p[k]);
+                    a[k * n + k] += self.variance(c_p[k], var_rel[k]);
                 }
                 let Some(chol) = Cholesky::new(&a, n) else {
                     return f64::NEG_INFINITY;
@@ -190,11 +218,16 @@ impl Likelihood {
                 let r: Vec<f64> = (0..n).map(|k| self.c_m[k] - c_p[k]).collect();
                 let alpha = chol.solve(&r);
                 let quad: f64 = r.iter().zip(&alpha).map(|(x, y)| x * y).sum();
-                if let Some(g) = grad {
+                if gc.is_some() || gv.is_some() {
                     let inv_diag = chol.inverse_diagonal();
                     for k in 0..n {
-                        g[k] = alpha[k]
-                            + 0.5 * (alpha[k] * alpha[k] - inv_diag[k]) * self.d_variance(c_p[k]);
+                        let dl_dv = 0.5 * (alpha[k] * alpha[k] - inv_diag[k]);
+                        if let Some(g) = gc.as_deref_mut() {
+                            g[k] = alpha[k] + dl_dv * self.d_variance(c_p[k], var_rel[k]);
+                        }
+                        if let Some(g) = gv.as_deref_mut() {
+                            g[k] = dl_dv * c_p[k] * c_p[k];
+                        }
                     }
                 }
                 -0.5 * quad - 0.5 * chol.ln_det() - n as f64 * LN_SQRT_2PI
@@ -205,17 +238,20 @@ impl Likelihood {
     /// chi^2 = r^T Sigma(c_p)^-1 r with r = c_m - c_p (the sum of squared pulls for the paper's
     /// independent model).
     pub fn chi2(&self, c_p: &[f64]) -> f64 {
+        self.chi2_var(c_p, &self.constant_var())
+    }
+
+    /// [`Likelihood::chi2`] with the model's sigma_p,k^2 at each point (`var_rel`).
+    pub fn chi2_var(&self, c_p: &[f64], var_rel: &[f64]) -> f64 {
         let n = self.len();
         match &self.covariance {
-            None => c_p
-                .iter()
-                .zip(&self.c_m)
-                .map(|(&c, &m)| (m - c).powi(2) / self.variance(c))
+            None => (0..n)
+                .map(|k| (self.c_m[k] - c_p[k]).powi(2) / self.variance(c_p[k], var_rel[k]))
                 .sum(),
             Some(vm) => {
                 let mut a = vm.clone();
                 for k in 0..n {
-                    a[k * n + k] += self.variance(c_p[k]);
+                    a[k * n + k] += self.variance(c_p[k], var_rel[k]);
                 }
                 let Some(chol) = Cholesky::new(&a, n) else {
                     return f64::INFINITY;
@@ -229,7 +265,12 @@ impl Likelihood {
 
     /// Pulls (c_p - c_m) / sigma per point, sigma the square root of Sigma's diagonal.
     pub fn pulls(&self, c_p: &[f64]) -> Vec<f64> {
-        let s = self.sigma(c_p);
+        self.pulls_var(c_p, &self.constant_var())
+    }
+
+    /// [`Likelihood::pulls`] with the model's sigma_p,k^2 at each point (`var_rel`).
+    pub fn pulls_var(&self, c_p: &[f64], var_rel: &[f64]) -> Vec<f64> {
+        let s = self.sigma_var(c_p, var_rel);
         (0..self.len())
             .map(|k| (c_p[k] - self.c_m[k]) / s[k])
             .collect()
@@ -251,12 +292,12 @@ impl Likelihood {
             None => c_p
                 .iter()
                 .zip(&z)
-                .map(|(&c, &e)| c + self.variance(c).sqrt() * e)
+                .map(|(&c, &e)| c + self.variance(c, self.sigma_rel_model.powi(2)).sqrt() * e)
                 .collect(),
             Some(vm) => {
                 let mut a = vm.clone();
                 for k in 0..n {
-                    a[k * n + k] += self.variance(c_p[k]);
+                    a[k * n + k] += self.variance(c_p[k], self.sigma_rel_model.powi(2));
                 }
                 let chol = Cholesky::new(&a, n).expect("a covariance plus a positive diagonal");
                 let e = chol.mul_lower(&z);

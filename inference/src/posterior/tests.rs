@@ -123,3 +123,62 @@ fn simulated_data_have_the_model_spread() {
         assert!((v - 1.0).abs() < 0.05, "{v}");
     }
 }
+
+/// d ln L / d sigma_p,k^2 and d ln L / dc with a per-point variance, both noise models.
+#[test]
+fn per_point_variance_gradients_match_finite_differences() {
+    let c_p = vec![310.0, 148.0, 91.0, 59.0, 44.0, 41.0];
+    let var = vec![1e-4, 4e-4, 2.5e-5, 9e-4, 1e-4, 1.6e-3];
+    let noise = NoiseSettings {
+        kind: NoiseKind::Covariance,
+        ..NoiseSettings::default()
+    };
+    for l in [
+        Likelihood::new(&data(None), NoiseSettings::default(), 0.015).unwrap(),
+        Likelihood::new(&data(Some(covariance())), noise, 0.015).unwrap(),
+    ] {
+        let (mut gc, mut gv) = (vec![0.0; 6], vec![0.0; 6]);
+        let ll = l.ln_likelihood_var(&c_p, &var, Some(&mut gc), Some(&mut gv));
+        // The constant variance is the special case.
+        let constant = vec![0.015f64.powi(2); 6];
+        let a = l.ln_likelihood_var(&c_p, &constant, None, None);
+        assert!((a - l.ln_likelihood(&c_p, None)).abs() < 1e-12);
+        assert!((ll - a).abs() > 1e-3);
+        for k in 0..6 {
+            let h = 1e-7;
+            let (mut p, mut m) = (var.clone(), var.clone());
+            p[k] += h;
+            m[k] -= h;
+            let fd = (l.ln_likelihood_var(&c_p, &p, None, None)
+                - l.ln_likelihood_var(&c_p, &m, None, None))
+                / (2.0 * h);
+            assert!(
+                (fd - gv[k]).abs() < 1e-5 * (1.0 + fd.abs()),
+                "var {k}: {fd} vs {}",
+                gv[k]
+            );
+            let h = 1e-4 * c_p[k];
+            let (mut p, mut m) = (c_p.clone(), c_p.clone());
+            p[k] += h;
+            m[k] -= h;
+            let fd = (l.ln_likelihood_var(&p, &var, None, None)
+                - l.ln_likelihood_var(&m, &var, None, None))
+                / (2.0 * h);
+            assert!(
+                (fd - gc[k]).abs() < 1e-6 * (1.0 + fd.abs()),
+                "c {k}: {fd} vs {}",
+                gc[k]
+            );
+        }
+        // chi^2, sigma and pulls use the same variance.
+        let s = l.sigma_var(&c_p, &var);
+        let pulls = l.pulls_var(&c_p, &var);
+        for k in 0..6 {
+            assert!((pulls[k] - (c_p[k] - l.c_m[k]) / s[k]).abs() < 1e-12);
+        }
+        if l.noise.kind == NoiseKind::Paper {
+            let chi2: f64 = pulls.iter().map(|p| p * p).sum();
+            assert!((chi2 - l.chi2_var(&c_p, &var)).abs() < 1e-9);
+        }
+    }
+}

@@ -8,7 +8,8 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use hpge_inference::fit::{
-    ExactGrids, FitJob, FitOptions, TruthRecord, outputs, read_truth, truth_records,
+    ExactGrids, FitJob, FitOptions, RefineProgress, RefineRound, TruthRecord, outputs, read_truth,
+    truth_records,
 };
 use hpge_inference::{Fit, FitSettings, Status};
 
@@ -30,6 +31,9 @@ pub trait FitObserver: Sync {
     fn exact_progress(&self, _done: usize, _total: usize) {}
     /// The exact-solver check ended.
     fn exact_done(&self) {}
+    /// A round of refinement ended (its check included); the next samples again unless it
+    /// passed or was the last.
+    fn round_done(&self, _round: &RefineRound) {}
     /// The fit is written (called by `report paper`'s fit steps, which show the result).
     fn finished(&self, _run: &FitRun) {}
 }
@@ -76,14 +80,35 @@ pub fn run_fit(o: &FitOptions, observer: &dyn FitObserver) -> Result<FitRun> {
         message: format!("cannot create the folder: {e}"),
     })?;
     observer.setup_done(&job, o, &settings);
-    let mut fit = job.run(&settings, &|s| observer.sampling(s))?;
-    observer.sampling_done();
-    if !o.no_exact_check {
-        observer.exact_start(o.exact_draws);
-        job.check_exact(&mut fit, &o.exact_check()?, &|done, total| {
-            observer.exact_progress(done, total)
-        })?;
-        observer.exact_done();
+    let (fit, correction) = if o.no_exact_check {
+        let fit = job.run(&settings, &|s| observer.sampling(s))?;
+        observer.sampling_done();
+        (fit, None)
+    } else {
+        let refined = job.run_refined(
+            &settings,
+            &o.exact_check()?,
+            &o.refine(),
+            RefineProgress {
+                sampling: &|s| observer.sampling(s),
+                sampled: &|_| {
+                    observer.sampling_done();
+                    observer.exact_start(o.exact_draws);
+                },
+                exact: &|done, total| observer.exact_progress(done, total),
+                round: &|r| {
+                    observer.exact_done();
+                    observer.round_done(r);
+                },
+            },
+        )?;
+        let file = refined.correction.as_ref().map(|_| {
+            outputs::ErrorModelFile::new(&job, &refined.training, refined.correction.as_ref())
+        });
+        (refined.fit, file)
+    };
+    if let Some(file) = &correction {
+        outputs::write_error_model(&out.join(outputs::ERROR_MODEL_FILE), file)?;
     }
     let records = truth.as_ref().map(|t| truth_records(&fit.summary, t));
     write_outputs(o, &out, &job, &fit, truth.as_deref(), records.as_deref())?;
@@ -228,9 +253,22 @@ pub fn summary_text(fit: &Fit, out: &Path) -> String {
         }
     }
     if let Some(c) = &s.exact_check {
+        let rounds = s.refinement.as_ref().map_or(1, Vec::len);
         let _ = writeln!(
             t,
-            "exact check ({} draws on {}, {:.1} s): Pareto k {:.2}, largest mean shift {:.2} sd, |c_exact - c_surrogate|/c at the mode <= {:.2}%: {}",
+            "exact check{} ({} draws on {}, {:.1} s): Pareto k {:.2}, largest mean shift {:.2} sd, |c_exact - c_model|/c at the mode <= {:.2}%: {}",
+            if rounds > 1 {
+                format!(
+                    " after {} rounds of refinement (the surrogate corrected by {} exact curves)",
+                    rounds - 1,
+                    s.refinement
+                        .as_ref()
+                        .and_then(|r| r.last())
+                        .map_or(0, |r| r.training_curves)
+                )
+            } else {
+                String::new()
+            },
             c.draws,
             grids_text(c),
             c.seconds,

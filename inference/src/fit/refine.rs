@@ -1,0 +1,249 @@
+//! Posterior-adaptive refinement of a fit (issue 21): sample, check the draws with the exact
+//! solver, and while the check fails, teach a model of the surrogate's error at those draws
+//! ([`GpCorrection`]) and sample again with the corrected surrogate ([`CorrectedModel`]).
+//!
+//! Round r samples the posterior of model M_r (M_0 the surrogate, M_r the surrogate corrected
+//! by every exact curve of rounds 0..r) and re-weights a thinned sample with the exact solver
+//! (`exact_check`, the weights ln L_exact - ln L_{M_r}, M_r's own per-point uncertainty in its
+//! likelihood). A passing check ends the loop: M_r's posterior is the fit's, and the check is
+//! its verification. A failing one adds its exact curves to the error model's training points
+//! (each check's curves are solved before they teach the model that the next check tests, so
+//! no check ever sees its own training data). The loop also ends after `max_rounds` rounds.
+
+use std::collections::BTreeMap;
+use std::time::Instant;
+
+use serde::Serialize;
+
+use super::exact_check::{ExactCheckSettings, ExactGrids, add_grid_check, exact_check};
+use super::job::FitJob;
+use super::run::{Fit, FitSettings, fit};
+use crate::Result;
+use crate::model::{CvModel, ExactModel};
+use crate::posterior::{Likelihood, Posterior};
+use crate::prior::Prior;
+use crate::refine::{CorrectedModel, GpCorrection, GpHyper};
+use crate::sampler::Status;
+
+/// Rounds of refinement at most (the first, with the plain surrogate, included): each costs a
+/// sampling run and one exact check (for the shipped B_RZ fit on two cores about 25 s and 100 s
+/// in the first round, 15-25 s and 60-70 s in the narrower later ones). The shipped fit passed
+/// in its fourth round (reports/inference.md, "Posterior-adaptive refinement"); five leave one
+/// round of margin.
+pub const DEFAULT_REFINE_ROUNDS: usize = 5;
+
+/// Nelder-Mead evaluations for the error model's hyperparameters per round.
+pub const DEFAULT_HYPER_EVALS: usize = 600;
+
+/// How a fit refines.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct RefineSettings {
+    /// Rounds at most, the first (plain surrogate) included; 1: no refinement.
+    pub max_rounds: usize,
+    /// Nelder-Mead evaluations of the error model's hyperparameters per round.
+    pub hyper_evals: usize,
+}
+
+impl Default for RefineSettings {
+    fn default() -> Self {
+        Self {
+            max_rounds: DEFAULT_REFINE_ROUNDS,
+            hyper_evals: DEFAULT_HYPER_EVALS,
+        }
+    }
+}
+
+/// One round of refinement.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct RefineRound {
+    /// 0 for the plain surrogate.
+    pub round: usize,
+    /// Exact curves the sampled model was corrected with (0 in round 0).
+    pub training_curves: usize,
+    /// Pareto k-hat of the round's exact check.
+    pub pareto_k: f64,
+    /// Its largest |mean shift| in posterior sd.
+    pub max_abs_shift_sd: f64,
+    /// Its largest |c_exact - c_model| / c_exact at the round's global mode.
+    pub max_rel_diff_at_mode: f64,
+    /// Whether the check passed.
+    pub pass: bool,
+    /// Sampling and summary, s.
+    pub sampling_seconds: f64,
+    /// The exact check, s.
+    pub exact_seconds: f64,
+    /// Fitting the error model before this round, s (0 in round 0).
+    pub error_model_seconds: f64,
+}
+
+/// A refined fit: the last round's fit (its exact check in its summary), the rounds, and the
+/// error model it was sampled with (None when the plain surrogate passed or no round ran
+/// corrected).
+pub struct RefinedFit {
+    /// The fit of the last round.
+    pub fit: Fit,
+    /// Every round, in order.
+    pub rounds: Vec<RefineRound>,
+    /// The error model of the last round's model.
+    pub correction: Option<GpCorrection>,
+    /// The error model's training points: model inputs x and ln(c_exact / c_surrogate) at the
+    /// voltages (every exact curve of the rounds before the last).
+    pub training: Vec<(Vec<f64>, Vec<f64>)>,
+}
+
+/// The models and the data a refined fit works with.
+#[derive(Clone, Copy)]
+pub struct RefineInputs<'a> {
+    /// The surrogate (the model of round 0, corrected in the later rounds).
+    pub surrogate: &'a dyn CvModel,
+    /// The exact solver (the check's reference and the error model's teacher).
+    pub exact: &'a dyn CvModel,
+    /// The prior.
+    pub prior: &'a Prior,
+    /// The likelihood of the data.
+    pub likelihood: &'a Likelihood,
+}
+
+/// What a refined fit reports as it goes: the sampling status, the check's curves (done,
+/// total) and each finished round.
+#[derive(Clone, Copy)]
+pub struct RefineProgress<'a> {
+    /// A sampling status update.
+    pub sampling: &'a (dyn Fn(&Status) + Sync),
+    /// A round's sampling ended and its exact check starts (with the round).
+    pub sampled: &'a (dyn Fn(usize) + Sync),
+    /// Curves done of the exact check.
+    pub exact: &'a (dyn Fn(usize, usize) + Sync),
+    /// A round ended.
+    pub round: &'a (dyn Fn(&RefineRound) + Sync),
+}
+
+/// Samples and checks with the exact solver, refining while the check fails (see the module
+/// text); `inputs` (file names and hashes) go into each round's summary.
+///
+/// # Errors
+/// As [`fit`] and [`exact_check`]; an error model that cannot be fitted.
+pub fn refine_fit(
+    m: RefineInputs,
+    settings: &FitSettings,
+    check: &ExactCheckSettings,
+    refine: &RefineSettings,
+    inputs: &BTreeMap<String, String>,
+    progress: RefineProgress,
+) -> Result<RefinedFit> {
+    let mut training: Vec<(Vec<f64>, Vec<f64>)> = Vec::new();
+    let mut rounds = Vec::new();
+    let mut hyper: Option<GpHyper> = None;
+    let mut correction: Option<GpCorrection> = None;
+    let mut error_model_seconds = 0.0;
+    let nv = m.likelihood.len();
+    let last = refine.max_rounds.max(1) - 1;
+    for round in 0..=last {
+        let corrected = match &correction {
+            Some(gp) => Some(CorrectedModel::new(m.surrogate, gp.clone())?),
+            None => None,
+        };
+        let model: &dyn CvModel = match &corrected {
+            Some(c) => c,
+            None => m.surrogate,
+        };
+        let posterior = Posterior::new(model, m.prior, m.likelihood)?;
+        let t = Instant::now();
+        let mut result = fit(&posterior, settings, inputs.clone(), progress.sampling)?;
+        let sampling_seconds = t.elapsed().as_secs_f64();
+        (progress.sampled)(round);
+        // The grid check once, on the last round's draws (below).
+        let no_grid_check = ExactCheckSettings {
+            grid_check: 0,
+            ..*check
+        };
+        let mut chk = exact_check(
+            model,
+            m.exact,
+            m.prior,
+            m.likelihood,
+            &result.samples,
+            &result.mode,
+            &no_grid_check,
+            progress.exact,
+        )?;
+        let done = chk.pass || round == last;
+        if done && chk.grids == ExactGrids::Mode && check.grid_check > 0 {
+            add_grid_check(&mut chk, m.exact, m.likelihood, check.grid_check)?;
+        }
+        let info = RefineRound {
+            round,
+            training_curves: training.len(),
+            pareto_k: chk.pareto_k,
+            max_abs_shift_sd: chk.max_abs_shift_sd,
+            max_rel_diff_at_mode: chk.max_rel_diff_at_mode,
+            pass: chk.pass,
+            sampling_seconds,
+            exact_seconds: chk.seconds,
+            error_model_seconds,
+        };
+        (progress.round)(&info);
+        rounds.push(info);
+        let solved = std::mem::take(&mut chk.solved);
+        result.summary.seconds += chk.seconds;
+        result.summary.exact_check = Some(chk);
+        if done {
+            result.summary.refinement = Some(rounds.clone());
+            return Ok(RefinedFit {
+                fit: result,
+                rounds,
+                correction,
+                training,
+            });
+        }
+        // Teach the error model the new curves: r = ln(c_exact / c_surrogate).
+        for (x, ce) in solved {
+            let mut cs = vec![0.0; nv];
+            if m.surrogate.curve(&x, &mut cs).is_err() {
+                continue;
+            }
+            let r: Vec<f64> = ce.iter().zip(&cs).map(|(e, s)| (e / s).ln()).collect();
+            if r.iter().all(|v| v.is_finite()) {
+                training.push((x, r));
+            }
+        }
+        let t_fit = Instant::now();
+        let (xs, rs): (Vec<Vec<f64>>, Vec<Vec<f64>>) = training.iter().cloned().unzip();
+        let gp = GpCorrection::fit(&xs, &rs, hyper.as_ref(), refine.hyper_evals)
+            .map_err(|e| e.context(format!("the error model of refinement round {}", round + 1)))?;
+        error_model_seconds = t_fit.elapsed().as_secs_f64();
+        hyper = Some(gp.hyper.clone());
+        correction = Some(gp);
+    }
+    unreachable!("the loop returns in its last round")
+}
+
+impl FitJob {
+    /// [`refine_fit`] with the job's surrogate, exact solver, prior and likelihood; each
+    /// round's check records the exact solver's tolerance, the fit the share of its draws
+    /// outside the surrogate's support.
+    ///
+    /// # Errors
+    /// As [`refine_fit`]; the exact model cannot be set up at the data's voltages.
+    pub fn run_refined(
+        &self,
+        settings: &FitSettings,
+        check: &ExactCheckSettings,
+        refine: &RefineSettings,
+        progress: RefineProgress,
+    ) -> Result<RefinedFit> {
+        let exact = ExactModel::new(self.exact.clone(), &self.data.voltage_v)?;
+        let m = RefineInputs {
+            surrogate: &self.surrogate,
+            exact: &exact,
+            prior: &self.prior,
+            likelihood: &self.likelihood,
+        };
+        let mut r = refine_fit(m, settings, check, refine, &self.inputs, progress)?;
+        r.fit.summary.posterior_outside_support = Some(self.outside_support(&r.fit.samples));
+        if let Some(c) = r.fit.summary.exact_check.as_mut() {
+            c.solver_tolerance = Some(self.exact.settings.grid.tolerance);
+        }
+        Ok(r)
+    }
+}
