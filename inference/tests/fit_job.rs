@@ -188,3 +188,54 @@ fn exact_nearby_curves_keep_each_draw_apart_and_agree_with_own_grids() {
         );
     }
 }
+
+#[test]
+fn zeta_bands_come_from_the_draws_and_the_truth_is_drawn_where_given() {
+    use hpge_inference::fit::zeta_profiles;
+    let o = shipped("priors/b-rz.toml");
+    let job = FitJob::from_files(&o.files(), o.noise().unwrap(), &o.grid).unwrap();
+    let a: Vec<f64> = vec![3.0, 0.66, 0.65, 0.58, -0.4, 0.55, 0.54, 0.47, -0.3];
+    let b: Vec<f64> = vec![2.5, 0.60, 0.70, 0.50, 0.2, 0.60, 0.50, 0.40, -0.8];
+    // Draws all equal to the mode: the bands collapse onto it, and the truth at the mode is it.
+    let z = zeta_profiles(&job.exact, &job.prior, &a, &[&a, &a, &a], Some(&a)).unwrap();
+    assert_eq!(z.band_draws, 3);
+    assert_eq!(z.along_z.len(), 5);
+    assert_eq!(z.along_r.len(), 3);
+    for p in z.along_z.iter().chain(&z.along_r) {
+        assert_eq!(p.truth_cm3, p.zeta_cm3);
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * b.abs().max(1.0);
+        for (k, v) in p.zeta_cm3.iter().enumerate() {
+            for band in [p.band_683_cm3[k], p.band_955_cm3[k]] {
+                assert!(close(band[0], *v) && close(band[1], *v), "{band:?} vs {v}");
+            }
+        }
+    }
+    // Two different draws: the 95.5% band lies between them and holds the 68.3% one.
+    let z2 = zeta_profiles(&job.exact, &job.prior, &a, &[&a, &b], None).unwrap();
+    let zb = zeta_profiles(&job.exact, &job.prior, &b, &[], None).unwrap();
+    let mut differ = 0;
+    for (p, q) in z2.along_r.iter().zip(&zb.along_r) {
+        assert!(p.truth_cm3.is_empty());
+        for k in 0..p.x_mm.len() {
+            let (lo, hi) = (
+                p.zeta_cm3[k].min(q.zeta_cm3[k]),
+                p.zeta_cm3[k].max(q.zeta_cm3[k]),
+            );
+            let (w, n) = (p.band_955_cm3[k], p.band_683_cm3[k]);
+            let eps = 1e-9 * hi.abs().max(1.0);
+            assert!(
+                lo - eps <= w[0]
+                    && w[0] <= n[0]
+                    && n[0] <= n[1]
+                    && n[1] <= w[1]
+                    && w[1] <= hi + eps,
+                "{lo} {w:?} {n:?} {hi}"
+            );
+            differ += usize::from(hi > lo);
+        }
+    }
+    assert!(
+        differ > 100,
+        "the two draws' profiles should differ: {differ}"
+    );
+}

@@ -11,7 +11,7 @@ use hpge_surrogate::{ExactSolver, Surrogate};
 
 use super::exact_check::{ExactCheckSettings, exact_check};
 use super::run::{Fit, FitSettings, fit};
-use super::zeta::{ZetaAtMode, zeta_at_mode};
+use super::zeta::{ZETA_BAND_DRAWS, ZetaAtMode, zeta_profiles};
 use crate::model::{CvModel, ExactModel, SurrogateModel};
 use crate::posterior::{Likelihood, NoiseSettings, Posterior};
 use crate::prior::{Prior, PriorSpec};
@@ -263,11 +263,25 @@ impl FitJob {
         Ok(())
     }
 
-    /// zeta at the global mode of `result` ([`zeta_at_mode`]).
+    /// zeta at the global mode of `result` with the posterior's 68.3% and 95.5% bands over
+    /// [`ZETA_BAND_DRAWS`] thinned draws, and the truth's profiles where `truth` gives every
+    /// parameter ([`zeta_profiles`]).
     ///
     /// # Errors
-    /// The detector cannot be built at the mode.
-    pub fn zeta_at_mode(&self, result: &Fit) -> Result<ZetaAtMode> {
-        zeta_at_mode(&self.exact, &self.prior, &result.mode)
+    /// The detector cannot be built at the mode or at the truth.
+    pub fn zeta_at_mode(&self, result: &Fit, truth: Option<&[Option<f64>]>) -> Result<ZetaAtMode> {
+        let all = result.samples.all();
+        let draws: Vec<&[f64]> = super::predictive::thin_indices(all.len(), ZETA_BAND_DRAWS)
+            .into_iter()
+            .map(|i| all[i])
+            .collect();
+        let truth: Option<Vec<f64>> = truth.and_then(|t| t.iter().copied().collect());
+        zeta_profiles(
+            &self.exact,
+            &self.prior,
+            &result.mode,
+            &draws,
+            truth.as_deref(),
+        )
     }
 }

@@ -30,4 +30,4 @@ pub use refine::{
 pub use run::{Fit, FitSettings, draw_range, fit};
 pub use summary::{FitSummary, LEVELS, ModeSummary, ParameterSummary};
 pub use truth::{TruthRecord, read_truth, truth_records};
-pub use zeta::{ZetaAtMode, ZetaProfile, zeta_at_mode};
+pub use zeta::{ZETA_BAND_DRAWS, ZetaAtMode, ZetaProfile, zeta_at_mode, zeta_profiles};

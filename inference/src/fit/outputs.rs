@@ -1,5 +1,5 @@
 //! The tables a fit writes beside its summary: `samples.csv` (every draw), `predictive.csv`
-//! (c_p - c_m bands per voltage), `zeta-mode.csv` (the profiles at the global mode) and
+//! (c_p - c_m bands per voltage), `zeta-mode.csv` (the profiles at the global mode with their posterior bands) and
 //! `summary.json`. The CSVs are plain tables (one header row, no comment lines) that
 //! `pandas.read_csv` and `numpy.genfromtxt(names=True, delimiter=',')` load as they are; their
 //! provenance (program version, inputs with hashes, sampler, seed, likelihood) is in
@@ -69,13 +69,26 @@ pub fn write_predictive(path: &Path, fit: &Fit) -> Result<()> {
     write_text(path, &w)
 }
 
-/// `zeta-mode.csv`: `profile,label,coordinate_mm,zeta_cm3` (profiles `along_z`, `along_r`).
+/// `zeta-mode.csv`: `profile,label,coordinate_mm,zeta_cm3` (the global mode; profiles
+/// `along_z`, `along_r`), then `lo_683_cm3,hi_683_cm3,lo_955_cm3,hi_955_cm3` (the posterior's
+/// central bands) and `truth_cm3`, each column empty where it was not computed.
 pub fn write_zeta(path: &Path, zeta: &ZetaAtMode) -> Result<()> {
-    let mut w = String::from("profile,label,coordinate_mm,zeta_cm3\n");
+    let mut w = String::from(
+        "profile,label,coordinate_mm,zeta_cm3,lo_683_cm3,hi_683_cm3,lo_955_cm3,hi_955_cm3,truth_cm3\n",
+    );
+    let pair = |b: Option<&[f64; 2]>| b.map_or(",".to_string(), |b| format!("{},{}", b[0], b[1]));
     for (kind, list) in [("along_z", &zeta.along_z), ("along_r", &zeta.along_r)] {
         for prof in list {
-            for (x, v) in prof.x_mm.iter().zip(&prof.zeta_cm3) {
-                w.push_str(&format!("{kind},{},{x},{v}\n", prof.label));
+            for (k, (x, v)) in prof.x_mm.iter().zip(&prof.zeta_cm3).enumerate() {
+                w.push_str(&format!(
+                    "{kind},{},{x},{v},{},{},{}\n",
+                    prof.label,
+                    pair(prof.band_683_cm3.get(k)),
+                    pair(prof.band_955_cm3.get(k)),
+                    prof.truth_cm3
+                        .get(k)
+                        .map_or(String::new(), |t| t.to_string())
+                ));
             }
         }
     }

@@ -137,7 +137,7 @@ pub fn write_outputs(
 ) -> Result<()> {
     outputs::write_samples(&out.join("samples.csv"), fit)?;
     outputs::write_predictive(&out.join("predictive.csv"), fit)?;
-    let zeta = s.zeta_at_mode(fit)?;
+    let zeta = s.zeta_at_mode(fit, truth)?;
     outputs::write_zeta(&out.join("zeta-mode.csv"), &zeta)?;
     let mut figures = Vec::new();
     if !o.no_plots {

@@ -118,30 +118,51 @@ pub(super) fn predictive<DB: DrawingBackend>(
     Ok(())
 }
 
-/// zeta in 1e10 cm^-3 along `axis` ("z" or "r"), one line per profile.
+/// zeta in 1e10 cm^-3 along `axis` ("z" or "r"), one colour per profile: the global mode (solid),
+/// the posterior's 68.3% and 95.5% central bands over the draws (shaded, where computed) and the
+/// truth (dashed, where known).
 pub(super) fn zeta<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     profiles: &[ZetaProfile],
+    band_draws: usize,
     axis: &str,
     title: &str,
 ) -> Result<()> {
     root.fill(&WHITE).map_err(err)?;
+    let bands = profiles.iter().any(|p| !p.band_955_cm3.is_empty());
+    let truth = profiles.iter().any(|p| !p.truth_cm3.is_empty());
     let root = root
         .titled(
-            &format!("{title}: impurity density at the global mode along {axis}"),
-            ("sans-serif", 24),
+            &format!(
+                "{title}: impurity density along {axis}, global mode{}{}",
+                if bands {
+                    format!(" with 68.3% / 95.5% bands ({band_draws} draws)")
+                } else {
+                    String::new()
+                },
+                if truth { ", truth dashed" } else { "" }
+            ),
+            ("sans-serif", 22),
         )
         .map_err(err)?;
-    let keys: Vec<(Key, String)> = profiles
+    let mut keys: Vec<(Key, String)> = profiles
         .iter()
         .enumerate()
         .map(|(k, p)| (Key::Line(PALETTE[k % PALETTE.len()]), p.label.clone()))
         .collect();
+    if truth {
+        keys.push((Key::Dashed(RGBColor(90, 90, 90)), "truth".into()));
+    }
     let body = key_strip(&root, &keys)?;
     let (x0, x1) = padded(profiles.iter().flat_map(|p| p.x_mm.iter().copied()), 0.02);
-    let ys = profiles
-        .iter()
-        .flat_map(|p| p.zeta_cm3.iter().map(|z| z / 1e10));
+    let ys = profiles.iter().flat_map(|p| {
+        p.zeta_cm3
+            .iter()
+            .chain(&p.truth_cm3)
+            .copied()
+            .chain(p.band_955_cm3.iter().flatten().copied())
+            .map(|z| z / 1e10)
+    });
     let (y0, y1) = padded(ys.chain([0.0]), 0.06);
     let mut chart = curve_chart(
         &body,
@@ -156,13 +177,49 @@ pub(super) fn zeta<DB: DrawingBackend>(
         ))
         .map_err(err)?;
     for (k, p) in profiles.iter().enumerate() {
+        let colour = PALETTE[k % PALETTE.len()];
+        for (band, alpha) in [(&p.band_955_cm3, 0.12), (&p.band_683_cm3, 0.25)] {
+            if band.len() != p.x_mm.len() || band.is_empty() {
+                continue;
+            }
+            let outline: Vec<(f64, f64)> = p
+                .x_mm
+                .iter()
+                .zip(band)
+                .map(|(x, b)| (*x, b[1] / 1e10))
+                .chain(
+                    p.x_mm
+                        .iter()
+                        .zip(band)
+                        .rev()
+                        .map(|(x, b)| (*x, b[0] / 1e10)),
+                )
+                .collect();
+            chart
+                .draw_series(std::iter::once(Polygon::new(
+                    outline,
+                    colour.mix(alpha).filled(),
+                )))
+                .map_err(err)?;
+        }
+    }
+    for (k, p) in profiles.iter().enumerate() {
+        let colour = PALETTE[k % PALETTE.len()];
         let pts = p.x_mm.iter().zip(&p.zeta_cm3).map(|(x, z)| (*x, z / 1e10));
         chart
-            .draw_series(LineSeries::new(
-                pts,
-                PALETTE[k % PALETTE.len()].stroke_width(3),
-            ))
+            .draw_series(LineSeries::new(pts, colour.stroke_width(3)))
             .map_err(err)?;
+        if p.truth_cm3.len() == p.x_mm.len() {
+            let pts: Vec<(f64, f64)> = p
+                .x_mm
+                .iter()
+                .zip(&p.truth_cm3)
+                .map(|(x, z)| (*x, z / 1e10))
+                .collect();
+            chart
+                .draw_series(DashedLineSeries::new(pts, 9, 6, colour.stroke_width(2)))
+                .map_err(err)?;
+        }
     }
     Ok(())
 }

@@ -100,7 +100,11 @@ pub fn fit_figures(
     ] {
         if !profiles.is_empty() {
             both!(out, dir, stem, (1100, 720), |root| curves::zeta(
-                &root, profiles, axis, title
+                &root,
+                profiles,
+                zeta.band_draws,
+                axis,
+                title
             ));
         }
     }

@@ -192,11 +192,24 @@ fn synthetic_fit(d: usize, chains: usize) -> Fit {
     }
 }
 
+fn zeta_cm3_of(x_mm: &[f64], f: &impl Fn(f64) -> f64) -> Vec<f64> {
+    x_mm.iter().map(|&x| f(x)).collect()
+}
+
 fn profile(label: String, f: impl Fn(f64) -> f64) -> ZetaProfile {
     let x_mm: Vec<f64> = (0..=40).map(|i| 2.0 * i as f64).collect();
     let zeta_cm3 = x_mm.iter().map(|&x| f(x)).collect();
+    let band = |w: f64| -> Vec<[f64; 2]> {
+        zeta_cm3_of(&x_mm, &f)
+            .iter()
+            .map(|z| [z - w * 1e9, z + w * 1e9])
+            .collect()
+    };
     ZetaProfile {
         label,
+        band_683_cm3: band(1.0),
+        band_955_cm3: band(2.0),
+        truth_cm3: zeta_cm3_of(&x_mm, &f).iter().map(|z| z + 5e8).collect(),
         x_mm,
         zeta_cm3,
     }
@@ -216,6 +229,7 @@ fn zeta() -> ZetaAtMode {
     ZetaAtMode {
         along_z: along_z.to_vec(),
         along_r: along_r.to_vec(),
+        band_draws: 400,
     }
 }
 
