@@ -229,6 +229,117 @@ fn a_failing_exact_check_exits_with_4_unless_allowed() {
 }
 
 #[test]
+fn a_killed_fit_resumes_its_finished_rounds_and_never_mixes_runs() {
+    // Two rounds of the B_Z fit on 10 draws (the check fails, so round 1 runs corrected: 11
+    // exact curves, as many as the error model of 9 inputs needs).
+    let d = temp("fit-resume");
+    let args = |out: &str| -> Vec<String> {
+        fit_args(
+            out,
+            &[
+                "--no-plots",
+                "--exact-draws",
+                "10",
+                "--exact-grid-check",
+                "0",
+                "--refine-rounds",
+                "2",
+                "--allow-exact-mismatch",
+                // A coarse exact solver keeps the test short.
+                "--tolerance",
+                "0.05",
+            ],
+        )
+        .iter()
+        .map(|a| a.to_string())
+        .collect()
+    };
+    let whole = d.join("whole");
+    let reference: serde_json::Value = serde_json::from_str(
+        ok(&run(&args(whole.to_str().unwrap())
+            .iter()
+            .map(String::as_str)
+            .collect::<Vec<_>>()))
+        .trim(),
+    )
+    .unwrap();
+    assert_eq!(reference["refinement"].as_array().unwrap().len(), 2);
+    // The same fit killed (SIGKILL) as soon as its first round is written, then started again.
+    let killed = d.join("killed");
+    let a = args(killed.to_str().unwrap());
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_hpge-cv"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .args(&a)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let first = killed.join("rounds").join("round-0.json");
+    let start = std::time::Instant::now();
+    while !first.exists() {
+        assert!(start.elapsed().as_secs() < 600, "round 0 never written");
+        assert!(
+            child.try_wait().unwrap().is_none(),
+            "the fit ended before round 0 was written"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    child.kill().unwrap();
+    let _ = child.wait();
+    let again = run(&a.iter().map(String::as_str).collect::<Vec<_>>());
+    let err = String::from_utf8_lossy(&again.stderr).to_string();
+    assert!(
+        err.contains("round 0") && err.contains("taken back from an interrupted run"),
+        "{err}"
+    );
+    let resumed: serde_json::Value = serde_json::from_str(ok(&again).trim()).unwrap();
+    let rounds = resumed["refinement"].as_array().unwrap();
+    assert_eq!(rounds[0]["resumed"], true);
+    assert_eq!(rounds[1]["resumed"], false);
+    // The same numbers as the run that was never interrupted.
+    for key in ["pareto_k", "max_abs_shift_sd", "pass"] {
+        for k in 0..2 {
+            assert_eq!(
+                rounds[k][key], reference["refinement"][k][key],
+                "round {k} {key}"
+            );
+        }
+    }
+    for (p, q) in resumed["parameters"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .zip(reference["parameters"].as_array().unwrap())
+    {
+        assert_eq!(p["mean"], q["mean"]);
+        assert_eq!(p["std"], q["std"]);
+    }
+    // Another seed in the same folder: the old rounds are not taken (cleared), nothing mixes.
+    let other = fit_args(
+        killed.to_str().unwrap(),
+        &[
+            "--no-plots",
+            "--exact-draws",
+            "6",
+            "--exact-grid-check",
+            "0",
+            "--refine-rounds",
+            "1",
+            "--allow-exact-mismatch",
+            "--tolerance",
+            "0.05",
+            "--seed",
+            "5",
+        ],
+    );
+    let o = run(&other);
+    let err = String::from_utf8_lossy(&o.stderr).to_string();
+    assert!(o.status.success(), "{err}");
+    assert!(!err.contains("taken back"), "{err}");
+    assert!(!killed.join("rounds").join("round-1.json").exists());
+}
+
+#[test]
 fn bad_input_is_refused_clearly() {
     let d = temp("fit-bad");
     let out = d.join("o");

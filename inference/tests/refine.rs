@@ -175,6 +175,7 @@ fn refinement_turns_a_failing_exact_check_into_a_passing_one() {
             exact: &|_, _| {},
             round: &|_| {},
         },
+        None,
     )
     .unwrap();
     let rounds = &refined.rounds;

@@ -172,15 +172,23 @@ fn round_text(r: &RefineRound) -> String {
         format!("surrogate corrected by {} exact curves", r.training_curves)
     };
     format!(
-        "round {} ({model}): exact check k-hat {:.2}, largest mean shift {:.2} sd, {:.2}% off at the mode: {} (sampling {:.1} s, exact check {:.1} s)",
+        "round {} ({model}): exact check k-hat {:.2}, largest mean shift {:.2} sd, {:.2}% off at the mode: {} (sampling {:.1} s, exact check {:.1} s){}",
         r.round,
         r.pareto_k,
         r.max_abs_shift_sd,
         100.0 * r.max_rel_diff_at_mode,
         if r.pass { "pass" } else { "fail" },
         r.sampling_seconds,
-        r.exact_seconds
-    )
+        r.exact_seconds,
+        if r.resumed {
+            "; taken back from an interrupted run (OUT/rounds/)"
+        } else {
+            ""
+        }
+    ) + &r
+        .stopped
+        .as_ref()
+        .map_or(String::new(), |s| format!("; refinement stopped: {s}"))
 }
 
 /// Runs `fit` ([`hpge_reports::fit::run_fit`]) with progress on stderr: `print_json` prints

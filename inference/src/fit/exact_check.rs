@@ -20,7 +20,7 @@
 use std::time::Instant;
 
 use rayon::prelude::*;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use super::predictive::thin_indices;
 use crate::model::CvModel;
@@ -32,7 +32,7 @@ use crate::summary::psis;
 use crate::{Error, Result};
 
 /// Where the check solves the exact curves of the draws.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum ExactGrids {
     /// On the global mode's final grids (see the module text): the default.
@@ -94,52 +94,63 @@ pub struct ExactCheckSettings {
 
 /// The draws solved both on the mode's grids and on their own: how much the choice of grid
 /// moves the check's inputs.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct GridCheck {
     /// Draws solved both ways (those whose both solves succeeded).
     pub draws: usize,
     /// Largest |c_own - c_mode| / c_own over those draws and the voltages.
+    #[serde(deserialize_with = "super::checkpoint::f64_or_nan")]
     pub max_rel_diff: f64,
     /// Largest |ln L_own - ln L_mode| (exact likelihood) over those draws: what the choice
     /// changes in an importance log-ratio.
+    #[serde(deserialize_with = "super::checkpoint::f64_or_nan")]
     pub max_abs_delta_ln_l: f64,
     /// Wall time of the own-grid solves, s.
+    #[serde(deserialize_with = "super::checkpoint::f64_or_nan")]
     pub seconds: f64,
 }
 
 /// One parameter's shift.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ParameterShift {
     /// Name.
     pub name: String,
     /// The re-weighted (exact-solver) mean.
+    #[serde(deserialize_with = "super::checkpoint::f64_or_nan")]
     pub exact_mean: f64,
     /// (exact mean - surrogate mean) / surrogate posterior sd.
+    #[serde(deserialize_with = "super::checkpoint::f64_or_nan")]
     pub shift_sd: f64,
 }
 
 /// The result of the check.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ExactCheck {
     /// Draws re-weighted.
     pub draws: usize,
     /// Exact solves that failed (weight 0).
     pub failed: usize,
     /// Pareto k-hat of the importance ratios.
+    #[serde(deserialize_with = "super::checkpoint::f64_or_nan")]
     pub pareto_k: f64,
     /// Effective sample size of the smoothed weights, 1 / sum w^2.
+    #[serde(deserialize_with = "super::checkpoint::f64_or_nan")]
     pub ess: f64,
     /// Per parameter.
     pub parameters: Vec<ParameterShift>,
     /// Largest |c_exact - c_surrogate| / c_exact over the voltages at the global mode.
+    #[serde(deserialize_with = "super::checkpoint::f64_or_nan")]
     pub max_rel_diff_at_mode: f64,
     /// chi^2 of the exact curve at the global mode (no surrogate term in sigma).
+    #[serde(deserialize_with = "super::checkpoint::f64_or_nan")]
     pub chi2_exact_at_mode: f64,
     /// The largest |shift_sd|.
+    #[serde(deserialize_with = "super::checkpoint::f64_or_nan")]
     pub max_abs_shift_sd: f64,
     /// Whether k-hat <= [`K_HAT_LIMIT`] and every |shift| <= [`SHIFT_LIMIT_SD`].
     pub pass: bool,
     /// Wall time, s.
+    #[serde(deserialize_with = "super::checkpoint::f64_or_nan")]
     pub seconds: f64,
     /// Where the draws' exact curves were solved.
     pub grids: ExactGrids,

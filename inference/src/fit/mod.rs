@@ -1,6 +1,7 @@
 //! A whole fit: sampling, the posterior summary (means, modes, smallest intervals, diagnostics),
 //! the posterior predictive, the modes of a multimodal posterior, and the exact-solver check.
 
+mod checkpoint;
 mod exact_check;
 mod job;
 mod options;
@@ -12,6 +13,7 @@ mod summary;
 mod truth;
 mod zeta;
 
+pub use checkpoint::{Checkpoint, ROUNDS_DIR, SavedRound, fingerprint};
 pub use exact_check::{
     DEFAULT_GRID_CHECK, ExactCheck, ExactCheckSettings, ExactGrids, GridCheck, K_HAT_LIMIT,
     ParameterShift, SHIFT_LIMIT_SD, add_grid_check, exact_check,
@@ -25,7 +27,7 @@ pub use predictive::thin_indices;
 pub use predictive::{Predictive, predictive};
 pub use refine::{
     DEFAULT_HYPER_EVALS, DEFAULT_REFINE_ROUNDS, RefineInputs, RefineProgress, RefineRound,
-    RefineSettings, RefinedFit, refine_fit,
+    RefineSettings, RefinedFit, Resume, refine_fit,
 };
 pub use run::{Fit, FitSettings, draw_range, fit};
 pub use summary::{FitSummary, LEVELS, ModeSummary, ParameterSummary};

@@ -13,8 +13,9 @@
 use std::collections::BTreeMap;
 use std::time::Instant;
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
+use super::checkpoint::{Checkpoint, SavedRound, fingerprint};
 use super::exact_check::{ExactCheckSettings, ExactGrids, add_grid_check, exact_check};
 use super::job::FitJob;
 use super::run::{Fit, FitSettings, fit};
@@ -54,26 +55,40 @@ impl Default for RefineSettings {
 }
 
 /// One round of refinement.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RefineRound {
     /// 0 for the plain surrogate.
     pub round: usize,
     /// Exact curves the sampled model was corrected with (0 in round 0).
     pub training_curves: usize,
     /// Pareto k-hat of the round's exact check.
+    #[serde(deserialize_with = "super::checkpoint::f64_or_nan")]
     pub pareto_k: f64,
     /// Its largest |mean shift| in posterior sd.
+    #[serde(deserialize_with = "super::checkpoint::f64_or_nan")]
     pub max_abs_shift_sd: f64,
     /// Its largest |c_exact - c_model| / c_exact at the round's global mode.
+    #[serde(deserialize_with = "super::checkpoint::f64_or_nan")]
     pub max_rel_diff_at_mode: f64,
     /// Whether the check passed.
     pub pass: bool,
     /// Sampling and summary, s.
+    #[serde(deserialize_with = "super::checkpoint::f64_or_nan")]
     pub sampling_seconds: f64,
     /// The exact check, s.
+    #[serde(deserialize_with = "super::checkpoint::f64_or_nan")]
     pub exact_seconds: f64,
     /// Fitting the error model before this round, s (0 in round 0).
+    #[serde(deserialize_with = "super::checkpoint::f64_or_nan")]
     pub error_model_seconds: f64,
+    /// Whether this round was taken back from a previous, interrupted run of the same fit
+    /// (`OUT/rounds/`) instead of being solved again.
+    #[serde(default)]
+    pub resumed: bool,
+    /// Why the refinement ended at this failed round (the round limit, too few exact curves for
+    /// the error model); absent on a passing or intermediate round.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stopped: Option<String>,
 }
 
 /// A refined fit: the last round's fit (its exact check in its summary), the rounds, and the
@@ -118,11 +133,46 @@ pub struct RefineProgress<'a> {
     pub round: &'a (dyn Fn(&RefineRound) + Sync),
 }
 
+/// Rounds a previous run of the same fit finished, and where this run writes its own
+/// ([`Checkpoint`]).
+pub struct Resume<'a> {
+    /// The finished rounds, from round 0 without a gap.
+    pub saved: Vec<SavedRound>,
+    /// Where each new round is written.
+    pub checkpoint: &'a Checkpoint,
+}
+
+/// Adds the exact curves `solved` (inputs x, c_exact) to the error model's training points as
+/// r = ln(c_exact / c_surrogate); a point where the surrogate fails or r is not finite is left
+/// out.
+fn teach(
+    surrogate: &dyn CvModel,
+    training: &mut Vec<(Vec<f64>, Vec<f64>)>,
+    solved: Vec<(Vec<f64>, Vec<f64>)>,
+) {
+    let nv = surrogate.voltages().len();
+    for (x, ce) in solved {
+        let mut cs = vec![0.0; nv];
+        if surrogate.curve(&x, &mut cs).is_err() {
+            continue;
+        }
+        let r: Vec<f64> = ce.iter().zip(&cs).map(|(e, s)| (e / s).ln()).collect();
+        if r.iter().all(|v| v.is_finite()) {
+            training.push((x, r));
+        }
+    }
+}
+
 /// Samples and checks with the exact solver, refining while the check fails (see the module
-/// text); `inputs` (file names and hashes) go into each round's summary.
+/// text); `inputs` (file names and hashes) go into each round's summary. With `resume`, the
+/// rounds a previous run finished are taken back (a failed one's curves teach the error model
+/// without sampling; the last one is sampled again, seeded as before, with its saved check) and
+/// every new round is written as it finishes.
 ///
 /// # Errors
-/// As [`fit`] and [`exact_check`]; an error model that cannot be fitted.
+/// As [`fit`] and [`exact_check`]; an error model that cannot be fitted; a round that cannot be
+/// written.
+#[allow(clippy::too_many_arguments)]
 pub fn refine_fit(
     m: RefineInputs,
     settings: &FitSettings,
@@ -130,83 +180,138 @@ pub fn refine_fit(
     refine: &RefineSettings,
     inputs: &BTreeMap<String, String>,
     progress: RefineProgress,
+    resume: Option<Resume>,
 ) -> Result<RefinedFit> {
     let mut training: Vec<(Vec<f64>, Vec<f64>)> = Vec::new();
     let mut rounds = Vec::new();
     let mut hyper: Option<GpHyper> = None;
     let mut correction: Option<GpCorrection> = None;
     let mut error_model_seconds = 0.0;
-    let nv = m.likelihood.len();
     let last = refine.max_rounds.max(1) - 1;
+    // The error model needs at least d + 2 curves (d inputs): a check of fewer draws cannot
+    // teach it, and the refinement stops there.
+    let needed = m.surrogate.inputs().len() + 2;
+    let stop_reason = |pass: bool, round: usize, curves: usize| -> Option<String> {
+        if pass {
+            None
+        } else if round == last {
+            Some(format!(
+                "the round limit ({} rounds, --refine-rounds)",
+                last + 1
+            ))
+        } else if curves < needed {
+            Some(format!(
+                "{curves} exact curves in all, the error model needs at least {needed} (--exact-draws)"
+            ))
+        } else {
+            None
+        }
+    };
     for round in 0..=last {
-        let corrected = match &correction {
-            Some(gp) => Some(CorrectedModel::new(m.surrogate, gp.clone())?),
-            None => None,
-        };
-        let model: &dyn CvModel = match &corrected {
-            Some(c) => c,
-            None => m.surrogate,
-        };
-        let posterior = Posterior::new(model, m.prior, m.likelihood)?;
-        let t = Instant::now();
-        let mut result = fit(&posterior, settings, inputs.clone(), progress.sampling)?;
-        let sampling_seconds = t.elapsed().as_secs_f64();
-        (progress.sampled)(round);
-        // The grid check once, on the last round's draws (below).
-        let no_grid_check = ExactCheckSettings {
-            grid_check: 0,
-            ..*check
-        };
-        let mut chk = exact_check(
-            model,
-            m.exact,
-            m.prior,
-            m.likelihood,
-            &result.samples,
-            &result.mode,
-            &no_grid_check,
-            progress.exact,
-        )?;
-        let done = chk.pass || round == last;
-        if done && chk.grids == ExactGrids::Mode && check.grid_check > 0 {
-            add_grid_check(&mut chk, m.exact, m.likelihood, check.grid_check)?;
-        }
-        let info = RefineRound {
-            round,
-            training_curves: training.len(),
-            pareto_k: chk.pareto_k,
-            max_abs_shift_sd: chk.max_abs_shift_sd,
-            max_rel_diff_at_mode: chk.max_rel_diff_at_mode,
-            pass: chk.pass,
-            sampling_seconds,
-            exact_seconds: chk.seconds,
-            error_model_seconds,
-        };
-        (progress.round)(&info);
-        rounds.push(info);
-        let solved = std::mem::take(&mut chk.solved);
-        result.summary.seconds += chk.seconds;
-        result.summary.exact_check = Some(chk);
-        if done {
-            result.summary.refinement = Some(rounds.clone());
-            return Ok(RefinedFit {
-                fit: result,
-                rounds,
-                correction,
-                training,
-            });
-        }
-        // Teach the error model the new curves: r = ln(c_exact / c_surrogate).
-        for (x, ce) in solved {
-            let mut cs = vec![0.0; nv];
-            if m.surrogate.curve(&x, &mut cs).is_err() {
-                continue;
+        let saved = resume.as_ref().and_then(|r| r.saved.get(round));
+        let finished = saved.filter(|s| {
+            stop_reason(s.round.pass, round, training.len() + s.solved.len()).is_none()
+                && !s.round.pass
+        });
+        let solved = if let Some(s) = finished {
+            // A failed round of a previous run: its curves, no sampling.
+            let info = RefineRound {
+                resumed: true,
+                ..s.round.clone()
+            };
+            (progress.round)(&info);
+            rounds.push(info);
+            s.solved.clone()
+        } else {
+            let corrected = match &correction {
+                Some(gp) => Some(CorrectedModel::new(m.surrogate, gp.clone())?),
+                None => None,
+            };
+            let model: &dyn CvModel = match &corrected {
+                Some(c) => c,
+                None => m.surrogate,
+            };
+            let posterior = Posterior::new(model, m.prior, m.likelihood)?;
+            let t = Instant::now();
+            let mut result = fit(&posterior, settings, inputs.clone(), progress.sampling)?;
+            let sampling_seconds = t.elapsed().as_secs_f64();
+            (progress.sampled)(round);
+            let (mut chk, info) = match saved {
+                Some(s) => {
+                    let mut chk = s.check.clone();
+                    chk.solved = s.solved.clone();
+                    let info = RefineRound {
+                        resumed: true,
+                        sampling_seconds,
+                        stopped: stop_reason(s.round.pass, round, training.len() + s.solved.len()),
+                        ..s.round.clone()
+                    };
+                    (chk, info)
+                }
+                None => {
+                    // The grid check once, on the last round's draws (below).
+                    let no_grid_check = ExactCheckSettings {
+                        grid_check: 0,
+                        ..*check
+                    };
+                    let mut chk = exact_check(
+                        model,
+                        m.exact,
+                        m.prior,
+                        m.likelihood,
+                        &result.samples,
+                        &result.mode,
+                        &no_grid_check,
+                        progress.exact,
+                    )?;
+                    let stopped = stop_reason(chk.pass, round, training.len() + chk.solved.len());
+                    let done = chk.pass || stopped.is_some();
+                    if done && chk.grids == ExactGrids::Mode && check.grid_check > 0 {
+                        add_grid_check(&mut chk, m.exact, m.likelihood, check.grid_check)?;
+                    }
+                    let info = RefineRound {
+                        round,
+                        training_curves: training.len(),
+                        pareto_k: chk.pareto_k,
+                        max_abs_shift_sd: chk.max_abs_shift_sd,
+                        max_rel_diff_at_mode: chk.max_rel_diff_at_mode,
+                        pass: chk.pass,
+                        sampling_seconds,
+                        exact_seconds: chk.seconds,
+                        error_model_seconds,
+                        resumed: false,
+                        stopped,
+                    };
+                    if let Some(r) = &resume {
+                        r.checkpoint.save(&SavedRound {
+                            fingerprint: r.checkpoint.fingerprint().to_string(),
+                            round: info.clone(),
+                            check: chk.clone(),
+                            solved: chk.solved.clone(),
+                        })?;
+                    }
+                    (chk, info)
+                }
+            };
+            (progress.round)(&info);
+            let done = info.pass || info.stopped.is_some() || round == last;
+            rounds.push(info);
+            let solved = std::mem::take(&mut chk.solved);
+            result.summary.seconds += chk.seconds;
+            result.summary.exact_check = Some(chk);
+            if done {
+                result.summary.refinement = Some(rounds.clone());
+                return Ok(RefinedFit {
+                    fit: result,
+                    rounds,
+                    correction,
+                    training,
+                });
             }
-            let r: Vec<f64> = ce.iter().zip(&cs).map(|(e, s)| (e / s).ln()).collect();
-            if r.iter().all(|v| v.is_finite()) {
-                training.push((x, r));
-            }
-        }
+            solved
+        };
+        // Teach the error model the new curves and fit it for the next round.
+        teach(m.surrogate, &mut training, solved);
         let t_fit = Instant::now();
         let (xs, rs): (Vec<Vec<f64>>, Vec<Vec<f64>>) = training.iter().cloned().unzip();
         let gp = GpCorrection::fit(&xs, &rs, hyper.as_ref(), refine.hyper_evals)
@@ -231,6 +336,7 @@ impl FitJob {
         check: &ExactCheckSettings,
         refine: &RefineSettings,
         progress: RefineProgress,
+        resume: Option<Resume>,
     ) -> Result<RefinedFit> {
         let exact = ExactModel::new(self.exact.clone(), &self.data.voltage_v)?;
         let m = RefineInputs {
@@ -239,11 +345,29 @@ impl FitJob {
             prior: &self.prior,
             likelihood: &self.likelihood,
         };
-        let mut r = refine_fit(m, settings, check, refine, &self.inputs, progress)?;
+        let mut r = refine_fit(m, settings, check, refine, &self.inputs, progress, resume)?;
         r.fit.summary.posterior_outside_support = Some(self.outside_support(&r.fit.samples));
         if let Some(c) = r.fit.summary.exact_check.as_mut() {
             c.solver_tolerance = Some(self.exact.settings.grid.tolerance);
         }
         Ok(r)
+    }
+
+    /// The fingerprint of a refined fit of this job with these settings
+    /// ([`super::checkpoint::fingerprint`]): its inputs with their hashes, the sampler and
+    /// likelihood settings, the check's settings, the refinement's and the exact solver's.
+    pub fn fingerprint(
+        &self,
+        settings: &FitSettings,
+        check: &ExactCheckSettings,
+        refine: &RefineSettings,
+    ) -> String {
+        fingerprint(&[
+            format!("{:?}", self.inputs),
+            format!("{settings:?}"),
+            format!("{check:?}"),
+            format!("{:?}", refine.hyper_evals),
+            format!("{:?}", self.exact.settings),
+        ])
     }
 }

@@ -8,8 +8,8 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use hpge_inference::fit::{
-    ExactGrids, FitJob, FitOptions, RefineProgress, RefineRound, TruthRecord, outputs, read_truth,
-    truth_records,
+    Checkpoint, ExactGrids, FitJob, FitOptions, RefineProgress, RefineRound, Resume, TruthRecord,
+    outputs, read_truth, truth_records,
 };
 use hpge_inference::{Fit, FitSettings, Status};
 
@@ -85,10 +85,14 @@ pub fn run_fit(o: &FitOptions, observer: &dyn FitObserver) -> Result<FitRun> {
         observer.sampling_done();
         (fit, None)
     } else {
+        let (check, refine) = (o.exact_check()?, o.refine());
+        // Rounds an interrupted run of the same fit finished (OUT/rounds/), taken back.
+        let (checkpoint, saved) =
+            Checkpoint::open(&out, job.fingerprint(&settings, &check, &refine))?;
         let refined = job.run_refined(
             &settings,
-            &o.exact_check()?,
-            &o.refine(),
+            &check,
+            &refine,
             RefineProgress {
                 sampling: &|s| observer.sampling(s),
                 sampled: &|_| {
@@ -101,6 +105,10 @@ pub fn run_fit(o: &FitOptions, observer: &dyn FitObserver) -> Result<FitRun> {
                     observer.round_done(r);
                 },
             },
+            Some(Resume {
+                saved,
+                checkpoint: &checkpoint,
+            }),
         )?;
         let file = refined.correction.as_ref().map(|_| {
             outputs::ErrorModelFile::new(&job, &refined.training, refined.correction.as_ref())

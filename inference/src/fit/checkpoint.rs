@@ -1,0 +1,127 @@
+//! Nothing lost on interruption (issue 21): a refined fit writes every finished round (its
+//! exact check and the exact curves it solved, the expensive part) to `OUT/rounds/round-K.json`
+//! as it goes. Started again with the same arguments, the fit takes those rounds back instead of
+//! solving them again: a failed round's curves go straight into the error model, and the last
+//! saved round is sampled again (the sampler is seeded, so its draws are the same) with its
+//! check attached. A folder written with other inputs or settings is cleared first (the
+//! fingerprint in each file says which run wrote it), so two runs never mix; a file cut short
+//! by a kill is not taken (each is written to a temporary name and renamed).
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use super::exact_check::ExactCheck;
+use super::refine::RefineRound;
+use crate::{Error, Result};
+
+/// The folder inside a fit's output folder that holds its rounds.
+pub const ROUNDS_DIR: &str = "rounds";
+
+/// One finished round as written.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SavedRound {
+    /// Which run wrote it ([`fingerprint`]).
+    pub fingerprint: String,
+    /// The round.
+    pub round: RefineRound,
+    /// Its exact check.
+    pub check: ExactCheck,
+    /// The model inputs and exact curve of every draw the check solved, the mode's last.
+    pub solved: Vec<(Vec<f64>, Vec<f64>)>,
+}
+
+/// Reads a number written by serde_json, where NaN (a k-hat of too few draws, a mode without an
+/// exact curve) is written as `null`: null reads back as NaN.
+///
+/// # Errors
+/// Neither a number nor null.
+pub fn f64_or_nan<'de, D: serde::Deserializer<'de>>(d: D) -> std::result::Result<f64, D::Error> {
+    Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::NAN))
+}
+
+/// The fingerprint of a run: FNV-1a of everything its rounds depend on, as 16 hex digits
+/// (`parts`: the inputs with their hashes, the sampler, likelihood, check and solver settings;
+/// the program version is added).
+pub fn fingerprint(parts: &[String]) -> String {
+    let text = format!("{}|{}", env!("CARGO_PKG_VERSION"), parts.join("|"));
+    format!("{:016x}", hpge_surrogate::hash::fnv1a(text.as_bytes()))
+}
+
+/// The rounds folder of one run.
+#[derive(Debug, Clone)]
+pub struct Checkpoint {
+    dir: PathBuf,
+    fingerprint: String,
+}
+
+impl Checkpoint {
+    /// Opens `out/rounds` for the run `fingerprint`: returns the rounds it already finished
+    /// (round 0, 1, ... without a gap). Files of another run, unreadable ones and those after a
+    /// gap are removed.
+    ///
+    /// # Errors
+    /// [`Error::Io`] when the folder cannot be made or read, or a stale file cannot be removed.
+    pub fn open(out: &Path, fingerprint: String) -> Result<(Self, Vec<SavedRound>)> {
+        let dir = out.join(ROUNDS_DIR);
+        std::fs::create_dir_all(&dir).map_err(|source| Error::Io {
+            file: dir.clone(),
+            action: "cannot create the folder",
+            source,
+        })?;
+        let entries = std::fs::read_dir(&dir).map_err(|source| Error::Io {
+            file: dir.clone(),
+            action: "cannot read the folder",
+            source,
+        })?;
+        let files: Vec<PathBuf> = entries.filter_map(|e| Some(e.ok()?.path())).collect();
+        let cp = Self { dir, fingerprint };
+        let mut saved = Vec::new();
+        while let Ok(text) = std::fs::read_to_string(cp.path(saved.len())) {
+            match serde_json::from_str::<SavedRound>(&text) {
+                Ok(r) if r.fingerprint == cp.fingerprint && r.round.round == saved.len() => {
+                    saved.push(r);
+                }
+                _ => break,
+            }
+        }
+        let keep: Vec<PathBuf> = (0..saved.len()).map(|k| cp.path(k)).collect();
+        for f in files.iter().filter(|f| !keep.contains(f)) {
+            std::fs::remove_file(f).map_err(|source| Error::Io {
+                file: f.clone(),
+                action: "cannot remove a file of another run",
+                source,
+            })?;
+        }
+        Ok((cp, saved))
+    }
+
+    fn path(&self, round: usize) -> PathBuf {
+        self.dir.join(format!("round-{round}.json"))
+    }
+
+    /// The run's fingerprint.
+    pub fn fingerprint(&self) -> &str {
+        &self.fingerprint
+    }
+
+    /// Writes a finished round (to a temporary file, then renamed into place).
+    ///
+    /// # Errors
+    /// [`Error::Io`] naming the file.
+    pub fn save(&self, r: &SavedRound) -> Result<()> {
+        let path = self.path(r.round.round);
+        let tmp = path.with_extension("json.tmp");
+        let text = serde_json::to_string(r).map_err(|e| Error::Numerical {
+            what: "a refinement round as JSON".into(),
+            message: e.to_string(),
+        })?;
+        std::fs::write(&tmp, text)
+            .and_then(|()| std::fs::rename(&tmp, &path))
+            .map_err(|source| Error::Io {
+                file: path,
+                action: "cannot write the file",
+                source,
+            })
+    }
+}
