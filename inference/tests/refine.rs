@@ -191,7 +191,13 @@ fn refinement_turns_a_failing_exact_check_into_a_passing_one() {
         last.pass,
         "refinement must end with a passing check: {rounds:?}"
     );
-    assert_eq!(last.training_curves, 101 * (rounds.len() - 1));
+    // Every earlier round taught the error model its 100 draws, its mode and its curves at the
+    // sampler's other local modes.
+    let taught: usize = rounds[..rounds.len() - 1]
+        .iter()
+        .map(|r| 101 + r.local_mode_curves)
+        .sum();
+    assert_eq!(last.training_curves, taught);
     let summary = &refined.fit.summary;
     assert_eq!(summary.refinement.as_ref().unwrap().len(), rounds.len());
     assert!(summary.exact_check.as_ref().unwrap().pass);

@@ -185,7 +185,14 @@ fn round_text(r: &RefineRound) -> String {
         } else {
             ""
         }
-    ) + &r
+    ) + &(if r.local_mode_curves > 0 {
+        format!(
+            "; {} more exact curves at other local modes for the error model",
+            r.local_mode_curves
+        )
+    } else {
+        String::new()
+    }) + &r
         .stopped
         .as_ref()
         .map_or(String::new(), |s| format!("; refinement stopped: {s}"))
