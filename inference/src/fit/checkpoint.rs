@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use super::exact_check::ExactCheck;
-use super::refine::RefineRound;
+use super::round::RefineRound;
 use crate::{Error, Result};
 
 /// The folder inside a fit's output folder that holds its rounds.
@@ -29,15 +29,6 @@ pub struct SavedRound {
     pub check: ExactCheck,
     /// The model inputs and exact curve of every draw the check solved, the mode's last.
     pub solved: Vec<(Vec<f64>, Vec<f64>)>,
-}
-
-/// Reads a number written by serde_json, where NaN (a k-hat of too few draws, a mode without an
-/// exact curve) is written as `null`: null reads back as NaN.
-///
-/// # Errors
-/// Neither a number nor null.
-pub fn f64_or_nan<'de, D: serde::Deserializer<'de>>(d: D) -> std::result::Result<f64, D::Error> {
-    Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::NAN))
 }
 
 /// The fingerprint of a run: FNV-1a of everything its rounds depend on, as 16 hex digits

@@ -99,14 +99,14 @@ pub struct GridCheck {
     /// Draws solved both ways (those whose both solves succeeded).
     pub draws: usize,
     /// Largest |c_own - c_mode| / c_own over those draws and the voltages.
-    #[serde(deserialize_with = "super::checkpoint::f64_or_nan")]
+    #[serde(deserialize_with = "super::round::f64_or_nan")]
     pub max_rel_diff: f64,
     /// Largest |ln L_own - ln L_mode| (exact likelihood) over those draws: what the choice
     /// changes in an importance log-ratio.
-    #[serde(deserialize_with = "super::checkpoint::f64_or_nan")]
+    #[serde(deserialize_with = "super::round::f64_or_nan")]
     pub max_abs_delta_ln_l: f64,
     /// Wall time of the own-grid solves, s.
-    #[serde(deserialize_with = "super::checkpoint::f64_or_nan")]
+    #[serde(deserialize_with = "super::round::f64_or_nan")]
     pub seconds: f64,
 }
 
@@ -116,10 +116,10 @@ pub struct ParameterShift {
     /// Name.
     pub name: String,
     /// The re-weighted (exact-solver) mean.
-    #[serde(deserialize_with = "super::checkpoint::f64_or_nan")]
+    #[serde(deserialize_with = "super::round::f64_or_nan")]
     pub exact_mean: f64,
     /// (exact mean - surrogate mean) / surrogate posterior sd.
-    #[serde(deserialize_with = "super::checkpoint::f64_or_nan")]
+    #[serde(deserialize_with = "super::round::f64_or_nan")]
     pub shift_sd: f64,
 }
 
@@ -131,26 +131,26 @@ pub struct ExactCheck {
     /// Exact solves that failed (weight 0).
     pub failed: usize,
     /// Pareto k-hat of the importance ratios.
-    #[serde(deserialize_with = "super::checkpoint::f64_or_nan")]
+    #[serde(deserialize_with = "super::round::f64_or_nan")]
     pub pareto_k: f64,
     /// Effective sample size of the smoothed weights, 1 / sum w^2.
-    #[serde(deserialize_with = "super::checkpoint::f64_or_nan")]
+    #[serde(deserialize_with = "super::round::f64_or_nan")]
     pub ess: f64,
     /// Per parameter.
     pub parameters: Vec<ParameterShift>,
     /// Largest |c_exact - c_surrogate| / c_exact over the voltages at the global mode.
-    #[serde(deserialize_with = "super::checkpoint::f64_or_nan")]
+    #[serde(deserialize_with = "super::round::f64_or_nan")]
     pub max_rel_diff_at_mode: f64,
     /// chi^2 of the exact curve at the global mode (no surrogate term in sigma).
-    #[serde(deserialize_with = "super::checkpoint::f64_or_nan")]
+    #[serde(deserialize_with = "super::round::f64_or_nan")]
     pub chi2_exact_at_mode: f64,
     /// The largest |shift_sd|.
-    #[serde(deserialize_with = "super::checkpoint::f64_or_nan")]
+    #[serde(deserialize_with = "super::round::f64_or_nan")]
     pub max_abs_shift_sd: f64,
     /// Whether k-hat <= [`K_HAT_LIMIT`] and every |shift| <= [`SHIFT_LIMIT_SD`].
     pub pass: bool,
     /// Wall time, s.
-    #[serde(deserialize_with = "super::checkpoint::f64_or_nan")]
+    #[serde(deserialize_with = "super::round::f64_or_nan")]
     pub seconds: f64,
     /// Where the draws' exact curves were solved.
     pub grids: ExactGrids,

@@ -8,6 +8,7 @@ mod options;
 pub mod outputs;
 mod predictive;
 mod refine;
+mod round;
 mod run;
 mod summary;
 mod truth;
@@ -26,9 +27,10 @@ pub use options::{
 pub use predictive::thin_indices;
 pub use predictive::{Predictive, predictive};
 pub use refine::{
-    DEFAULT_HYPER_EVALS, DEFAULT_REFINE_ROUNDS, RefineInputs, RefineProgress, RefineRound,
-    RefineSettings, RefinedFit, Resume, refine_fit,
+    DEFAULT_HYPER_EVALS, DEFAULT_REFINE_ROUNDS, MAX_LOCAL_MODE_CURVES, RefineInputs,
+    RefineProgress, RefineSettings, RefinedFit, Resume, refine_fit,
 };
+pub use round::{RefineRound, f64_or_nan};
 pub use run::{Fit, FitSettings, draw_range, fit};
 pub use summary::{FitSummary, LEVELS, ModeSummary, ParameterSummary};
 pub use truth::{TruthRecord, read_truth, truth_records};
