@@ -223,8 +223,10 @@ pub fn refine_fit(
         });
         let solved = if let Some(s) = finished {
             // A failed round of a previous run: its curves, no sampling.
+            // Not the last round now (a run continued with more --refine-rounds): no stop.
             let info = RefineRound {
                 resumed: true,
+                stopped: None,
                 ..s.round.clone()
             };
             (progress.round)(&info);
