@@ -8,7 +8,10 @@
 //! likelihood). A passing check ends the loop: M_r's posterior is the fit's, and the check is
 //! its verification. A failing one adds its exact curves to the error model's training points
 //! (each check's curves are solved before they teach the model that the next check tests, so
-//! no check ever sees its own training data). The loop also ends after `max_rounds` rounds.
+//! no check ever sees its own training data), and the sampler's other local modes get exact
+//! curves too ([`MAX_LOCAL_MODE_CURVES`]). The loop also ends after `max_rounds` rounds, or when
+//! too few curves exist for the error model. With a [`Resume`], every finished round is written
+//! ([`Checkpoint`]) and a restarted fit takes its finished rounds back.
 
 use std::collections::BTreeMap;
 use std::time::Instant;
