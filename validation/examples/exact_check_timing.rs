@@ -6,7 +6,8 @@
 //! (the shipped data, model, prior and detector).
 
 use hpge_inference::fit::{
-    DEFAULT_DATA, DEFAULT_DETECTOR, DEFAULT_MODEL, DEFAULT_PRIOR, FitFiles, FitJob, thin_indices,
+    DEFAULT_DATA, DEFAULT_DETECTOR, DEFAULT_MODEL, DEFAULT_PRIOR, FitFiles, FitJob, outputs,
+    thin_indices,
 };
 use hpge_solver::GridOverrides;
 use hpge_solver::field::{Continuation, cv_curve_with};
@@ -31,23 +32,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let first: usize = args.get(3).map_or(Ok(0), |a| a.parse())?;
     let count: usize = args.get(4).map_or(Ok(n), |a| a.parse())?;
     let job = FitJob::from_files(&files, Default::default(), &grid)?;
-    let text = std::fs::read_to_string(samples)?;
-    let mut lines = text.lines();
-    let header: Vec<&str> = lines
-        .next()
-        .ok_or("empty samples file")?
-        .split(',')
-        .collect();
-    let np = header.len() - 3;
-    let draws: Vec<Vec<f64>> = lines
-        .map(|l| {
-            l.split(',')
-                .skip(2)
-                .take(np)
-                .map(|v| v.parse().unwrap_or(f64::NAN))
-                .collect()
-        })
-        .collect();
+    let draws = outputs::read_samples(std::path::Path::new(samples))?;
     let nx = job.prior.input_names.len();
     let volts = &job.data.voltage_v;
     let mut total = 0.0;

@@ -6,7 +6,8 @@
 
 use hpge_inference::CvModel;
 use hpge_inference::fit::{
-    DEFAULT_DATA, DEFAULT_DETECTOR, DEFAULT_MODEL, DEFAULT_PRIOR, FitFiles, FitJob, thin_indices,
+    DEFAULT_DATA, DEFAULT_DETECTOR, DEFAULT_MODEL, DEFAULT_PRIOR, FitFiles, FitJob, outputs,
+    thin_indices,
 };
 use hpge_inference::model::ExactModel;
 use hpge_solver::GridOverrides;
@@ -25,19 +26,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         detector: repo_path(DEFAULT_DETECTOR),
     };
     let job = FitJob::from_files(&files, Default::default(), &GridOverrides::default())?;
-    let text = std::fs::read_to_string(dir.join("samples.csv"))?;
-    let mut lines = text.lines();
-    let header: Vec<&str> = lines.next().ok_or("empty")?.split(',').collect();
-    let np = header.len() - 3;
-    let draws: Vec<Vec<f64>> = lines
-        .map(|l| {
-            l.split(',')
-                .skip(2)
-                .take(np)
-                .map(|v| v.parse().unwrap_or(f64::NAN))
-                .collect()
-        })
-        .collect();
+    let draws = outputs::read_samples(&dir.join("samples.csv"))?;
     let summary: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json"))?)?;
     let mode: Vec<f64> = summary["parameters"]

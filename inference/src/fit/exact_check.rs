@@ -207,10 +207,8 @@ pub fn exact_check(
         .par_iter()
         .map(|theta| {
             let c = unless_rejected(eval(surrogate, theta))?.unwrap_or_else(|| vec![f64::NAN; nv]);
-            let mut var = vec![surrogate.sigma_rel().powi(2); nv];
-            if surrogate.has_point_variance() {
-                unless_rejected(surrogate.curve_variance(&expand(theta), &mut var, None))?;
-            }
+            let mut var = vec![0.0; nv];
+            unless_rejected(surrogate.curve_variance(&expand(theta), &mut var, None))?;
             Ok((c, var))
         })
         .collect::<Result<_>>()?;

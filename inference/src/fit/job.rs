@@ -9,10 +9,9 @@ use hpge_solver::{Detector, FieldSettings, GridOverrides, Parameters};
 use hpge_surrogate::hash::fnv1a;
 use hpge_surrogate::{ExactSolver, Surrogate};
 
-use super::exact_check::{ExactCheckSettings, exact_check};
 use super::run::{Fit, FitSettings, fit};
 use super::zeta::{ZETA_BAND_DRAWS, ZetaAtMode, zeta_profiles};
-use crate::model::{CvModel, ExactModel, SurrogateModel};
+use crate::model::{CvModel, SurrogateModel};
 use crate::posterior::{Likelihood, NoiseSettings, Posterior};
 use crate::prior::{Prior, PriorSpec};
 use crate::sampler::Status;
@@ -231,36 +230,6 @@ impl FitJob {
                 format!("{e}; pass {flag} to fit there anyway"),
             ))
         }
-    }
-
-    /// Re-weights `settings.draws` thinned draws of `result` with the exact field solver
-    /// ([`exact_check`]: PSIS, Pareto k-hat, mean shifts) and records the check and its time in
-    /// the summary; `progress` sees (curves done, curves in all).
-    ///
-    /// # Errors
-    /// The exact model cannot be set up at the data's voltages, or a non-recoverable solver
-    /// failure.
-    pub fn check_exact(
-        &self,
-        result: &mut Fit,
-        settings: &ExactCheckSettings,
-        progress: &(dyn Fn(usize, usize) + Sync),
-    ) -> Result<()> {
-        let exact = ExactModel::new(self.exact.clone(), &self.data.voltage_v)?;
-        let mut check = exact_check(
-            &self.surrogate,
-            &exact,
-            &self.prior,
-            &self.likelihood,
-            &result.samples,
-            &result.mode,
-            settings,
-            progress,
-        )?;
-        check.solver_tolerance = Some(self.exact.settings.grid.tolerance);
-        result.summary.seconds += check.seconds;
-        result.summary.exact_check = Some(check);
-        Ok(())
     }
 
     /// zeta at the global mode of `result` with the posterior's 68.3% and 95.5% bands over

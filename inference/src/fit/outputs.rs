@@ -43,6 +43,36 @@ pub fn write_samples(path: &Path, fit: &Fit) -> Result<()> {
     write_text(path, &w)
 }
 
+/// The draws of a `samples.csv` ([`write_samples`]) read back: each row's parameter values, in
+/// the file's order.
+///
+/// # Errors
+/// [`Error::Io`] when the file cannot be read, [`Error::Format`] for an empty file or a row
+/// whose values are not numbers.
+pub fn read_samples(path: &Path) -> Result<Vec<Vec<f64>>> {
+    let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+        file: path.to_path_buf(),
+        action: "cannot read the file",
+        source,
+    })?;
+    let mut lines = text.lines();
+    let header = lines.next().ok_or_else(|| {
+        Error::format(path, "empty: expected a chain,draw,...,ln_posterior header")
+    })?;
+    let np = header.split(',').count().saturating_sub(3);
+    lines
+        .enumerate()
+        .map(|(i, l)| {
+            l.split(',')
+                .skip(2)
+                .take(np)
+                .map(|v| v.parse::<f64>())
+                .collect::<std::result::Result<Vec<f64>, _>>()
+                .map_err(|e| Error::format(path, format!("row {}: {e}", i + 2)))
+        })
+        .collect()
+}
+
 /// `predictive.csv`: per voltage the data, the curve at the global mode, sigma, the pull at the
 /// mode and the median and 68.3/95.5/99.7% bands of c_p - c_m over the posterior.
 pub fn write_predictive(path: &Path, fit: &Fit) -> Result<()> {

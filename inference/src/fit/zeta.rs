@@ -47,7 +47,7 @@ pub const ZETA_BAND_DRAWS: usize = 400;
 /// One line: its label and the (coordinate, r, z) of its points, mm.
 type Line = (String, Vec<(f64, f64, f64)>);
 
-/// The lines of [`zeta_at_mode`] through `det`'s semiconductor: along z at 2, 25, 50, 75 and 98%
+/// The lines of [`zeta_profiles`] through `det`'s semiconductor: along z at 2, 25, 50, 75 and 98%
 /// of the radial span at mid-height, along r at 2, 50 and 98% of the height, inside the
 /// semiconductor only (a borehole or groove is left out).
 fn lines(det: &Detector) -> (Vec<Line>, Vec<Line>) {
@@ -170,12 +170,4 @@ pub fn zeta_profiles(
         along_r: keep(along_r),
         band_draws: dets.len(),
     })
-}
-
-/// The fitted zeta at the global mode alone ([`zeta_profiles`] without bands or truth).
-///
-/// # Errors
-/// The detector cannot be built at the mode (a solver error).
-pub fn zeta_at_mode(exact: &ExactSolver, prior: &Prior, mode: &[f64]) -> Result<ZetaAtMode> {
-    zeta_profiles(exact, prior, mode, &[], None)
 }

@@ -60,12 +60,7 @@ impl Cholesky {
     /// x = A^-1 b.
     pub fn solve(&self, b: &[f64]) -> Vec<f64> {
         let n = self.n;
-        let mut y = b.to_vec();
-        for i in 0..n {
-            let row = &self.l[i * n..i * n + i];
-            let s = y[i] - row.iter().zip(&y[..i]).map(|(a, b)| a * b).sum::<f64>();
-            y[i] = s / self.l[i * n + i];
-        }
+        let mut y = self.solve_lower(b);
         for i in (0..n).rev() {
             let s = y[i] - (i + 1..n).map(|k| self.l[k * n + i] * y[k]).sum::<f64>();
             y[i] = s / self.l[i * n + i];

@@ -100,9 +100,7 @@ impl<'a> Posterior<'a> {
         let mut x = vec![0.0; self.prior.input_names.len()];
         self.prior.expand(theta, &mut x);
         self.model.curve(&x, &mut c_p)?;
-        if self.model.has_point_variance() {
-            self.model.curve_variance(&x, &mut var_rel, None)?;
-        }
+        self.model.curve_variance(&x, &mut var_rel, None)?;
         let ll = self
             .likelihood
             .ln_likelihood_var(&c_p, &var_rel, None, None);

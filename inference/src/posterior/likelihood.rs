@@ -77,6 +77,22 @@ impl Default for NoiseSettings {
     }
 }
 
+/// The model's squared relative uncertainty sigma_p^2: one constant, or one per point.
+#[derive(Clone, Copy)]
+enum ModelVar<'a> {
+    Constant(f64),
+    PerPoint(&'a [f64]),
+}
+
+impl ModelVar<'_> {
+    fn at(self, k: usize) -> f64 {
+        match self {
+            ModelVar::Constant(v) => v,
+            ModelVar::PerPoint(v) => v[k],
+        }
+    }
+}
+
 /// The likelihood of one measured curve.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Likelihood {
@@ -148,32 +164,46 @@ impl Likelihood {
         d
     }
 
-    /// The model's constant sigma_p^2 at every point.
-    fn constant_var(&self) -> Vec<f64> {
-        vec![self.sigma_rel_model * self.sigma_rel_model; self.len()]
+    /// Sigma(c_p) = V_m + diag(model-side variance) (row-major), for the covariance variant.
+    fn covariance_at(&self, vm: &[f64], c_p: &[f64], v: ModelVar) -> Vec<f64> {
+        let n = self.len();
+        let mut a = vm.to_vec();
+        for k in 0..n {
+            a[k * n + k] += self.variance(c_p[k], v.at(k));
+        }
+        a
     }
 
     /// The standard deviation of each point (pF) at c_p: sqrt of the diagonal of Sigma.
     pub fn sigma(&self, c_p: &[f64]) -> Vec<f64> {
-        self.sigma_var(c_p, &self.constant_var())
+        self.sigma_with(c_p, self.constant())
     }
 
     /// [`Likelihood::sigma`] with the model's own sigma_p,k^2 at each point (`var_rel`, a model
     /// whose uncertainty varies: `CvModel::curve_variance`) in place of the constant.
     pub fn sigma_var(&self, c_p: &[f64], var_rel: &[f64]) -> Vec<f64> {
+        self.sigma_with(c_p, ModelVar::PerPoint(var_rel))
+    }
+
+    fn sigma_with(&self, c_p: &[f64], v: ModelVar) -> Vec<f64> {
         let n = self.len();
         c_p.iter()
             .enumerate()
             .map(|(k, &c)| {
-                let v = self.covariance.as_ref().map_or(0.0, |m| m[k * n + k]);
-                (self.variance(c, var_rel[k]) + v).sqrt()
+                let m = self.covariance.as_ref().map_or(0.0, |m| m[k * n + k]);
+                (self.variance(c, v.at(k)) + m).sqrt()
             })
             .collect()
     }
 
+    /// The model's constant sigma_p^2.
+    fn constant(&self) -> ModelVar<'static> {
+        ModelVar::Constant(self.sigma_rel_model * self.sigma_rel_model)
+    }
+
     /// ln L(c_p) (see the module docs); with `grad`, also d ln L / d c_p.
     pub fn ln_likelihood(&self, c_p: &[f64], grad: Option<&mut [f64]>) -> f64 {
-        self.ln_likelihood_var(c_p, &self.constant_var(), grad, None)
+        self.ln_likelihood_with(c_p, self.constant(), grad, None)
     }
 
     /// ln L(c_p) with the model's sigma_p,k^2 at each point (`var_rel`) in place of the
@@ -185,6 +215,16 @@ impl Likelihood {
         grad_c: Option<&mut [f64]>,
         grad_var: Option<&mut [f64]>,
     ) -> f64 {
+        self.ln_likelihood_with(c_p, ModelVar::PerPoint(var_rel), grad_c, grad_var)
+    }
+
+    fn ln_likelihood_with(
+        &self,
+        c_p: &[f64],
+        v: ModelVar,
+        grad_c: Option<&mut [f64]>,
+        grad_var: Option<&mut [f64]>,
+    ) -> f64 {
         let n = self.len();
         let mut gc = grad_c;
         let mut gv = grad_var;
@@ -192,14 +232,14 @@ impl Likelihood {
             None => {
                 let mut ll = 0.0;
                 for k in 0..n {
-                    let var = self.variance(c_p[k], var_rel[k]);
+                    let var = self.variance(c_p[k], v.at(k));
                     let r = self.c_m[k] - c_p[k];
                     ll -= 0.5 * r * r / var + 0.5 * var.ln() + LN_SQRT_2PI;
                     // d/dvar of -r^2/(2v) - ln v / 2.
                     let dl_dv = 0.5 * (r * r / var - 1.0) / var;
                     if let Some(g) = gc.as_deref_mut() {
                         // d/dc, with dr/dc = -1.
-                        g[k] = r / var + dl_dv * self.d_variance(c_p[k], var_rel[k]);
+                        g[k] = r / var + dl_dv * self.d_variance(c_p[k], v.at(k));
                     }
                     if let Some(g) = gv.as_deref_mut() {
                         g[k] = dl_dv * c_p[k] * c_p[k];
@@ -208,11 +248,7 @@ impl Likelihood {
                 ll
             }
             Some(vm) => {
-                let mut a = vm.clone();
-                for k in 0..n {
-                    a[k * n + k] += self.variance(c_p[k], var_rel[k]);
-                }
-                let Some(chol) = Cholesky::new(&a, n) else {
+                let Some(chol) = Cholesky::new(&self.covariance_at(vm, c_p, v), n) else {
                     return f64::NEG_INFINITY;
                 };
                 let r: Vec<f64> = (0..n).map(|k| self.c_m[k] - c_p[k]).collect();
@@ -223,7 +259,7 @@ impl Likelihood {
                     for k in 0..n {
                         let dl_dv = 0.5 * (alpha[k] * alpha[k] - inv_diag[k]);
                         if let Some(g) = gc.as_deref_mut() {
-                            g[k] = alpha[k] + dl_dv * self.d_variance(c_p[k], var_rel[k]);
+                            g[k] = alpha[k] + dl_dv * self.d_variance(c_p[k], v.at(k));
                         }
                         if let Some(g) = gv.as_deref_mut() {
                             g[k] = dl_dv * c_p[k] * c_p[k];
@@ -238,22 +274,22 @@ impl Likelihood {
     /// chi^2 = r^T Sigma(c_p)^-1 r with r = c_m - c_p (the sum of squared pulls for the paper's
     /// independent model).
     pub fn chi2(&self, c_p: &[f64]) -> f64 {
-        self.chi2_var(c_p, &self.constant_var())
+        self.chi2_with(c_p, self.constant())
     }
 
     /// [`Likelihood::chi2`] with the model's sigma_p,k^2 at each point (`var_rel`).
     pub fn chi2_var(&self, c_p: &[f64], var_rel: &[f64]) -> f64 {
+        self.chi2_with(c_p, ModelVar::PerPoint(var_rel))
+    }
+
+    fn chi2_with(&self, c_p: &[f64], v: ModelVar) -> f64 {
         let n = self.len();
         match &self.covariance {
             None => (0..n)
-                .map(|k| (self.c_m[k] - c_p[k]).powi(2) / self.variance(c_p[k], var_rel[k]))
+                .map(|k| (self.c_m[k] - c_p[k]).powi(2) / self.variance(c_p[k], v.at(k)))
                 .sum(),
             Some(vm) => {
-                let mut a = vm.clone();
-                for k in 0..n {
-                    a[k * n + k] += self.variance(c_p[k], var_rel[k]);
-                }
-                let Some(chol) = Cholesky::new(&a, n) else {
+                let Some(chol) = Cholesky::new(&self.covariance_at(vm, c_p, v), n) else {
                     return f64::INFINITY;
                 };
                 let r: Vec<f64> = (0..n).map(|k| self.c_m[k] - c_p[k]).collect();
@@ -265,12 +301,16 @@ impl Likelihood {
 
     /// Pulls (c_p - c_m) / sigma per point, sigma the square root of Sigma's diagonal.
     pub fn pulls(&self, c_p: &[f64]) -> Vec<f64> {
-        self.pulls_var(c_p, &self.constant_var())
+        self.pulls_with(c_p, self.constant())
     }
 
     /// [`Likelihood::pulls`] with the model's sigma_p,k^2 at each point (`var_rel`).
     pub fn pulls_var(&self, c_p: &[f64], var_rel: &[f64]) -> Vec<f64> {
-        let s = self.sigma_var(c_p, var_rel);
+        self.pulls_with(c_p, ModelVar::PerPoint(var_rel))
+    }
+
+    fn pulls_with(&self, c_p: &[f64], v: ModelVar) -> Vec<f64> {
+        let s = self.sigma_with(c_p, v);
         (0..self.len())
             .map(|k| (c_p[k] - self.c_m[k]) / s[k])
             .collect()
@@ -292,13 +332,15 @@ impl Likelihood {
             None => c_p
                 .iter()
                 .zip(&z)
-                .map(|(&c, &e)| c + self.variance(c, self.sigma_rel_model.powi(2)).sqrt() * e)
+                .map(|(&c, &e)| {
+                    c + self
+                        .variance(c, self.sigma_rel_model * self.sigma_rel_model)
+                        .sqrt()
+                        * e
+                })
                 .collect(),
             Some(vm) => {
-                let mut a = vm.clone();
-                for k in 0..n {
-                    a[k * n + k] += self.variance(c_p[k], self.sigma_rel_model.powi(2));
-                }
+                let a = self.covariance_at(vm, c_p, self.constant());
                 let chol = Cholesky::new(&a, n).expect("a covariance plus a positive diagonal");
                 let e = chol.mul_lower(&z);
                 c_p.iter().zip(e).map(|(&c, e)| c + e).collect()
