@@ -42,6 +42,7 @@ fn model(recipe: &str) -> Surrogate {
         test_figures: Figures::of(&[1.0], &[1.0]),
         detector: None,
         coverage: None,
+        error_model: None,
         sigma_p: 0.01,
     };
     Surrogate::new(info, Predictor::Networks(nets)).expect("valid model")

@@ -5,6 +5,8 @@
 #   paper-60000/rows.csv   60000 samples of spaces/super-siegfried-rz.toml, golden sequence, seed 0
 #   train.csv, test.csv    its 80:20 split by index order (0..47999, 48000..59999), as in the paper
 #   heldout-5000/rows.csv  5000 further samples from offset 100000 (never used for training)
+#   calibration-1200/rows.csv  1200 samples from offset 200000: the surrogates' per-point
+#                          uncertainty is calibrated on them (hpge-cv calibrate; never trained on)
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 OUT=${OUT:-data/training}
@@ -14,13 +16,15 @@ S=spaces/super-siegfried-rz.toml
 D=detectors/super-siegfried-k1.toml
 $B generate --space $S --detector $D --n 60000 --out "$OUT/paper-60000"
 $B generate --space $S --detector $D --n 5000 --offset 100000 --out "$OUT/heldout-5000"
+$B generate --space $S --detector $D --n 1200 --offset 200000 --out "$OUT/calibration-1200"
 # Rows in index order (generation appends in completion order).
 sorted() { head -n 1 "$1"; tail -n +2 "$1" | sort -t, -k1,1n; }
 sorted "$OUT/paper-60000/rows.csv" | awk -F, 'NR == 1 || $1 < 48000' > "$OUT/train.csv"
 sorted "$OUT/paper-60000/rows.csv" | awk -F, 'NR == 1 || $1 >= 48000' > "$OUT/test.csv"
 sorted "$OUT/heldout-5000/rows.csv" > "$OUT/heldout.csv"
+sorted "$OUT/calibration-1200/rows.csv" > "$OUT/calibration.csv"
 # Hash of the content that is deterministic: every column but `seconds` (wall time).
 canonical() { tail -n +2 "$1" | sed 's/,[^,]*$//' | sha256sum | cut -c1-64; }
-for f in train test heldout; do
+for f in train test heldout calibration; do
   echo "$f.csv: $(($(wc -l < "$OUT/$f.csv") - 1)) rows, sha256 (without seconds) $(canonical "$OUT/$f.csv")"
 done

@@ -51,6 +51,27 @@ fn shipped_files_make_a_job_with_hashed_inputs() {
     assert_eq!(s.sample.chains, 4);
     assert_eq!(s.sample.max_seconds, 300.0);
     assert_eq!(o.out_dir(), PathBuf::from("fits/b-z"));
+    // The shipped model carries a calibrated per-point sigma_s (issue 21), which the likelihood
+    // uses; --constant-sigma restores the paper's constant sigma_p.
+    assert!(job.surrogate.has_point_variance());
+    assert!(job.surrogate.describe().contains("per-point sigma_s"));
+    let mut var = vec![0.0; job.data.voltage_v.len()];
+    let mid: Vec<f64> = job
+        .surrogate
+        .domain()
+        .iter()
+        .map(|r| 0.5 * (r[0] + r[1]))
+        .collect();
+    job.surrogate.curve_variance(&mid, &mut var, None).unwrap();
+    // Larger at the lowest bias (25 V) than at the highest, where the network is most accurate.
+    assert!(var[0] > 4.0 * var[var.len() - 1], "{var:?}");
+    let c = FitOptions {
+        constant_sigma: true,
+        ..o.clone()
+    };
+    let plain = FitJob::from_files(&c.files(), c.noise().unwrap(), &c.grid).unwrap();
+    assert!(!plain.surrogate.has_point_variance());
+    assert!(plain.surrogate.describe().contains("sigma_p"));
 }
 
 #[test]

@@ -503,7 +503,7 @@ fn predict<'py>(
     let u = m.voltages(&voltages).map_err(err)?;
     let n = voltages.len();
     let np = m.n_params();
-    let (c, spread, jac) = py
+    let (c, spread, jac, sigma) = py
         .detach(|| {
             let mut c = vec![0.0; n];
             let mut spread = vec![0.0; n];
@@ -516,15 +516,13 @@ fn predict<'py>(
             } else {
                 None
             };
-            Ok::<_, hpge_surrogate::Error>((c, spread, jac))
+            let sigma = m.curve_sigma_pf(&p, &u, &c)?;
+            Ok::<_, hpge_surrogate::Error>((c, spread, jac, sigma))
         })
         .map_err(err)?;
     let d = PyDict::new(py);
     d.set_item("voltage_V", array(py, voltages))?;
-    d.set_item(
-        "sigma_pF",
-        array(py, c.iter().map(|c| m.sigma_p() * c).collect()),
-    )?;
+    d.set_item("sigma_pF", array(py, sigma))?;
     d.set_item("c12_pF", array(py, c))?;
     if m.members() > 1 {
         d.set_item("ensemble_spread_pF", array(py, spread))?;
@@ -608,7 +606,8 @@ fn measure<'py>(
 /// rounds of posterior-adaptive refinement, as `--refine-rounds`),
 /// `out` (a folder: also write every file and figure
 /// `hpge-cv fit --out` writes), `progress`, `extrapolate` (fit a curve with voltages outside the
-/// surrogate's support, as `--extrapolate`).
+/// surrogate's support, as `--extrapolate`), `constant_sigma` (the model's constant sigma_p in
+/// the likelihood even where its file has a calibrated per-point sigma_s, as `--constant-sigma`).
 ///
 /// Returns a dict: `summary` (the `summary.json` object as a dict), `names` (parameters),
 /// `draws` (array [chain, draw, parameter] in the prior's units), `ln_posterior` ([chain, draw]),
@@ -618,7 +617,7 @@ fn measure<'py>(
     data=None, model=None, prior=None, detector=None, seed=None, sampler=None, likelihood=None,
     chains=None, ess=None, rhat=None, max_seconds=None, exact_check=false, exact_draws=None,
     out=None, progress=None, extrapolate=false, exact_grids=None, exact_grid_check=None,
-    refine_rounds=None
+    refine_rounds=None, constant_sigma=false
 ))]
 #[allow(clippy::too_many_arguments)]
 fn fit<'py>(
@@ -642,6 +641,7 @@ fn fit<'py>(
     exact_grids: Option<String>,
     exact_grid_check: Option<usize>,
     refine_rounds: Option<usize>,
+    constant_sigma: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let d = FitOptions::default();
     let o = FitOptions {
@@ -663,6 +663,7 @@ fn fit<'py>(
         rhat: rhat.unwrap_or(d.rhat),
         max_seconds: max_seconds.unwrap_or(d.max_seconds),
         extrapolate,
+        constant_sigma,
         ..d
     };
     let progress = progress_arg(progress, "fit")?;

@@ -75,6 +75,10 @@ enum Command {
     /// Accuracy of a surrogate on a data set it never saw: error histograms, Gaussian sigma,
     /// quantiles, the worst samples.
     Evaluate(EvaluateArgs),
+    /// Calibrate a surrogate's per-point uncertainty sigma_s(p, U_B) on rows it never saw and
+    /// write it into the model file (the weights unchanged); `fit` then uses it in place of the
+    /// constant sigma_p.
+    Calibrate(hpge_surrogate::job::CalibrateOptions),
     /// c12 along a curve from a surrogate (optionally with its Jacobian).
     Predict(PredictArgs),
     /// The posterior of an impurity model given a measured C-V curve (Bayesian fit with the
@@ -382,6 +386,7 @@ pub fn run(cli: Cli) -> Result<()> {
             ValidateStudy::Coverage(a) => validate::coverage(&a.options, a.json),
         },
         Command::Evaluate(a) => surrogate::evaluate(&a.options, a.json, a.plot.as_deref()),
+        Command::Calibrate(o) => surrogate::calibrate(&o),
         Command::Predict(a) => surrogate::predict(&a.options, a.json),
         Command::Measure(a) => measure::run(&a.options, a.plot.as_ref(), a.json),
         Command::Synthesize(o) => measure::synthesize(&o),

@@ -6,7 +6,8 @@ use std::path::Path;
 use anyhow::{Context, Result};
 use hpge_surrogate::Surrogate;
 use hpge_surrogate::job::{
-    EvaluateOptions, Evaluation, PredictOptions, TrainEvent, TrainJob, parse_params, read_for_model,
+    CalibrateOptions, EvaluateOptions, Evaluation, PredictOptions, TrainEvent, TrainJob,
+    parse_params, read_for_model,
 };
 use hpge_surrogate::model::EpochRecord;
 use indicatif::{ProgressBar, ProgressStyle};
@@ -157,6 +158,24 @@ pub fn train(job: &TrainJob, plot: Option<&Path>, quiet: bool) -> Result<()> {
     Ok(())
 }
 
+/// Fits and writes a model's per-point uncertainty.
+pub fn calibrate(o: &CalibrateOptions) -> Result<()> {
+    let m = o.run()?;
+    eprintln!(
+        "error model: ln sigma_s^2 quadratic in the {} inputs' z, fitted on {} rows of {} in {} \
+         Newton steps; kappa {:.3}; on those rows {:.1}% within 1 sigma_s, {:.1}% within 2",
+        m.inputs.len(),
+        m.calibration.n,
+        o.data.display(),
+        m.iterations,
+        m.kappa,
+        100.0 * m.coverage_1sigma,
+        100.0 * m.coverage_2sigma
+    );
+    eprintln!("wrote {}", o.out_file().display());
+    Ok(())
+}
+
 /// Accuracy of a model on a data set of its space.
 pub fn evaluate(o: &EvaluateOptions, json: bool, plot: Option<&Path>) -> Result<()> {
     let model = Surrogate::load(&o.model)?;
@@ -206,6 +225,16 @@ pub fn evaluate(o: &EvaluateOptions, json: bool, plot: Option<&Path>) -> Result<
         "absolute error rms {:.4} pF; sigma_p of the model {:.4}%",
         f.abs_rms_pf,
         100.0 * model.sigma_p()
+    );
+    println!(
+        "predicted uncertainty ({}): {:.1}% of the samples within 1 sigma, {:.1}% within 2",
+        if ev.sigma_kind == "per-point" {
+            "the calibrated per-point sigma_s"
+        } else {
+            "the constant sigma_p"
+        },
+        100.0 * ev.coverage.0,
+        100.0 * ev.coverage.1
     );
     println!(
         "edges: |relative error| of the rows in the lowest / highest {:.0}% of each input's u \
@@ -280,6 +309,8 @@ struct PredictJson<'a> {
     ensemble_spread_pf: Option<Vec<f64>>,
     jacobian_pf: Option<Vec<Vec<f64>>>,
     sigma_p: f64,
+    /// `per-point` (sigma_pF from the calibrated sigma_s(p, U)) or `constant` (sigma_p c12).
+    sigma_kind: &'a str,
     program_version: &'static str,
 }
 
@@ -313,7 +344,13 @@ pub fn predict(o: &PredictOptions, json: bool) -> Result<()> {
     } else {
         None
     };
-    let sigma: Vec<f64> = c.iter().map(|c| model.sigma_p() * c).collect();
+    // sigma_s(p, U) c12 with a calibrated error model, sigma_p c12 without.
+    let sigma = model.curve_sigma_pf(&params, &u, &c)?;
+    let sigma_kind = if model.error_model().is_some() {
+        "per-point"
+    } else {
+        "constant"
+    };
     let ensemble = model.members() > 1;
     if json {
         let j = PredictJson {
@@ -331,6 +368,7 @@ pub fn predict(o: &PredictOptions, json: bool) -> Result<()> {
             ensemble_spread_pf: ensemble.then_some(spread),
             jacobian_pf: jac,
             sigma_p: model.sigma_p(),
+            sigma_kind,
             program_version: env!("CARGO_PKG_VERSION"),
         };
         println!("{}", serde_json::to_string(&j)?);
@@ -339,10 +377,15 @@ pub fn predict(o: &PredictOptions, json: bool) -> Result<()> {
     // The table on stdout is a plain CSV (`predict ... > c.csv` loads with pandas as it is);
     // the model line goes to stderr.
     eprintln!(
-        "model {} (recipe {}), sigma_p {:.4}%",
+        "model {} (recipe {}), sigma_p {:.4}%; sigma_pF: {}",
         o.model.display(),
         model.info.recipe_name,
-        100.0 * model.sigma_p()
+        100.0 * model.sigma_p(),
+        if sigma_kind == "per-point" {
+            "the calibrated per-point sigma_s(p, U) c12"
+        } else {
+            "sigma_p c12"
+        }
     );
     let mut header = "voltage_V,c12_pF,sigma_pF".to_string();
     if ensemble {

@@ -1,8 +1,12 @@
 //! The shipped surrogates reproduce, on the committed held-out set (5000 samples of the paper's
 //! space from sequence index 100000, never used in training), the figures committed beside them
 //! (models/*.heldout.json, quoted in reports/surrogate.md), and the paper recipe meets the
-//! paper's figure (Gaussian sigma of the relative error <= 1.5%).
+//! paper's figure (Gaussian sigma of the relative error <= 1.5%). Each carries its per-point
+//! uncertainty sigma_s(p, U_B) calibrated on data/training/calibration.csv (issue 21): refitting
+//! it there gives the stored model, and its held-out coverage is the committed one.
 
+use hpge_surrogate::job::Evaluation;
+use hpge_surrogate::model::TARGET_COVERAGE_2SIGMA;
 use hpge_surrogate::{DataSet, Figures, Surrogate};
 use hpge_validation::repo_path;
 
@@ -10,7 +14,8 @@ fn check(name: &str) -> Figures {
     let model = Surrogate::load(&repo_path(&format!("models/{name}.safetensors"))).expect("model");
     let data = DataSet::read(&repo_path("data/training/heldout.csv"), &model.info.space)
         .expect("held-out set of the model's space");
-    let f = Figures::of(&model.predict_set(&data), &data.c12_pf);
+    let ev = Evaluation::new(&model, &data, 0);
+    let f = ev.figures.clone();
     let text = std::fs::read_to_string(repo_path(&format!("models/{name}.heldout.json"))).unwrap();
     let j: serde_json::Value = serde_json::from_str(&text).unwrap();
     assert_eq!(j["n"].as_u64().unwrap() as usize, f.n);
@@ -20,6 +25,8 @@ fn check(name: &str) -> Figures {
         ("abs_rel_q50", f.abs_rel_q50),
         ("abs_rel_q90", f.abs_rel_q90),
         ("abs_rel_q99", f.abs_rel_q99),
+        ("coverage_1sigma", ev.coverage.0),
+        ("coverage_2sigma", ev.coverage.1),
     ] {
         let committed = j[key].as_f64().unwrap();
         // The same weights and data; only the last bits of exp/tanh may differ between CPUs.
@@ -43,4 +50,48 @@ fn best_recipe_reproduces_its_committed_figures() {
     let f = check("super-siegfried-rz-paper-log-ensemble");
     let paper = check("super-siegfried-rz-paper");
     assert!(f.rel_sigma < paper.rel_sigma && f.abs_rel_q90 < paper.abs_rel_q90);
+}
+
+#[test]
+fn shipped_models_carry_the_error_model_their_calibration_set_gives() {
+    for name in [
+        "super-siegfried-rz-split",
+        "super-siegfried-rz-paper",
+        "super-siegfried-rz-paper-log-ensemble",
+    ] {
+        let model =
+            Surrogate::load(&repo_path(&format!("models/{name}.safetensors"))).expect("model");
+        let stored = model.error_model().expect("a calibrated error model");
+        let data = DataSet::read(
+            &repo_path("data/training/calibration.csv"),
+            &model.info.space,
+        )
+        .expect("calibration set of the model's space");
+        assert_eq!(
+            data.excluded, 0,
+            "the current solver leaves no row without c12"
+        );
+        assert_eq!(
+            stored.calibration.hash, data.hash,
+            "{name}: calibrated on another file"
+        );
+        let refit = model.fit_error_model(&data).unwrap();
+        for (k, (a, b)) in refit.weights.iter().zip(&stored.weights).enumerate() {
+            assert!(
+                (a - b).abs() <= 1e-9 * (1.0 + b.abs()),
+                "{name} w{k}: {a} vs {b}"
+            );
+        }
+        assert!((refit.kappa - stored.kappa).abs() <= 1e-9 * stored.kappa);
+        assert!((stored.coverage_2sigma - TARGET_COVERAGE_2SIGMA).abs() < 2e-3);
+        // The error model knows where the network is worse: at the low-bias edge more than at
+        // the centre of the space.
+        let centre = vec![0.0; stored.inputs.len()];
+        let mut low_bias = centre.clone();
+        *low_bias.last_mut().unwrap() = -2.5;
+        assert!(
+            stored.sigma(&low_bias, None) > stored.sigma(&centre, None),
+            "{name}"
+        );
+    }
 }

@@ -130,14 +130,21 @@ impl FitJob {
                 detector.display()
             )),
         }
+        let sigma = match surrogate.error_model() {
+            Some(m) if !noise.constant_sigma => format!(
+                "per-point sigma_s calibrated on {} rows of {}",
+                m.calibration.n, m.calibration.file
+            ),
+            _ => format!("sigma_p {:.3}%", 100.0 * surrogate.sigma_p()),
+        };
         let describe = format!(
-            "{} (recipe {}, sigma_p {:.3}%)",
+            "{} (recipe {}, {sigma})",
             model.display(),
             surrogate.info.recipe_name,
-            100.0 * surrogate.sigma_p()
         );
         let sm = SurrogateModel::new(surrogate, &data_curve.voltage_v, describe)
-            .map_err(|e| e.context(format!("the voltages of {}", data.display())))?;
+            .map_err(|e| e.context(format!("the voltages of {}", data.display())))?
+            .constant_sigma(noise.constant_sigma);
         let spec = PriorSpec::from_file(prior)?;
         let prior_b = Prior::bind(&spec, &sm.inputs(), &sm.domain())?;
         let likelihood = Likelihood::new(&data_curve, noise, sm.sigma_rel())?;

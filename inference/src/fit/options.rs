@@ -98,6 +98,10 @@ pub struct FitOptions {
     /// covariance instead of the 3% term).
     #[cfg_attr(feature = "clap", arg(long, default_value = NoiseKind::default().as_str()))]
     pub likelihood: String,
+    /// The surrogate's constant sigma_p in the likelihood (the paper's eq. 13) even where its
+    /// model file has a calibrated per-point uncertainty sigma_s(p, U_B) (`hpge-cv calibrate`).
+    #[cfg_attr(feature = "clap", arg(long))]
+    pub constant_sigma: bool,
     /// Chains (run in parallel).
     #[cfg_attr(feature = "clap", arg(long, default_value_t = DEFAULT_CHAINS))]
     pub chains: usize,
@@ -144,6 +148,7 @@ impl Default for FitOptions {
             refine_rounds: DEFAULT_REFINE_ROUNDS,
             allow_exact_mismatch: false,
             likelihood: NoiseKind::default().as_str().into(),
+            constant_sigma: false,
             chains: DEFAULT_CHAINS,
             ess: DEFAULT_ESS_MIN,
             rhat: DEFAULT_RHAT_MAX,
@@ -191,7 +196,10 @@ impl FitOptions {
     /// # Errors
     /// [`Error::BadOption`] for an unknown name.
     pub fn noise(&self) -> Result<NoiseSettings> {
-        noise_settings(&self.likelihood)
+        Ok(NoiseSettings {
+            constant_sigma: self.constant_sigma,
+            ..noise_settings(&self.likelihood)?
+        })
     }
 
     /// The exact-solver check's settings (`--exact-draws`, `--exact-grids`,

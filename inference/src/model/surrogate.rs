@@ -1,4 +1,7 @@
-//! The trained surrogate as a [`CvModel`].
+//! The trained surrogate as a [`CvModel`]. With a calibrated error model in its file
+//! (`hpge-cv calibrate`, issue 21) its uncertainty is per point, sigma_s(p, U_k)
+//! ([`CvModel::curve_variance`]); without one, or with [`SurrogateModel::constant_sigma`], the
+//! constant sigma_p of the paper's eq. 13.
 
 use hpge_surrogate::Surrogate;
 use hpge_surrogate::model::Voltages;
@@ -13,6 +16,7 @@ pub struct SurrogateModel {
     pub surrogate: Surrogate,
     voltages: Voltages,
     describe: String,
+    constant: bool,
 }
 
 impl SurrogateModel {
@@ -23,7 +27,16 @@ impl SurrogateModel {
             surrogate,
             voltages,
             describe: describe.into(),
+            constant: false,
         })
+    }
+
+    /// Uses the constant sigma_p even where the model file has an error model (for comparison
+    /// with the paper's likelihood).
+    #[must_use]
+    pub fn constant_sigma(mut self, constant: bool) -> Self {
+        self.constant = constant;
+        self
     }
 }
 
@@ -68,5 +81,27 @@ impl CvModel for SurrogateModel {
 
     fn describe(&self) -> String {
         self.describe.clone()
+    }
+
+    fn has_point_variance(&self) -> bool {
+        !self.constant && self.surrogate.error_model().is_some()
+    }
+
+    fn curve_variance(
+        &self,
+        x: &[f64],
+        var_rel: &mut [f64],
+        jac: Option<&mut [f64]>,
+    ) -> Result<()> {
+        if !self.has_point_variance() {
+            var_rel.fill(self.sigma_rel().powi(2));
+            if let Some(j) = jac {
+                j.fill(0.0);
+            }
+            return Ok(());
+        }
+        self.surrogate
+            .curve_variance_into(x, &self.voltages, var_rel, jac)
+            .map_err(Error::from)
     }
 }

@@ -64,6 +64,10 @@ pub struct NoiseSettings {
     pub solver_rel: f64,
     /// a_s: absolute field-solver uncertainty, pF (paper eq. 7: 1 pF).
     pub solver_abs_pf: f64,
+    /// Use the surrogate's constant sigma_p (the paper's eq. 13) even where its model file has a
+    /// calibrated per-point sigma_s(p, U_B) (`--constant-sigma`; default false).
+    #[serde(default)]
+    pub constant_sigma: bool,
 }
 
 impl Default for NoiseSettings {
@@ -73,6 +77,7 @@ impl Default for NoiseSettings {
             measurement_rel: 0.03,
             solver_rel: 0.01,
             solver_abs_pf: 1.0,
+            constant_sigma: false,
         }
     }
 }
@@ -326,21 +331,32 @@ impl Likelihood {
 
     /// A simulated measurement: c_p plus noise from this noise model (N(0, Sigma(c_p))).
     pub fn simulate<R: Rng + ?Sized>(&self, c_p: &[f64], rng: &mut R) -> Vec<f64> {
+        self.simulate_with(c_p, self.constant(), rng)
+    }
+
+    /// A simulated measurement whose model term has a squared relative uncertainty per point,
+    /// `var_rel` (a calibrated surrogate's sigma_s(p, U_k)^2).
+    pub fn simulate_var<R: Rng + ?Sized>(
+        &self,
+        c_p: &[f64],
+        var_rel: &[f64],
+        rng: &mut R,
+    ) -> Vec<f64> {
+        self.simulate_with(c_p, ModelVar::PerPoint(var_rel), rng)
+    }
+
+    fn simulate_with<R: Rng + ?Sized>(&self, c_p: &[f64], v: ModelVar, rng: &mut R) -> Vec<f64> {
         let n = self.len();
         let z: Vec<f64> = (0..n).map(|_| StandardNormal.sample(rng)).collect();
         match &self.covariance {
             None => c_p
                 .iter()
                 .zip(&z)
-                .map(|(&c, &e)| {
-                    c + self
-                        .variance(c, self.sigma_rel_model * self.sigma_rel_model)
-                        .sqrt()
-                        * e
-                })
+                .enumerate()
+                .map(|(k, (&c, &e))| c + self.variance(c, v.at(k)).sqrt() * e)
                 .collect(),
             Some(vm) => {
-                let a = self.covariance_at(vm, c_p, self.constant());
+                let a = self.covariance_at(vm, c_p, v);
                 let chol = Cholesky::new(&a, n).expect("a covariance plus a positive diagonal");
                 let e = chol.mul_lower(&z);
                 c_p.iter().zip(e).map(|(&c, e)| c + e).collect()

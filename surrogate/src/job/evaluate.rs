@@ -130,6 +130,13 @@ pub struct Evaluation {
     pub predictions: Vec<f64>,
     /// The accuracy at the edges of every input (network order).
     pub edges: Vec<EdgeFigures>,
+    /// The predicted relative uncertainty of every sample: the model's calibrated sigma_s(p,
+    /// U_B), or its constant sigma_p without an error model.
+    pub sigmas: Vec<f64>,
+    /// Fractions of the samples whose relative error lies within 1 and 2 predicted sigma.
+    pub coverage: (f64, f64),
+    /// `per-point` (a calibrated error model) or `constant` (sigma_p).
+    pub sigma_kind: &'static str,
 }
 
 /// `evaluate --json`: the issue's fields first, then the rest (the field order is the JSON's).
@@ -155,6 +162,16 @@ pub struct EvaluationJson<'a> {
     pub rel_rms: f64,
     /// Root mean square of c_p - c_s (pF).
     pub abs_rms_pf: f64,
+    /// Fraction of samples whose relative error is within 1 predicted sigma (the calibrated
+    /// sigma_s(p, U_B), or sigma_p for a model without an error model; issue 21).
+    pub coverage_1sigma: f64,
+    /// The same within 2 predicted sigma.
+    pub coverage_2sigma: f64,
+    /// The Gaussian sigma of the relative error (= `rel_sigma`: the core of the distribution,
+    /// as the paper defines sigma_p).
+    pub rel_sigma_core: f64,
+    /// `per-point` (the model file's calibrated sigma_s) or `constant` (sigma_p).
+    pub sigma_kind: &'a str,
     /// Rows without c12, left out.
     pub excluded: usize,
     /// The model file as given.
@@ -212,6 +229,9 @@ impl Evaluation {
             })
             .collect();
         let edges = edge_figures(model, data, &pred);
+        let sigmas = model.sigma_set(data);
+        let rels: Vec<f64> = (0..data.len()).map(rel).collect();
+        let coverage = crate::model::coverage_of(&rels, sigmas.iter().copied());
         Evaluation {
             figures,
             excluded: data.excluded,
@@ -221,6 +241,13 @@ impl Evaluation {
             worst,
             predictions: pred,
             edges,
+            sigmas,
+            coverage,
+            sigma_kind: if model.error_model().is_some() {
+                "per-point"
+            } else {
+                "constant"
+            },
         }
     }
 
@@ -238,6 +265,10 @@ impl Evaluation {
             abs_rel_q999: f.abs_rel_q999,
             rel_rms: f.rel_rms,
             abs_rms_pf: f.abs_rms_pf,
+            coverage_1sigma: self.coverage.0,
+            coverage_2sigma: self.coverage.1,
+            rel_sigma_core: f.rel_sigma,
+            sigma_kind: self.sigma_kind,
             excluded: self.excluded,
             model: model_file.display().to_string(),
             data: data_file.display().to_string(),

@@ -1,10 +1,11 @@
 //! The surrogate's application layer, as the `train`, `evaluate` and `predict` commands use it
 //! (and tests and other programs can, without the command line): a training run with its
 //! resumable checkpoints and learning curves ([`TrainJob`]), a model's accuracy on a data set
-//! ([`Evaluation`]) and parameter lists as a user writes them ([`parse_params`]); the commands'
+//! ([`Evaluation`]), its calibrated per-point uncertainty ([`CalibrateOptions`]) and parameter lists as a user writes them ([`parse_params`]); the commands'
 //! options are declared here once ([`GenerateOptions`], [`TrainJob`], [`EvaluateOptions`],
 //! [`PredictOptions`]).
 
+mod calibrate;
 mod checkpoint;
 mod evaluate;
 mod options;
@@ -14,6 +15,7 @@ mod train;
 #[cfg(test)]
 mod tests;
 
+pub use calibrate::CalibrateOptions;
 pub use checkpoint::{curves_path, partial_dir, resume_members, save_member, write_curves};
 pub use evaluate::{
     EDGE_FRACTION, EdgeFigures, EdgeStats, Evaluation, EvaluationJson, Worst, edge_figures,

@@ -320,6 +320,7 @@ impl TrainJob {
                 None => None,
             },
             coverage,
+            error_model: None,
             sigma_p: f64::NAN,
         })
     }

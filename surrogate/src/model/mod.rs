@@ -3,6 +3,7 @@
 
 mod coverage;
 mod dataset;
+mod error_model;
 mod file;
 mod gelu;
 mod metrics;
@@ -14,10 +15,15 @@ mod train;
 mod transform;
 
 #[cfg(test)]
+mod error_tests;
+#[cfg(test)]
 mod tests;
 
 pub use coverage::{Coverage, SUPPORT_ROWS, support_rows};
 pub use dataset::{DataSet, network_order};
+pub use error_model::{
+    ErrorModel, RIDGE_PER_ROW, SIGMA_MAX, SIGMA_MIN, TARGET_COVERAGE_2SIGMA, coverage_of,
+};
 pub use metrics::{Figures, gaussian_fit, quantile};
 pub use network::{Dense, Network};
 pub use polynomial::{Polynomial, monomials};

@@ -7,6 +7,7 @@ use serde::{Deserialize, Serialize};
 
 use super::coverage::{Coverage, support_rows};
 use super::dataset::{DataSet, network_order};
+use super::error_model::ErrorModel;
 use super::metrics::Figures;
 use super::network::Network;
 use super::polynomial::Polynomial;
@@ -98,6 +99,11 @@ pub struct ModelInfo {
     /// points `predict` accepts without `--extrapolate`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub coverage: Option<Vec<Coverage>>,
+    /// The calibrated per-point uncertainty sigma_s(p, U_B) (issue 21; `hpge-cv calibrate`):
+    /// when present, inference uses it in place of [`Self::sigma_p`]. Absent in files not
+    /// calibrated.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub error_model: Option<ErrorModel>,
     /// sigma_p: the relative surrogate uncertainty inference uses (sigma_c^p = sigma_p c_p, the
     /// paper's eq. CapUncertaintyDNN): the Gaussian sigma on the test set.
     pub sigma_p: f64,
@@ -120,7 +126,7 @@ pub struct Surrogate {
     /// The predictor.
     pub predictor: Predictor,
     /// Dimensions in network order.
-    dims: Vec<Dimension>,
+    pub(super) dims: Vec<Dimension>,
 }
 
 /// Bias voltages mapped once to the network's coordinates (reuse them for every curve).
@@ -128,7 +134,7 @@ pub struct Surrogate {
 pub struct Voltages {
     /// U_B (V).
     pub volts: Vec<f64>,
-    z: Vec<f64>,
+    pub(super) z: Vec<f64>,
 }
 
 impl Surrogate {

@@ -7,7 +7,7 @@ use super::*;
 use crate::Error;
 use crate::space::ParameterSpace;
 
-fn space() -> ParameterSpace {
+pub(super) fn space() -> ParameterSpace {
     let mut text = String::from("name = \"test\"\n");
     for (k, (lo, hi)) in [(0.2, 5.0), (0.02, 1.0), (-1.0, 1.0)].iter().enumerate() {
         text += &format!(
@@ -40,7 +40,7 @@ fn write_set(path: &std::path::Path, sp: &ParameterSpace, n: usize, offset: usiz
     std::fs::write(path, text).unwrap();
 }
 
-fn random_network(arch: &Architecture, seed: u64) -> Network {
+pub(super) fn random_network(arch: &Architecture, seed: u64) -> Network {
     let mut net = initial_network(arch, 3, seed);
     // Non-zero biases so that every code path matters.
     for (k, l) in net.trunk.iter_mut().chain(net.head.iter_mut()).enumerate() {
@@ -161,6 +161,7 @@ fn tiny_training_lowers_the_loss_and_the_file_reloads_identically() {
         test_figures: Figures::of(&[1.0], &[1.0]),
         detector: None,
         coverage: None,
+        error_model: None,
         sigma_p: 0.05,
     };
     let model = Surrogate::new(info, Predictor::Networks(t.members)).unwrap();
@@ -251,17 +252,11 @@ fn tiny_training_lowers_the_loss_and_the_file_reloads_identically() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
-#[test]
-fn physical_jacobian_matches_finite_differences() {
-    let arch = Architecture {
-        trunk: vec![8],
-        head: vec![8],
-    };
-    let net = random_network(&arch, 9);
-    let sp = space();
-    let mut info_space = sp.clone();
+/// The metadata of an untrained unit-test model of [`space`] (sigma_p 1%).
+pub(super) fn unit_info() -> ModelInfo {
+    let mut info_space = space();
     info_space.name = "test".into();
-    let info = ModelInfo {
+    ModelInfo {
         format: FORMAT.into(),
         format_version: FORMAT_VERSION,
         program_version: "test".into(),
@@ -289,8 +284,19 @@ fn physical_jacobian_matches_finite_differences() {
         test_figures: Figures::of(&[1.0], &[1.0]),
         detector: None,
         coverage: None,
+        error_model: None,
         sigma_p: 0.01,
+    }
+}
+
+#[test]
+fn physical_jacobian_matches_finite_differences() {
+    let arch = Architecture {
+        trunk: vec![8],
+        head: vec![8],
     };
+    let net = random_network(&arch, 9);
+    let info = unit_info();
     let m = Surrogate::new(
         info,
         Predictor::Networks(vec![net.clone(), random_network(&arch, 10)]),

@@ -174,7 +174,8 @@ struct TruthResult {
 }
 
 /// Runs the study: `data_model` simulates the data (with `template`'s noise; pass
-/// `data_sigma_rel` = 0 for exact-solver data, the surrogate's sigma_p for surrogate data),
+/// `data_sigma_rel` = 0 for exact-solver data, the surrogate's sigma_p for surrogate data; a
+/// `data_model` with a per-point uncertainty then draws its model error with that instead),
 /// `fit_model` is fitted. `progress(done, total)` after each truth.
 #[allow(clippy::too_many_arguments)]
 pub fn coverage(
@@ -215,9 +216,17 @@ pub fn coverage(
                 }
                 Err(e) => return Err(e.into()),
             }
-            let c_m = template
-                .with_sigma_rel(data_sigma_rel)
-                .simulate(&c, &mut rng);
+            // Surrogate data with a calibrated per-point uncertainty draws its model error
+            // with sigma_s at the truth, as the likelihood assumes it.
+            let c_m = if data_sigma_rel > 0.0 && data_model.has_point_variance() {
+                let mut var = vec![0.0; nv];
+                data_model.curve_variance(&x, &mut var, None)?;
+                template.simulate_var(&c, &var, &mut rng)
+            } else {
+                template
+                    .with_sigma_rel(data_sigma_rel)
+                    .simulate(&c, &mut rng)
+            };
             let like = template.with_data(c_m);
             let posterior = Posterior::new(fit_model, prior, &like)?;
             let mut fs = settings.fit;
