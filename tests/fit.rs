@@ -59,16 +59,22 @@ fn b_z_fit_writes_every_output() {
         assert!(p["rhat"].as_f64().unwrap() <= 1.01);
         assert!(p["ess_bulk"].as_f64().unwrap() >= 300.0);
     }
-    // The paper's finding on B_Z: the misfit sits at low voltages.
+    // The paper's finding on B_Z: the misfit sits at low voltages. (With the surrogate's
+    // calibrated sigma_s, largest at the lowest biases, the pull there is smaller than with the
+    // paper's constant sigma_p; the misfit itself is not.)
     let pred = std::fs::read_to_string(out.join("predictive.csv")).unwrap();
-    let mut rows = pred.lines().filter(|l| !l.starts_with('#')).skip(1);
-    let first: Vec<f64> = rows
-        .next()
-        .unwrap()
-        .split(',')
-        .map(|x| x.parse().unwrap())
+    let rows: Vec<Vec<f64>> = pred
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .skip(1)
+        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
         .collect();
-    assert!(first[4].abs() > 3.0, "pull at 25 V {}", first[4]);
+    // voltage_V, c_m_pF, c_mode_pF, ...: the relative misfit at the mode.
+    let off = |r: &Vec<f64>| ((r[2] - r[1]) / r[1]).abs();
+    assert!(off(&rows[0]) > 0.2, "25 V: {:?}", rows[0]);
+    for r in rows.iter().filter(|r| r[0] > 500.0) {
+        assert!(off(r) < off(&rows[0]) / 4.0, "{r:?}");
+    }
     for f in [
         "samples.csv",
         "summary.json",
@@ -114,6 +120,10 @@ fn nuts_and_the_covariance_likelihood_run() {
             "nuts",
             "--likelihood",
             "covariance",
+            // The paper's constant sigma_p: with the calibrated sigma_s this B_Z posterior has
+            // three separated modes (weights 0.89 / 0.08 / 0.03), between which NUTS, without
+            // the Metropolis sampler's mode-jump proposals, does not mix (R-hat 1.7 in 300 s).
+            "--constant-sigma",
         ],
     )));
     let v: serde_json::Value = serde_json::from_str(stdout.trim()).unwrap();
@@ -337,6 +347,27 @@ fn a_killed_fit_resumes_its_finished_rounds_and_never_mixes_runs() {
     assert!(o.status.success(), "{err}");
     assert!(!err.contains("taken back"), "{err}");
     assert!(!killed.join("rounds").join("round-1.json").exists());
+}
+
+#[test]
+fn a_folder_another_fit_is_writing_is_refused() {
+    // This process holds the folder's lock as a running fit would (the lock is the operating
+    // system's: a killed fit releases it, as the resume test shows).
+    let d = temp("fit-locked");
+    let out = d.join("out");
+    std::fs::create_dir_all(&out).unwrap();
+    std::fs::write(out.join("keep.txt"), "x").unwrap();
+    let lock = hpge_inference::fit::lock_output(&out).unwrap();
+    let o = run(&fit_args(out.to_str().unwrap(), &["--no-exact-check"]));
+    bad(
+        &o,
+        &[
+            "another `fit` process is writing this folder",
+            &format!("pid {}", std::process::id()),
+        ],
+    );
+    assert!(!out.join("summary.json").exists() && out.join("keep.txt").exists());
+    drop(lock);
 }
 
 #[test]

@@ -130,14 +130,17 @@ pub enum Error {
         /// Name of the model's parameter space.
         space: String,
     },
-    /// An output folder another process is writing (`generate`'s one-writer lock).
+    /// An output folder another process is writing (the one-writer lock of `generate` and
+    /// `fit`).
     #[error(
-        "{}: another `generate` process is writing this folder ({holder}); wait for it to finish or use another --out",
+        "{}: another `{command}` process is writing this folder ({holder}); wait for it to finish or use another --out",
         folder.display()
     )]
     Locked {
         /// The folder.
         folder: PathBuf,
+        /// The command whose lock it is (`generate`, `fit`).
+        command: String,
         /// Who holds the lock (pid, host, start time), as it wrote itself into the lock file.
         holder: String,
     },

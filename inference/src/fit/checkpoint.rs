@@ -5,9 +5,15 @@
 //! saved round is sampled again (the sampler is seeded, so its draws are the same) with its
 //! check attached. A folder written with other inputs or settings is cleared first (the
 //! fingerprint in each file says which run wrote it), so two runs never mix; a file cut short
-//! by a kill is not taken (each is written to a temporary name and renamed).
+//! by a kill is not taken (each is written to a temporary name and renamed). One folder, one
+//! writer: a fit writing to a folder holds an exclusive lock on `OUT/fit.lock` ([`FIT_LOCK`],
+//! [`lock_output`]; an advisory `flock` the operating system drops when the process ends in any
+//! way, `kill -9` included), so a second fit started on the same folder while the first runs is
+//! refused, naming the holder, instead of clearing or mixing its rounds.
 
 use std::path::{Path, PathBuf};
+
+use hpge_surrogate::generate::FolderLock;
 
 use serde::{Deserialize, Serialize};
 
@@ -17,6 +23,18 @@ use crate::{Error, Result};
 
 /// The folder inside a fit's output folder that holds its rounds.
 pub const ROUNDS_DIR: &str = "rounds";
+/// The lock file a running fit holds in its output folder.
+pub const FIT_LOCK: &str = "fit.lock";
+
+/// Takes the lock of a fit's output folder `out` (which must exist) for as long as the returned
+/// value lives.
+///
+/// # Errors
+/// Another process holds it (`hpge_surrogate::Error::Locked`, naming its pid, host and start),
+/// or the lock file cannot be opened.
+pub fn lock_output(out: &Path) -> Result<FolderLock> {
+    Ok(FolderLock::acquire_named(out, FIT_LOCK)?)
+}
 
 /// One finished round as written.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -49,7 +67,7 @@ pub struct Checkpoint {
 impl Checkpoint {
     /// Opens `out/rounds` for the run `fingerprint`: returns the rounds it already finished
     /// (round 0, 1, ... without a gap). Files of another run, unreadable ones and those after a
-    /// gap are removed.
+    /// gap are removed. The caller holds the folder's lock ([`lock_output`]).
     ///
     /// # Errors
     /// [`Error::Io`] when the folder cannot be made or read, or a stale file cannot be removed.

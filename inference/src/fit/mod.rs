@@ -14,7 +14,7 @@ mod summary;
 mod truth;
 mod zeta;
 
-pub use checkpoint::{Checkpoint, ROUNDS_DIR, SavedRound, fingerprint};
+pub use checkpoint::{Checkpoint, FIT_LOCK, ROUNDS_DIR, SavedRound, fingerprint, lock_output};
 pub use exact_check::{
     DEFAULT_GRID_CHECK, ExactCheck, ExactCheckSettings, ExactGrids, GridCheck, K_HAT_LIMIT,
     ParameterShift, SHIFT_LIMIT_SD, add_grid_check, exact_check,

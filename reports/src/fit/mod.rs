@@ -79,6 +79,8 @@ pub fn run_fit(o: &FitOptions, observer: &dyn FitObserver) -> Result<FitRun> {
         file: out.clone(),
         message: format!("cannot create the folder: {e}"),
     })?;
+    // One writer per folder, until the last file is written.
+    let _lock = hpge_inference::fit::lock_output(&out)?;
     observer.setup_done(&job, o, &settings);
     let (fit, correction) = if o.no_exact_check {
         let fit = job.run(&settings, &|s| observer.sampling(s))?;

@@ -1,4 +1,5 @@
-//! One folder, one writer: a `generate` run holds an exclusive lock on `--out` while it writes.
+//! One folder, one writer: a `generate` run holds an exclusive lock on `--out` while it writes
+//! (and a `fit` on its output folder, under another name: [`FolderLock::acquire_named`]).
 //!
 //! The lock is an advisory `flock` (std's [`File::try_lock`]) on `OUT/generate.lock`, held for
 //! the whole run. The operating system drops it when the process ends in any way (a normal exit,
@@ -31,7 +32,13 @@ impl FolderLock {
     /// Takes the lock of folder `dir` (which must exist), or fails with [`Error::Locked`]
     /// naming the process that holds it.
     pub fn acquire(dir: &Path) -> Result<Self> {
-        let path = dir.join(LOCK_FILE);
+        Self::acquire_named(dir, LOCK_FILE)
+    }
+
+    /// The same with the lock file `name` in `dir` (another command's lock: `fit` holds
+    /// `OUT/fit.lock` while it writes its rounds and outputs).
+    pub fn acquire_named(dir: &Path, name: &str) -> Result<Self> {
+        let path = dir.join(name);
         let io = |action: &'static str| {
             let path = path.clone();
             move |source| Error::Io {
@@ -55,6 +62,7 @@ impl FolderLock {
                 let holder = holder.trim();
                 return Err(Error::Locked {
                     folder: dir.into(),
+                    command: name.trim_end_matches(".lock").into(),
                     holder: if holder.is_empty() {
                         "a process that has not written its name yet".into()
                     } else {
@@ -99,8 +107,13 @@ mod tests {
         let first = FolderLock::acquire(&dir).unwrap();
         // flock locks belong to the open file: a second open, even in this process, conflicts.
         match FolderLock::acquire(&dir) {
-            Err(Error::Locked { folder, holder }) => {
+            Err(Error::Locked {
+                folder,
+                command,
+                holder,
+            }) => {
                 assert_eq!(folder, dir);
+                assert_eq!(command, "generate");
                 assert!(
                     holder.contains(&format!("pid {}", std::process::id())),
                     "{holder}"

@@ -4,6 +4,8 @@
 
 use std::path::{Path, PathBuf};
 
+use serde::{Deserialize, Serialize};
+
 use crate::error::{Error, Result};
 use crate::hash::fnv1a;
 use crate::space::{ParameterSpace, Target};
@@ -226,4 +228,29 @@ pub fn network_order(space: &ParameterSpace) -> Result<Vec<usize>> {
     let mut order: Vec<usize> = (0..targets.len()).filter(|&j| j != bias[0]).collect();
     order.push(bias[0]);
     Ok(order)
+}
+
+/// Provenance of a data set used in training.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct DataInfo {
+    /// File as given.
+    pub file: String,
+    /// FNV-1a hash (hex) of its bytes.
+    pub hash: String,
+    /// Samples used.
+    pub n: usize,
+    /// Rows without c12, left out.
+    pub excluded: usize,
+}
+
+impl DataInfo {
+    /// Of a data set.
+    pub fn of(set: &DataSet) -> Self {
+        DataInfo {
+            file: set.file.display().to_string(),
+            hash: set.hash.clone(),
+            n: set.len(),
+            excluded: set.excluded,
+        }
+    }
 }

@@ -13,6 +13,7 @@ mod recipe;
 mod surrogate;
 mod train;
 mod transform;
+mod uncertainty;
 
 #[cfg(test)]
 mod error_tests;
@@ -20,7 +21,7 @@ mod error_tests;
 mod tests;
 
 pub use coverage::{Coverage, SUPPORT_ROWS, support_rows};
-pub use dataset::{DataSet, network_order};
+pub use dataset::{DataInfo, DataSet, network_order};
 pub use error_model::{
     ErrorModel, RIDGE_PER_ROW, SIGMA_MAX, SIGMA_MIN, TARGET_COVERAGE_2SIGMA, coverage_of,
 };
@@ -29,7 +30,7 @@ pub use network::{Dense, Network};
 pub use polynomial::{Polynomial, monomials};
 pub use recipe::{Architecture, Cycle, Loss, OutputTransform, RECIPES, Recipe};
 pub use surrogate::{
-    DataInfo, DetectorInfo, FORMAT, FORMAT_VERSION, ModelInfo, Predictor, Surrogate, Voltages,
+    DetectorInfo, FORMAT, FORMAT_VERSION, ModelInfo, Predictor, Surrogate, Voltages,
 };
 pub use train::{
     EpochRecord, Member, Trained, candle_outputs, initial_network, output_transform, train,

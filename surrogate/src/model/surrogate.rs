@@ -6,7 +6,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::coverage::{Coverage, support_rows};
-use super::dataset::{DataSet, network_order};
+use super::dataset::{DataInfo, DataSet, network_order};
 use super::error_model::ErrorModel;
 use super::metrics::Figures;
 use super::network::Network;
@@ -20,31 +20,6 @@ use crate::space::{Dimension, ParameterSpace};
 pub const FORMAT: &str = "hpge-cv-surrogate";
 /// Version of the model-file layout this program reads and writes.
 pub const FORMAT_VERSION: u32 = 1;
-
-/// Provenance of a data set used in training.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct DataInfo {
-    /// File as given.
-    pub file: String,
-    /// FNV-1a hash (hex) of its bytes.
-    pub hash: String,
-    /// Samples used.
-    pub n: usize,
-    /// Rows without c12, left out.
-    pub excluded: usize,
-}
-
-impl DataInfo {
-    /// Of a data set.
-    pub fn of(set: &DataSet) -> Self {
-        DataInfo {
-            file: set.file.display().to_string(),
-            hash: set.hash.clone(),
-            n: set.len(),
-            excluded: set.excluded,
-        }
-    }
-}
 
 /// The detector a model's training rows were simulated for.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
