@@ -206,3 +206,67 @@ fn tiny_network_on_a_tiny_generated_set() {
     );
     let _ = std::fs::remove_dir_all(&d);
 }
+
+#[test]
+fn calibrate_writes_the_per_point_uncertainty_evaluate_reports_its_coverage() {
+    let d = std::env::temp_dir().join(format!("hpge-calibrate-cli-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    let shipped = "models/super-siegfried-rz-split.safetensors";
+    let out = d.join("split.safetensors");
+    let o = run(&[
+        "calibrate",
+        "--model",
+        shipped,
+        "--data",
+        "data/training/calibration.csv",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    ok(&o);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("1200 rows") && err.contains("95.4% within 2"),
+        "{err}"
+    );
+    let eval = |m: &str| -> serde_json::Value {
+        let text = ok(&run(&[
+            "evaluate",
+            "--model",
+            m,
+            "--data",
+            "data/training/calibration.csv",
+            "--json",
+        ]));
+        serde_json::from_str(&text).unwrap()
+    };
+    // The shipped model was calibrated by this command on this file: the same error model, the
+    // same predictions, hence the same figures and coverage.
+    let (a, b) = (eval(out.to_str().unwrap()), eval(shipped));
+    for key in [
+        "rel_sigma",
+        "abs_rel_q99",
+        "coverage_1sigma",
+        "coverage_2sigma",
+    ] {
+        assert_eq!(a[key], b[key], "{key}");
+    }
+    assert_eq!(a["sigma_kind"], "per-point");
+    assert_eq!(a["rel_sigma_core"], a["rel_sigma"]);
+    let c2 = a["coverage_2sigma"].as_f64().unwrap();
+    assert!((c2 - 0.9545).abs() < 2e-3, "{c2}");
+    // Bad input: exit code 2 naming the file.
+    bad(
+        &run(&[
+            "calibrate",
+            "--model",
+            shipped,
+            "--data",
+            "no/such.csv",
+            "--out",
+            out.to_str().unwrap(),
+        ]),
+        &["no/such.csv"],
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}

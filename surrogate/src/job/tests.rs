@@ -320,6 +320,43 @@ fn the_polynomial_writes_no_curves_and_evaluates() {
         )),
         "{e}"
     );
+
+    // Calibration (issue 21): refused on the model's own training or test set; on rows it never
+    // saw it writes the error model into a copy, predictions unchanged, and evaluate reports the
+    // per-point coverage.
+    let cal_out = d.join("calibrated.safetensors");
+    for own in [&job.data, &job.test] {
+        let e = CalibrateOptions {
+            model: job.out.clone(),
+            data: own.clone(),
+            out: Some(cal_out.clone()),
+        }
+        .run()
+        .unwrap_err();
+        assert!(
+            matches!(e, Error::Argument { .. }) && e.to_string().contains("never saw"),
+            "{e}"
+        );
+    }
+    assert!(!cal_out.exists());
+    let fresh = d.join("fresh.csv");
+    write_set(&fresh, &model.info.space, 200, 5000);
+    let cal = CalibrateOptions {
+        model: job.out.clone(),
+        data: fresh.clone(),
+        out: Some(cal_out.clone()),
+    };
+    let em = cal.run().unwrap();
+    assert!(em.calibration.n > 150, "{}", em.calibration.n);
+    let calibrated = Surrogate::load(&cal_out).unwrap();
+    assert_eq!(calibrated.predictor, model.predictor);
+    assert_eq!(calibrated.info.error_model.as_ref(), Some(&em));
+    let rows = read_for_model(&calibrated, &cal_out, &fresh).unwrap();
+    let ev = Evaluation::new(&calibrated, &rows, 0);
+    assert_eq!(ev.sigma_kind, "per-point");
+    assert!((ev.coverage.1 - 0.9545).abs() < 0.01, "{:?}", ev.coverage);
+    let plain = Evaluation::new(&model, &rows, 0);
+    assert_eq!((plain.sigma_kind, plain.figures), ("constant", ev.figures));
     let _ = std::fs::remove_dir_all(&d);
 }
 
