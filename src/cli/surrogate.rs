@@ -346,11 +346,7 @@ pub fn predict(o: &PredictOptions, json: bool) -> Result<()> {
     };
     // sigma_s(p, U) c12 with a calibrated error model, sigma_p c12 without.
     let sigma = model.curve_sigma_pf(&params, &u, &c)?;
-    let sigma_kind = if model.error_model().is_some() {
-        "per-point"
-    } else {
-        "constant"
-    };
+    let sigma_kind = model.sigma_kind();
     let ensemble = model.members() > 1;
     if json {
         let j = PredictJson {

@@ -14,6 +14,15 @@ use crate::Result;
 /// c(x) and each nearby point's curve or its error ([`CvModel::curves_near`]).
 pub type NearCurves = (Vec<f64>, Vec<Result<Vec<f64>>>);
 
+/// [`CvModel::curve_variance`] of a constant relative uncertainty `sigma_rel`: sigma_rel^2 at
+/// every point, zero derivatives.
+pub(crate) fn constant_variance(sigma_rel: f64, var_rel: &mut [f64], jac: Option<&mut [f64]>) {
+    var_rel.fill(sigma_rel * sigma_rel);
+    if let Some(j) = jac {
+        j.fill(0.0);
+    }
+}
+
 /// A model of c12 along a fixed list of bias voltages.
 ///
 /// Inputs are the model's own parameters in physical units (for the paper's surrogate: d_Li in
@@ -53,10 +62,7 @@ pub trait CvModel: Send + Sync {
         var_rel: &mut [f64],
         jac: Option<&mut [f64]>,
     ) -> Result<()> {
-        var_rel.fill(self.sigma_rel().powi(2));
-        if let Some(j) = jac {
-            j.fill(0.0);
-        }
+        constant_variance(self.sigma_rel(), var_rel, jac);
         Ok(())
     }
     /// A short description for reports (file, recipe, ...).

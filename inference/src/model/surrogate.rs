@@ -6,7 +6,7 @@
 use hpge_surrogate::Surrogate;
 use hpge_surrogate::model::Voltages;
 
-use super::CvModel;
+use super::{CvModel, constant_variance};
 use crate::{Error, Result};
 
 /// A surrogate bound to the measured voltages (mapped once).
@@ -94,10 +94,7 @@ impl CvModel for SurrogateModel {
         jac: Option<&mut [f64]>,
     ) -> Result<()> {
         if !self.has_point_variance() {
-            var_rel.fill(self.sigma_rel().powi(2));
-            if let Some(j) = jac {
-                j.fill(0.0);
-            }
+            constant_variance(self.sigma_rel(), var_rel, jac);
             return Ok(());
         }
         self.surrogate

@@ -130,10 +130,8 @@ pub struct Evaluation {
     pub predictions: Vec<f64>,
     /// The accuracy at the edges of every input (network order).
     pub edges: Vec<EdgeFigures>,
-    /// The predicted relative uncertainty of every sample: the model's calibrated sigma_s(p,
-    /// U_B), or its constant sigma_p without an error model.
-    pub sigmas: Vec<f64>,
-    /// Fractions of the samples whose relative error lies within 1 and 2 predicted sigma.
+    /// Fractions of the samples whose relative error lies within 1 and 2 predicted sigma (the
+    /// model's calibrated sigma_s(p, U_B), or its constant sigma_p without an error model).
     pub coverage: (f64, f64),
     /// `per-point` (a calibrated error model) or `constant` (sigma_p).
     pub sigma_kind: &'static str,
@@ -229,9 +227,8 @@ impl Evaluation {
             })
             .collect();
         let edges = edge_figures(model, data, &pred);
-        let sigmas = model.sigma_set(data);
         let rels: Vec<f64> = (0..data.len()).map(rel).collect();
-        let coverage = crate::model::coverage_of(&rels, sigmas.iter().copied());
+        let coverage = crate::model::coverage_of(&rels, model.sigma_set(data).into_iter());
         Evaluation {
             figures,
             excluded: data.excluded,
@@ -241,13 +238,8 @@ impl Evaluation {
             worst,
             predictions: pred,
             edges,
-            sigmas,
             coverage,
-            sigma_kind: if model.error_model().is_some() {
-                "per-point"
-            } else {
-                "constant"
-            },
+            sigma_kind: model.sigma_kind(),
         }
     }
 

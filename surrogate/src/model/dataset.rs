@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
+use super::transform::unit_to_z;
 use crate::error::{Error, Result};
 use crate::hash::fnv1a;
 use crate::space::{ParameterSpace, Target};
@@ -47,6 +48,11 @@ impl DataSet {
     /// The unit-cube row i.
     pub fn unit_row(&self, i: usize) -> &[f64] {
         &self.unit[i * self.dim..(i + 1) * self.dim]
+    }
+
+    /// The network coordinates z = Phi^-1(u) of row i (the input map of every model).
+    pub fn z_row(&self, i: usize) -> Vec<f64> {
+        self.unit_row(i).iter().map(|&u| unit_to_z(u)).collect()
     }
 
     /// The physical row i.

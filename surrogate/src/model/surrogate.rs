@@ -12,7 +12,7 @@ use super::metrics::Figures;
 use super::network::Network;
 use super::polynomial::Polynomial;
 use super::recipe::{OutputTransform, Recipe};
-use super::transform::{dimension_from_unit, dimension_to_unit, physical_to_z, unit_to_z};
+use super::transform::{dimension_from_unit, dimension_to_unit, physical_to_z};
 use crate::error::{Error, Result};
 use crate::space::{Dimension, ParameterSpace};
 
@@ -411,7 +411,7 @@ impl Surrogate {
         (0..set.len())
             .into_par_iter()
             .map(|i| {
-                let z: Vec<f64> = set.unit_row(i).iter().map(|&u| unit_to_z(u)).collect();
+                let z = set.z_row(i);
                 match &self.predictor {
                     Predictor::Networks(nets) => {
                         let mut y = [0.0];

@@ -5,7 +5,7 @@
 use super::dataset::{DataInfo, DataSet};
 use super::error_model::ErrorModel;
 use super::surrogate::{Surrogate, Voltages};
-use super::transform::{physical_to_z, unit_to_z};
+use super::transform::physical_to_z;
 use crate::error::Result;
 
 impl Surrogate {
@@ -17,15 +17,22 @@ impl Surrogate {
             .filter(|m| m.inputs.len() == self.dims.len())
     }
 
+    /// `per-point` (a calibrated error model: sigma_s(p, U_B)) or `constant` (sigma_p), as
+    /// `evaluate --json` and `predict --json` name it.
+    pub fn sigma_kind(&self) -> &'static str {
+        if self.error_model().is_some() {
+            "per-point"
+        } else {
+            "constant"
+        }
+    }
+
     /// The relative uncertainty of every row of a data set (read with this model's space):
     /// sigma_s(z) of the error model, or the constant sigma_p without one.
     pub fn sigma_set(&self, set: &DataSet) -> Vec<f64> {
         match self.error_model() {
             Some(m) => (0..set.len())
-                .map(|i| {
-                    let z: Vec<f64> = set.unit_row(i).iter().map(|&u| unit_to_z(u)).collect();
-                    m.sigma(&z, None)
-                })
+                .map(|i| m.sigma(&set.z_row(i), None))
                 .collect(),
             None => vec![self.sigma_p(); set.len()],
         }
@@ -106,14 +113,7 @@ impl Surrogate {
             .zip(&set.c12_pf)
             .map(|(p, t)| (p - t) / t)
             .collect();
-        let z: Vec<f64> = (0..set.len())
-            .flat_map(|i| {
-                set.unit_row(i)
-                    .iter()
-                    .map(|&u| unit_to_z(u))
-                    .collect::<Vec<_>>()
-            })
-            .collect();
+        let z: Vec<f64> = (0..set.len()).flat_map(|i| set.z_row(i)).collect();
         let names = self.dims.iter().map(|d| d.name.clone()).collect();
         ErrorModel::fit(names, &z, &rel, DataInfo::of(set))
     }
