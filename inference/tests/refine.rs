@@ -154,6 +154,7 @@ fn refinement_turns_a_failing_exact_check_into_a_passing_one() {
         draws: 100,
         grids: ExactGrids::Own,
         grid_check: 0,
+        ascents: 0,
     };
     let refined = refine_fit(
         RefineInputs {

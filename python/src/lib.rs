@@ -607,7 +607,9 @@ fn measure<'py>(
 /// `out` (a folder: also write every file and figure
 /// `hpge-cv fit --out` writes), `progress`, `extrapolate` (fit a curve with voltages outside the
 /// surrogate's support, as `--extrapolate`), `constant_sigma` (the model's constant sigma_p in
-/// the likelihood even where its file has a calibrated per-point sigma_s, as `--constant-sigma`).
+/// the likelihood even where its file has a calibrated per-point sigma_s, as `--constant-sigma`),
+/// `exact_ascents` (after a passing check, climb the exact posterior from this many local modes
+/// in other basins, as `--exact-ascents`).
 ///
 /// Returns a dict: `summary` (the `summary.json` object as a dict), `names` (parameters),
 /// `draws` (array [chain, draw, parameter] in the prior's units), `ln_posterior` ([chain, draw]),
@@ -617,7 +619,7 @@ fn measure<'py>(
     data=None, model=None, prior=None, detector=None, seed=None, sampler=None, likelihood=None,
     chains=None, ess=None, rhat=None, max_seconds=None, exact_check=false, exact_draws=None,
     out=None, progress=None, extrapolate=false, exact_grids=None, exact_grid_check=None,
-    refine_rounds=None, constant_sigma=false
+    refine_rounds=None, constant_sigma=false, exact_ascents=None
 ))]
 #[allow(clippy::too_many_arguments)]
 fn fit<'py>(
@@ -642,6 +644,7 @@ fn fit<'py>(
     exact_grid_check: Option<usize>,
     refine_rounds: Option<usize>,
     constant_sigma: bool,
+    exact_ascents: Option<usize>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let d = FitOptions::default();
     let o = FitOptions {
@@ -656,6 +659,7 @@ fn fit<'py>(
         exact_draws: exact_draws.unwrap_or(d.exact_draws),
         exact_grids: exact_grids.unwrap_or(d.exact_grids),
         exact_grid_check: exact_grid_check.unwrap_or(d.exact_grid_check),
+        exact_ascents: exact_ascents.unwrap_or(d.exact_ascents),
         refine_rounds: refine_rounds.unwrap_or(d.refine_rounds),
         likelihood: likelihood.unwrap_or(d.likelihood),
         chains: chains.unwrap_or(d.chains),
@@ -827,29 +831,17 @@ fn discover<'py>(
         let s = FitJob::from_files(&files, noise, &w.grid).map_err(err)?;
         let spec = hpge_inference::PriorSpec::from_file(&prior_file).map_err(err)?;
         let settings = o.settings(noise).map_err(err)?;
-        let surrogate: std::sync::Arc<dyn hpge_inference::CvModel> =
-            std::sync::Arc::new(s.surrogate.clone());
-        let mut inputs = s.inputs.clone();
-        inputs.insert("start_model".into(), prior_file.display().to_string());
-        let d = hpge_inference::discover(
-            &hpge_inference::DiscoverInputs {
-                surrogate,
-                exact: &s.exact,
-                start: &spec,
-                likelihood: &s.likelihood,
-                inputs,
-            },
+        let dir = out.as_ref().map(|_| o.out_dir(&prior_file));
+        let d = hpge_reports::discover::run_discover(
+            &s,
+            &spec,
+            &prior_file,
             &settings,
+            dir.as_deref(),
+            w.no_plots,
             &progress,
         )
         .map_err(err)?;
-        if out.is_some() {
-            let dir = o.out_dir(&prior_file);
-            std::fs::create_dir_all(&dir).map_err(|e| {
-                HpgeError::new_err(format!("{}: cannot create the folder: {e}", dir.display()))
-            })?;
-            hpge_reports::discover::write_outputs(&dir, &d, &s.exact, w.no_plots).map_err(err)?;
-        }
         serde_json::to_value(&d.summary).map_err(err)
     })?;
     json_to_py(py, &summary)

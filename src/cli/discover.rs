@@ -3,13 +3,12 @@
 //! probes, score the catalogue of extensions, fit the best, and show the gap shrink.
 
 use std::path::Path;
-use std::sync::Arc;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use hpge_inference::discover::DiscoverOptions;
 use hpge_inference::discover::catalogue;
 use hpge_inference::posterior::NoiseKind;
-use hpge_inference::{CvModel, DiscoverInputs, Discovery, PriorSpec, Progress, Status, discover};
+use hpge_inference::{CvModel, Discovery, PriorSpec, Progress, Status};
 use indicatif::ProgressBar;
 
 use hpge_inference::fit::noise_settings;
@@ -77,8 +76,6 @@ pub fn run(a: &DiscoverArgs) -> Result<()> {
     s.posterior()?;
     let spec = PriorSpec::from_file(&prior_file)?;
     let out = o.out_dir(&prior_file);
-    std::fs::create_dir_all(&out)
-        .with_context(|| format!("--out {}: cannot create the folder", out.display()))?;
     eprintln!(
         "discover: {} ({} voltages), start model {} ({} parameters), {}",
         w.data.display(),
@@ -89,22 +86,16 @@ pub fn run(a: &DiscoverArgs) -> Result<()> {
     );
     let (bar, sampling) = progress_printer(false);
     let printer = Printer::new(bar.clone(), sampling);
-    let surrogate: Arc<dyn CvModel> = Arc::new(s.surrogate.clone());
-    let mut inputs = s.inputs.clone();
-    inputs.insert("start_model".into(), prior_file.display().to_string());
-    let d = discover(
-        &DiscoverInputs {
-            surrogate,
-            exact: &s.exact,
-            start: &spec,
-            likelihood: &s.likelihood,
-            inputs,
-        },
+    let d = hpge_reports::discover::run_discover(
+        &s,
+        &spec,
+        &prior_file,
         &settings,
+        Some(&out),
+        w.no_plots,
         &printer,
     )?;
     bar.finish_and_clear();
-    hpge_reports::discover::write_outputs(&out, &d, &s.exact, w.no_plots)?;
     if a.json {
         println!("{}", serde_json::to_string_pretty(&d.summary)?);
     } else {

@@ -192,6 +192,15 @@ fn round_text(r: &RefineRound) -> String {
         )
     } else {
         String::new()
+    }) + &r.better_basin.as_ref().map_or(String::new(), |b| {
+        format!(
+            "; an exact ascent from a local mode ended in another basin at {:?}, exact ln p {:.2} above the fit's mode",
+            b.theta
+                .iter()
+                .map(|t| (t * 1e4).round() / 1e4)
+                .collect::<Vec<_>>(),
+            b.ln_posterior_exact - b.ln_posterior_exact_at_mode
+        )
     }) + &r
         .stopped
         .as_ref()

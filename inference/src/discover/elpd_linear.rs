@@ -14,8 +14,8 @@
 //! sigma is held at its value at the mode (its dependence on c is second order here).
 
 use super::checks::{Elpd, block_partition};
-use super::laplace::LaplaceFit;
 use crate::numerics::Cholesky;
+use crate::posterior::LaplaceFit;
 
 /// H = covariance^-1 (d x d, row-major); None when the covariance is not positive definite.
 fn precision(cov: &[f64], d: usize) -> Option<Vec<f64>> {

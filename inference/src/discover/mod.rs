@@ -8,13 +8,14 @@ mod catalogue;
 mod checks;
 mod elpd_linear;
 mod fits;
-mod laplace;
 mod options;
 mod region;
+mod resume;
 mod run;
 mod settings;
 mod summary;
 
+pub use crate::posterior::{LaplaceFit, LaplaceSettings, laplace_fit};
 pub use catalogue::{
     Affine, AffineKind, Baseline, CalibrationScale, Candidate, ExactVariant, Extension,
     ExtensionPredictor, LiSlope, Modifier, QuadraticZ, Radial, Scaled, Shifted, StrayCapacitance,
@@ -23,9 +24,9 @@ pub use catalogue::{
 pub use checks::{
     Elpd, PredictiveDraws, ResidualCheck, Window, delta_elpd, leave_window_out, residual_check,
 };
-pub use laplace::{LaplaceFit, LaplaceSettings, laplace_fit};
 pub use options::{DEFAULT_START_MODEL, DiscoverOptions, WorkflowOptions};
 pub use region::{ProbedRegion, probed_region};
+pub use resume::{DISCOVER_LOCK, STAGES_DIR, Stages, lock_output, run_fingerprint};
 pub use run::discover;
 pub use settings::{
     DEFAULT_MIN_LN_BAYES, DiscoverInputs, DiscoverSettings, Discovery, ModelFit, Progress,

@@ -7,13 +7,14 @@ use std::time::Instant;
 use super::catalogue::{Baseline, ExtensionPredictor, catalogue};
 use super::checks::delta_elpd;
 use super::fits::{best_laplace, bind, gap, laplace_model_fit, mcmc_fit, start_points};
-use super::laplace::{LaplaceFit, laplace_fit};
 use super::region::probed_region;
+use super::resume::{Stages, stage};
 use super::settings::{DiscoverInputs, DiscoverSettings, Discovery, Progress};
 use super::summary::{CandidateScore, Disagreement, DiscoverySummary, NotApplicable};
 use crate::Result;
 use crate::model::{CvModel, ExactModel};
 use crate::posterior::Posterior;
+use crate::posterior::{LaplaceFit, laplace_fit};
 use crate::prior::Prior;
 
 /// Runs the workflow (see the module docs).
@@ -58,10 +59,13 @@ pub fn discover(
         "quick fit of the start model ({})",
         predictor.as_str()
     ));
-    let base_fit = best_laplace(
-        &p0,
-        &start_points(&prior0, &sur_mode, settings.exact),
-        settings,
+    let starts0 = start_points(&prior0, &sur_mode, settings.exact);
+    let base_fit = stage(
+        inp.stages,
+        progress,
+        &format!("start-{}", predictor.as_str()),
+        &starts0,
+        || best_laplace(&p0, &starts0, settings),
     )?;
     let (before, before_gap, mode) = if settings.exact {
         let theta = base_fit.theta.clone();
@@ -131,11 +135,10 @@ pub fn discover(
                 if base_exact.is_none() {
                     progress.stage("quick fit of the start model (exact solver)");
                     let p = Posterior::new(exact_model.as_ref(), &exact_prior, &lik_exact)?;
-                    base_exact = Some(best_laplace(
-                        &p,
-                        &start_points(&exact_prior, &sur_mode, true),
-                        settings,
-                    )?);
+                    let starts = start_points(&exact_prior, &sur_mode, true);
+                    base_exact = Some(stage(inp.stages, progress, "start-exact", &starts, || {
+                        best_laplace(&p, &starts, settings)
+                    })?);
                 }
                 (base_exact.as_ref().expect("set above"), &lik_exact)
             }
@@ -149,7 +152,13 @@ pub fn discover(
         if start.len() == baseline.theta.len() + c.added.len() {
             start[..baseline.theta.len()].copy_from_slice(&baseline.theta);
         }
-        let lf = laplace_fit(&p, &start, &settings.laplace)?;
+        let lf = stage(
+            inp.stages,
+            progress,
+            &format!("{}-{}", c.name, c.predictor.as_str()),
+            std::slice::from_ref(&start),
+            || laplace_fit(&p, &start, &settings.laplace),
+        )?;
         scores.push(CandidateScore {
             name: c.name.clone(),
             score: lf.ln_evidence - baseline.ln_evidence,
@@ -255,6 +264,7 @@ pub fn discover(
         program_version: env!("CARGO_PKG_VERSION").into(),
         inputs: inp.inputs.clone(),
         settings: settings.clone(),
+        resumed_stages: inp.stages.map(Stages::taken).unwrap_or_default(),
     };
     Ok(Discovery {
         summary,

@@ -7,11 +7,11 @@ use hpge_surrogate::ExactSolver;
 use serde::Serialize;
 
 use super::checks::{Elpd, ResidualCheck};
-use super::laplace::{LaplaceFit, LaplaceSettings};
 use super::summary::DiscoverySummary;
 use crate::fit::{Fit, FitSettings};
 use crate::model::CvModel;
 use crate::posterior::Likelihood;
+use crate::posterior::{LaplaceFit, LaplaceSettings};
 use crate::prior::PriorSpec;
 use crate::sampler::Status;
 use crate::{Error, Result};
@@ -107,6 +107,9 @@ pub struct DiscoverInputs<'a> {
     pub likelihood: &'a Likelihood,
     /// Input files and hashes for the summary.
     pub inputs: BTreeMap<String, String>,
+    /// Where the finished stages go and are taken back from (`OUT/stages`, see
+    /// [`super::Stages`]); None: nothing is written, nothing resumed.
+    pub stages: Option<&'a super::Stages>,
 }
 
 /// One model's fit, as the workflow keeps it.

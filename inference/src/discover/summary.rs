@@ -135,4 +135,7 @@ pub struct DiscoverySummary {
     pub inputs: BTreeMap<String, String>,
     /// Settings and seed.
     pub settings: DiscoverSettings,
+    /// The stages taken back from an interrupted run of the same arguments (`OUT/stages`), in
+    /// order; empty for a run that solved everything itself.
+    pub resumed_stages: Vec<String>,
 }

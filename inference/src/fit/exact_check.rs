@@ -90,6 +90,9 @@ pub struct ExactCheckSettings {
     /// With [`ExactGrids::Mode`]: how many of the draws (evenly spread) are solved on their own
     /// adaptive grids too, for [`GridCheck`] (0: none).
     pub grid_check: usize,
+    /// After a passing check in a refined fit: ascents of the exact posterior from this many of
+    /// the sampler's local modes in other basins ([`super::basin_ascents`]; 0: none).
+    pub ascents: usize,
 }
 
 /// The draws solved both on the mode's grids and on their own: how much the choice of grid
@@ -147,7 +150,8 @@ pub struct ExactCheck {
     /// The largest |shift_sd|.
     #[serde(deserialize_with = "super::round::f64_or_nan")]
     pub max_abs_shift_sd: f64,
-    /// Whether k-hat <= [`K_HAT_LIMIT`] and every |shift| <= [`SHIFT_LIMIT_SD`].
+    /// Whether k-hat <= [`K_HAT_LIMIT`], every |shift| <= [`SHIFT_LIMIT_SD`] and no ascent
+    /// found a better basin ([`super::BasinAscent::better`]).
     pub pass: bool,
     /// Wall time, s.
     #[serde(deserialize_with = "super::round::f64_or_nan")]
@@ -161,6 +165,10 @@ pub struct ExactCheck {
     /// the caller knows it (a fit records its exact solver's).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub solver_tolerance: Option<f64>,
+    /// Ascents of the exact posterior from the sampler's local modes in other basins (after a
+    /// passing check; one that found a better basin fails it).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub ascents: Vec<super::BasinAscent>,
     /// The model inputs x and the exact curve of every draw whose solve succeeded, the mode's
     /// last (what posterior-adaptive refinement learns from; not in the summary).
     #[serde(skip)]
@@ -316,6 +324,7 @@ pub fn exact_check(
         grids,
         grid_check: None,
         solver_tolerance: None,
+        ascents: Vec::new(),
         solved,
     })
     .and_then(|mut check| {

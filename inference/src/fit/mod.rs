@@ -1,6 +1,7 @@
 //! A whole fit: sampling, the posterior summary (means, modes, smallest intervals, diagnostics),
 //! the posterior predictive, the modes of a multimodal posterior, and the exact-solver check.
 
+mod ascent;
 mod checkpoint;
 mod exact_check;
 mod job;
@@ -14,6 +15,9 @@ mod summary;
 mod truth;
 mod zeta;
 
+pub use ascent::{
+    ASCENT_MARGIN, BasinAscent, DEFAULT_ASCENTS, MIN_ASCENT_WEIGHT, away_from_mode, basin_ascents,
+};
 pub use checkpoint::{Checkpoint, FIT_LOCK, ROUNDS_DIR, SavedRound, fingerprint, lock_output};
 pub use exact_check::{
     DEFAULT_GRID_CHECK, ExactCheck, ExactCheckSettings, ExactGrids, GridCheck, K_HAT_LIMIT,

@@ -6,6 +6,7 @@ use std::path::PathBuf;
 
 use hpge_solver::GridOverrides;
 
+use super::ascent::DEFAULT_ASCENTS;
 use super::exact_check::{DEFAULT_GRID_CHECK, ExactCheckSettings, ExactGrids};
 use super::job::FitFiles;
 use super::refine::{DEFAULT_REFINE_ROUNDS, RefineSettings};
@@ -84,6 +85,12 @@ pub struct FitOptions {
     /// grids' difference (0: none).
     #[cfg_attr(feature = "clap", arg(long, default_value_t = DEFAULT_GRID_CHECK))]
     pub exact_grid_check: usize,
+    /// After a passing exact check: climb the exact posterior from this many of the sampler's
+    /// local modes in other basins; an ascent that ends in another basin more than e^1 times as
+    /// dense as the fit's mode fails the check, and its curves refine the surrogate there
+    /// (0: none).
+    #[cfg_attr(feature = "clap", arg(long, default_value_t = DEFAULT_ASCENTS))]
+    pub exact_ascents: usize,
     /// Rounds of posterior-adaptive refinement at most, the first (plain surrogate) included:
     /// while the exact check fails, its exact curves teach a model of the surrogate's error
     /// (a Gaussian process at the voltages) and the fit samples again with the corrected
@@ -145,6 +152,7 @@ impl Default for FitOptions {
             exact_draws: DEFAULT_EXACT_DRAWS,
             exact_grids: ExactGrids::default().as_str().into(),
             exact_grid_check: DEFAULT_GRID_CHECK,
+            exact_ascents: DEFAULT_ASCENTS,
             refine_rounds: DEFAULT_REFINE_ROUNDS,
             allow_exact_mismatch: false,
             likelihood: NoiseKind::default().as_str().into(),
@@ -212,6 +220,7 @@ impl FitOptions {
             draws: self.exact_draws,
             grids: ExactGrids::parse(&self.exact_grids)?,
             grid_check: self.exact_grid_check,
+            ascents: self.exact_ascents,
         })
     }
 

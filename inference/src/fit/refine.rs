@@ -16,6 +16,7 @@
 use std::collections::BTreeMap;
 use std::time::Instant;
 
+use super::ascent::{away_from_mode, basin_ascents};
 use super::checkpoint::{Checkpoint, SavedRound, fingerprint};
 use super::exact_check::{ExactCheckSettings, ExactGrids, add_grid_check, exact_check};
 use super::job::FitJob;
@@ -70,21 +71,13 @@ pub const MAX_LOCAL_MODE_CURVES: usize = 8;
 /// left out.
 fn local_mode_curves(m: RefineInputs, result: &Fit) -> Result<Vec<(Vec<f64>, Vec<f64>)>> {
     use rayon::prelude::*;
-    let support: Vec<[f64; 2]> = m.prior.parameters.iter().map(|p| p.support).collect();
-    let away = |theta: &[f64]| {
-        theta
-            .iter()
-            .zip(&result.mode)
-            .zip(&support)
-            .any(|((a, b), s)| (a - b).abs() > 0.01 * (s[1] - s[0]))
-    };
     let nx = m.prior.input_names.len();
     let nv = m.likelihood.len();
     let xs: Vec<Vec<f64>> = result
         .samples
         .local_modes
         .iter()
-        .filter(|l| away(&l.theta))
+        .filter(|l| away_from_mode(m.prior, &result.mode, &l.theta))
         .take(MAX_LOCAL_MODE_CURVES)
         .map(|l| {
             let mut x = vec![0.0; nx];
@@ -277,6 +270,19 @@ pub fn refine_fit(
                         &no_grid_check,
                         progress.exact,
                     )?;
+                    // A passing check also climbs the exact posterior from the sampler's
+                    // local modes in other basins; a better basin fails it.
+                    if chk.pass && check.ascents > 0 {
+                        let t_ascent = Instant::now();
+                        let (ascents, curves) =
+                            basin_ascents(m.exact, m.prior, m.likelihood, &result, check.ascents)?;
+                        if ascents.iter().any(|a| a.better) {
+                            chk.pass = false;
+                            chk.solved.extend(curves);
+                        }
+                        chk.ascents = ascents;
+                        chk.seconds += t_ascent.elapsed().as_secs_f64();
+                    }
                     let stopped = stop_reason(chk.pass, round, training.len() + chk.solved.len());
                     let done = chk.pass || stopped.is_some();
                     if done && chk.grids == ExactGrids::Mode && check.grid_check > 0 {
@@ -305,6 +311,12 @@ pub fn refine_fit(
                         resumed: false,
                         stopped,
                         local_mode_curves,
+                        better_basin: chk
+                            .ascents
+                            .iter()
+                            .filter(|a| a.better)
+                            .max_by(|a, b| a.ln_posterior_exact.total_cmp(&b.ln_posterior_exact))
+                            .cloned(),
                     };
                     if let Some(r) = &resume {
                         r.checkpoint.save(&SavedRound {

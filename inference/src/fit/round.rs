@@ -51,4 +51,8 @@ pub struct RefineRound {
     /// teach the error model with the check's, see [`crate::fit::MAX_LOCAL_MODE_CURVES`]).
     #[serde(default)]
     pub local_mode_curves: usize,
+    /// The best ascent of this round's check that found a better basin than the fit's
+    /// ([`crate::fit::basin_ascents`]); absent when none did or none ran.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub better_basin: Option<super::BasinAscent>,
 }

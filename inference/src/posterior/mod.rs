@@ -2,9 +2,11 @@
 //! measured covariance) and the posterior the samplers see.
 
 mod density;
+mod laplace;
 mod likelihood;
 
 pub use density::{Evaluation, Posterior};
+pub use laplace::{LaplaceFit, LaplaceSettings, fd_steps, laplace_fit};
 pub use likelihood::{Likelihood, NoiseKind, NoiseSettings};
 
 #[cfg(test)]

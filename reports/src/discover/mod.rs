@@ -6,7 +6,9 @@ mod report;
 use std::fmt::Write as _;
 use std::path::Path;
 
-use hpge_inference::Discovery;
+use hpge_inference::discover::{Stages, lock_output, run_fingerprint};
+use hpge_inference::fit::FitJob;
+use hpge_inference::{DiscoverInputs, DiscoverSettings, Discovery, PriorSpec, Progress, discover};
 
 pub use report::write_report;
 
@@ -62,4 +64,58 @@ pub fn write_outputs(
     };
     write_report(&out.join("report.md"), d, &figures)?;
     Ok(())
+}
+
+/// Runs `discover` as the command line and Python do, on `job` (data, surrogate, exact solver;
+/// its prior is not used) with the start model `start` read from `start_file`. With `out`, the
+/// folder is made and locked for the run ([`lock_output`]; a second `discover` on it is refused,
+/// naming the holder), the finished stages are written to `out/stages` as they go and taken back
+/// by a rerun with the same arguments ([`Stages`]; a folder of another run is cleared first),
+/// and every output is written there at the end (figures unless `no_plots`).
+///
+/// # Errors
+/// An output folder that cannot be made or is locked, the workflow's errors, writing failures.
+pub fn run_discover(
+    job: &FitJob,
+    start: &PriorSpec,
+    start_file: &Path,
+    settings: &DiscoverSettings,
+    out: Option<&Path>,
+    no_plots: bool,
+    progress: &dyn Progress,
+) -> Result<Discovery> {
+    let mut inputs = job.inputs.clone();
+    inputs.insert("start_model".into(), start_file.display().to_string());
+    let (lock, stages) = match out {
+        Some(dir) => {
+            std::fs::create_dir_all(dir).map_err(|e| Error::Output {
+                flag: "--out".into(),
+                file: dir.to_path_buf(),
+                message: format!("cannot create the folder: {e}"),
+            })?;
+            let lock = lock_output(dir)?;
+            let fp = run_fingerprint(&inputs, settings, &job.exact.settings);
+            (Some(lock), Some(Stages::open(dir, fp)?))
+        }
+        None => (None, None),
+    };
+    let surrogate: std::sync::Arc<dyn hpge_inference::CvModel> =
+        std::sync::Arc::new(job.surrogate.clone());
+    let d = discover(
+        &DiscoverInputs {
+            surrogate,
+            exact: &job.exact,
+            start,
+            likelihood: &job.likelihood,
+            inputs,
+            stages: stages.as_ref(),
+        },
+        settings,
+        progress,
+    )?;
+    if let Some(dir) = out {
+        write_outputs(dir, &d, &job.exact, no_plots)?;
+    }
+    drop(lock);
+    Ok(d)
 }

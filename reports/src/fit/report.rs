@@ -207,7 +207,7 @@ pub fn write_report(
         let _ = writeln!(r, "## Exact-solver check\n");
         let _ = writeln!(
             r,
-            "{} posterior draws re-weighted with the exact field solver{}, solved on {} ({} failed solves) in {:.1} s: Pareto k-hat {:.2} ({}), weights' ESS {:.0}; |c_exact - c_model| / c_exact at the global mode up to {:.2}%; chi^2 of the exact curve at the mode {:.1}. **{}** (pass: k-hat <= {} and every shift <= {} sd).\n",
+            "{} posterior draws re-weighted with the exact field solver{}, solved on {} ({} failed solves) in {:.1} s: Pareto k-hat {:.2} ({}), weights' ESS {:.0}; |c_exact - c_model| / c_exact at the global mode up to {:.2}%; chi^2 of the exact curve at the mode {:.1}. **{}** (pass: k-hat <= {}, every shift <= {} sd, and no exact ascent from a local mode ends more than {} above the mode's exact ln p).\n",
             c.draws,
             c.solver_tolerance
                 .map(|t| format!(" at a tolerance of {}% of c12", 100.0 * t))
@@ -228,8 +228,38 @@ pub fn write_report(
             c.chi2_exact_at_mode,
             if c.pass { "Pass" } else { "Fail" },
             hpge_inference::fit::K_HAT_LIMIT,
-            hpge_inference::fit::SHIFT_LIMIT_SD
+            hpge_inference::fit::SHIFT_LIMIT_SD,
+            hpge_inference::fit::ASCENT_MARGIN
         );
+        if !c.ascents.is_empty() {
+            let _ = writeln!(
+                r,
+                "Ascents of the exact posterior (Levenberg-Marquardt on the exact solver) from the sampler's local modes in other basins: the draws cannot show a basin they do not visit.\n"
+            );
+            let _ = writeln!(
+                r,
+                "| from | to | exact ln p - exact ln p at the mode | exact curves | better basin |"
+            );
+            let _ = writeln!(r, "|---|---|---|---|---|");
+            let v = |t: &[f64]| {
+                t.iter()
+                    .map(|x| format!("{x:.3}"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            };
+            for a in &c.ascents {
+                let _ = writeln!(
+                    r,
+                    "| ({}) | ({}) | {:+.2} | {} | {} |",
+                    v(&a.start),
+                    v(&a.theta),
+                    a.ln_posterior_exact - a.ln_posterior_exact_at_mode,
+                    a.evaluations,
+                    if a.better { "**yes**" } else { "no" }
+                );
+            }
+            let _ = writeln!(r);
+        }
         if let Some(rounds) = sm.refinement.as_ref().filter(|r| r.len() > 1) {
             let _ = writeln!(
                 r,

@@ -287,6 +287,7 @@ pub fn run_hidden(
             start,
             likelihood: &likelihood,
             inputs,
+            stages: None,
         },
         settings,
         progress,

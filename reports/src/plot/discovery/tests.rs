@@ -187,6 +187,7 @@ fn synthetic(extended: bool) -> Discovery {
         program_version: "0".into(),
         inputs,
         settings: DiscoverSettings::default(),
+        resumed_stages: Vec::new(),
     };
     Discovery {
         summary,

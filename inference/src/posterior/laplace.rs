@@ -1,4 +1,5 @@
-//! The quick fit of a candidate: the posterior mode by Levenberg-Marquardt on the whitened
+//! A posterior's mode and its Laplace approximation (`discover`'s quick fit of a candidate, and
+//! the exact check's ascent into another basin): the mode by Levenberg-Marquardt on the whitened
 //! residuals, and the Laplace approximation around it (the evidence and a Gaussian posterior).
 //!
 //! Residuals: e_k = (c_p,k(theta) - c_m,k) / sigma_k, with sigma_k the likelihood's standard
@@ -14,10 +15,10 @@
 //! differences from [`crate::CvModel::curves_near`]: the exact solver solves the steps on the
 //! grids of theta's curve, so the differences are smooth in theta.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
+use super::Posterior;
 use crate::numerics::Cholesky;
-use crate::posterior::Posterior;
 use crate::prior::PriorDistribution;
 use crate::rejection::unless_rejected;
 use crate::{Error, Result};
@@ -56,7 +57,7 @@ impl Default for LaplaceSettings {
 }
 
 /// A posterior mode with its Laplace approximation.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct LaplaceFit {
     /// theta at the mode.
     pub theta: Vec<f64>,
@@ -78,6 +79,21 @@ pub struct LaplaceFit {
     pub evaluations: usize,
     /// Accepted steps.
     pub steps: usize,
+}
+
+/// The forward-difference steps at theta: h_j = `fd_step` times parameter j's support width,
+/// backwards (-h_j) where theta_j + h_j would leave the support.
+pub fn fd_steps(prior: &crate::prior::Prior, theta: &[f64], fd_step: f64) -> Vec<f64> {
+    prior
+        .parameters
+        .iter()
+        .zip(theta)
+        .map(|(p, t)| {
+            let [lo, hi] = p.support;
+            let h = fd_step * (hi - lo);
+            if t + h > hi { -h } else { h }
+        })
+        .collect()
 }
 
 /// c_p and dc_p/dtheta at theta (analytic where the model has a Jacobian).
@@ -106,19 +122,13 @@ fn curve_and_jacobian(
     }
     // Forward differences: the steps' curves from the model's nearby-curve method (the exact
     // solver solves them on x's grids, so a grid change cannot masquerade as a derivative).
-    let mut steps = Vec::with_capacity(d);
+    let steps = fd_steps(prior, theta, fd_step);
     let mut xs = Vec::with_capacity(d);
-    for j in 0..d {
-        let s = prior.parameters[j].support;
-        let mut h = fd_step * (s[1] - s[0]);
-        if theta[j] + h > s[1] {
-            h = -h;
-        }
+    for (j, h) in steps.iter().enumerate() {
         let mut t = theta.to_vec();
         t[j] += h;
         let mut xj = vec![0.0; nx];
         prior.expand(&t, &mut xj);
-        steps.push(h);
         xs.push(xj);
     }
     let (c0, near) = posterior.model.curves_near(&x, &xs, &|_, _| {})?;
