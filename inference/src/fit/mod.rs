@@ -16,7 +16,8 @@ mod truth;
 mod zeta;
 
 pub use ascent::{
-    ASCENT_MARGIN, BasinAscent, DEFAULT_ASCENTS, MIN_ASCENT_WEIGHT, away_from_mode, basin_ascents,
+    ASCENT_MARGIN, AWAY_SD, BasinAscent, DEFAULT_ASCENTS, MIN_ASCENT_WEIGHT, away_from_mode,
+    basin_ascents,
 };
 pub use checkpoint::{Checkpoint, FIT_LOCK, ROUNDS_DIR, SavedRound, fingerprint, lock_output};
 pub use exact_check::{
