@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{bad, ok, run, temp};
+use common::{bad, kill_when, ok, run, temp};
 
 /// One catalogue entry, light sampling and a coarse exact solver (about 75 s in a release build
 /// on the 2-core machine; the exact quick fits are most of it).
@@ -49,32 +49,13 @@ fn a_killed_discover_takes_back_its_finished_stages_and_never_mixes_runs() {
     // The same run killed (SIGKILL) as soon as its first stage is written, then started again.
     let killed = d.join("killed");
     let a = args(killed.to_str().unwrap());
-    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_hpge-cv"))
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .args(&a)
-        .stdout(std::process::Stdio::null())
-        .stderr(std::process::Stdio::null())
-        .spawn()
-        .unwrap();
     let stages = killed.join("stages");
-    let start = std::time::Instant::now();
-    while std::fs::read_dir(&stages).map_or(0, |r| {
-        r.filter(|e| {
-            e.as_ref()
-                .is_ok_and(|e| e.path().extension().is_some_and(|x| x == "json"))
+    kill_when(&a, "a stage", || {
+        std::fs::read_dir(&stages).is_ok_and(|r| {
+            r.filter_map(|e| e.ok())
+                .any(|e| e.path().extension().is_some_and(|x| x == "json"))
         })
-        .count()
-    }) == 0
-    {
-        assert!(start.elapsed().as_secs() < 600, "no stage written");
-        assert!(
-            child.try_wait().unwrap().is_none(),
-            "discover ended before a stage was written"
-        );
-        std::thread::sleep(std::time::Duration::from_millis(50));
-    }
-    child.kill().unwrap();
-    let _ = child.wait();
+    });
     let again = run(&a);
     let err = String::from_utf8_lossy(&again.stderr).to_string();
     assert!(

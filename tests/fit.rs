@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{bad, fails_with, ok, run, temp};
+use common::{bad, fails_with, kill_when, ok, run, temp};
 
 fn fit_args<'a>(out: &'a str, extra: &[&'a str]) -> Vec<&'a str> {
     let mut a = vec![
@@ -277,25 +277,12 @@ fn a_killed_fit_resumes_its_finished_rounds_and_never_mixes_runs() {
     // The same fit killed (SIGKILL) as soon as its first round is written, then started again.
     let killed = d.join("killed");
     let a = args(killed.to_str().unwrap());
-    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_hpge-cv"))
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .args(&a)
-        .stdout(std::process::Stdio::null())
-        .stderr(std::process::Stdio::null())
-        .spawn()
-        .unwrap();
     let first = killed.join("rounds").join("round-0.json");
-    let start = std::time::Instant::now();
-    while !first.exists() {
-        assert!(start.elapsed().as_secs() < 600, "round 0 never written");
-        assert!(
-            child.try_wait().unwrap().is_none(),
-            "the fit ended before round 0 was written"
-        );
-        std::thread::sleep(std::time::Duration::from_millis(50));
-    }
-    child.kill().unwrap();
-    let _ = child.wait();
+    kill_when(
+        &a.iter().map(String::as_str).collect::<Vec<_>>(),
+        "round 0",
+        || first.exists(),
+    );
     let again = run(&a.iter().map(String::as_str).collect::<Vec<_>>());
     let err = String::from_utf8_lossy(&again.stderr).to_string();
     assert!(

@@ -43,3 +43,26 @@ pub fn temp(tag: &str) -> PathBuf {
     std::fs::create_dir_all(&d).unwrap();
     d
 }
+
+/// Starts `hpge-cv ARGS` in the repository root and kills it (SIGKILL) as soon as `written()`
+/// holds (a checkpoint file exists), asserting it does within 600 s and before the run ends.
+pub fn kill_when(args: &[&str], what: &str, written: impl Fn() -> bool) {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_hpge-cv"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .args(args)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let start = std::time::Instant::now();
+    while !written() {
+        assert!(start.elapsed().as_secs() < 600, "{what} never written");
+        assert!(
+            child.try_wait().unwrap().is_none(),
+            "the run ended before {what} was written"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    child.kill().unwrap();
+    let _ = child.wait();
+}

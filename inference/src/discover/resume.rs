@@ -21,6 +21,7 @@ use serde::Serialize;
 use serde::de::DeserializeOwned;
 
 use super::settings::Progress;
+use crate::fit::checkpoint::{folder_files, write_whole};
 use crate::fit::fingerprint;
 use crate::{Error, Result};
 
@@ -79,17 +80,7 @@ impl Stages {
     /// [`Error::Io`] when the folder cannot be made or read, or a stale file cannot be removed.
     pub fn open(out: &Path, fingerprint: String) -> Result<Self> {
         let dir = out.join(STAGES_DIR);
-        std::fs::create_dir_all(&dir).map_err(|source| Error::Io {
-            file: dir.clone(),
-            action: "cannot create the folder",
-            source,
-        })?;
-        let entries = std::fs::read_dir(&dir).map_err(|source| Error::Io {
-            file: dir.clone(),
-            action: "cannot read the folder",
-            source,
-        })?;
-        for f in entries.filter_map(|e| Some(e.ok()?.path())) {
+        for f in folder_files(&dir)? {
             let ours = std::fs::read_to_string(&f)
                 .ok()
                 .and_then(|t| serde_json::from_str::<Saved<serde_json::Value>>(&t).ok())
@@ -142,8 +133,6 @@ impl Stages {
     /// # Errors
     /// [`Error::Io`] naming the file.
     pub fn save<T: Serialize>(&self, name: &str, start: &[Vec<f64>], value: &T) -> Result<()> {
-        let path = self.path(name, start);
-        let tmp = path.with_extension("json.tmp");
         let text = serde_json::to_string(&Saved {
             fingerprint: self.fingerprint.clone(),
             stage: name.to_string(),
@@ -153,13 +142,7 @@ impl Stages {
             what: format!("discover stage {name} as JSON"),
             message: e.to_string(),
         })?;
-        std::fs::write(&tmp, text)
-            .and_then(|()| std::fs::rename(&tmp, &path))
-            .map_err(|source| Error::Io {
-                file: path,
-                action: "cannot write the file",
-                source,
-            })
+        write_whole(&self.path(name, start), &text)
     }
 
     /// The stages taken back so far, in order.

@@ -73,17 +73,7 @@ impl Checkpoint {
     /// [`Error::Io`] when the folder cannot be made or read, or a stale file cannot be removed.
     pub fn open(out: &Path, fingerprint: String) -> Result<(Self, Vec<SavedRound>)> {
         let dir = out.join(ROUNDS_DIR);
-        std::fs::create_dir_all(&dir).map_err(|source| Error::Io {
-            file: dir.clone(),
-            action: "cannot create the folder",
-            source,
-        })?;
-        let entries = std::fs::read_dir(&dir).map_err(|source| Error::Io {
-            file: dir.clone(),
-            action: "cannot read the folder",
-            source,
-        })?;
-        let files: Vec<PathBuf> = entries.filter_map(|e| Some(e.ok()?.path())).collect();
+        let files = folder_files(&dir)?;
         let cp = Self { dir, fingerprint };
         let mut saved = Vec::new();
         while let Ok(text) = std::fs::read_to_string(cp.path(saved.len())) {
@@ -119,18 +109,45 @@ impl Checkpoint {
     /// # Errors
     /// [`Error::Io`] naming the file.
     pub fn save(&self, r: &SavedRound) -> Result<()> {
-        let path = self.path(r.round.round);
-        let tmp = path.with_extension("json.tmp");
         let text = serde_json::to_string(r).map_err(|e| Error::Numerical {
             what: "a refinement round as JSON".into(),
             message: e.to_string(),
         })?;
-        std::fs::write(&tmp, text)
-            .and_then(|()| std::fs::rename(&tmp, &path))
-            .map_err(|source| Error::Io {
-                file: path,
-                action: "cannot write the file",
-                source,
-            })
+        write_whole(&self.path(r.round.round), &text)
     }
+}
+
+/// The files in folder `dir`, which is made first if it does not exist (a checkpoint folder:
+/// `fit`'s rounds, `discover`'s stages).
+///
+/// # Errors
+/// [`Error::Io`] when the folder cannot be made or read.
+pub(crate) fn folder_files(dir: &Path) -> Result<Vec<PathBuf>> {
+    std::fs::create_dir_all(dir).map_err(|source| Error::Io {
+        file: dir.to_path_buf(),
+        action: "cannot create the folder",
+        source,
+    })?;
+    let entries = std::fs::read_dir(dir).map_err(|source| Error::Io {
+        file: dir.to_path_buf(),
+        action: "cannot read the folder",
+        source,
+    })?;
+    Ok(entries.filter_map(|e| Some(e.ok()?.path())).collect())
+}
+
+/// Writes `text` to `path` whole or not at all: to `path.json.tmp` first, then renamed into
+/// place, so a kill never leaves a file cut short under the real name.
+///
+/// # Errors
+/// [`Error::Io`] naming the file.
+pub(crate) fn write_whole(path: &Path, text: &str) -> Result<()> {
+    let tmp = path.with_extension("json.tmp");
+    std::fs::write(&tmp, text)
+        .and_then(|()| std::fs::rename(&tmp, path))
+        .map_err(|source| Error::Io {
+            file: path.to_path_buf(),
+            action: "cannot write the file",
+            source,
+        })
 }

@@ -2,7 +2,7 @@
 //! the posterior predictive, the modes of a multimodal posterior, and the exact-solver check.
 
 mod ascent;
-mod checkpoint;
+pub(crate) mod checkpoint;
 mod exact_check;
 mod job;
 mod options;
