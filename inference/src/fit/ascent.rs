@@ -8,13 +8,14 @@
 //! So a passing check also climbs the exact posterior (Levenberg-Marquardt, [`laplace_fit`] on
 //! the exact solver, a few steps) from the sampler's local modes in other basins (weight at least
 //! [`MIN_ASCENT_WEIGHT`], away from the global mode by more than 1% of a parameter's support and
-//! more than [`AWAY_SD`] posterior sd, best first). It fails when an ascent ends at an exact ln p above the exact ln p at the global
-//! mode by more than [`ASCENT_MARGIN`]: the exact posterior is e^margin times denser there than
-//! at the fit's best point. (An ascent that climbs back into the fitted basin cannot do that
-//! while the check passes: its exact peak then lies within a quarter sd of the fitted mode in
-//! every parameter, which is 0.03 d below it in ln p for a Gaussian.) The ascent's
-//! end and its d finite-difference neighbours (solved anyway, on the end's grids) then teach the
-//! error model, so the next round's corrected surrogate knows that basin.
+//! more than [`AWAY_SD`] posterior sd, best first). It fails when an ascent ends at an exact
+//! ln p above the exact ln p at the global mode by more than [`ASCENT_MARGIN`]: the exact
+//! posterior is e^margin times denser there than at the fit's best point. (An ascent that climbs
+//! back into the fitted basin cannot do that while the check passes: its exact peak then lies
+//! within a quarter sd of the fitted mode in every parameter, which is 0.03 d below it in ln p
+//! for a Gaussian.) The ascent's end and its d finite-difference neighbours (solved anyway, on
+//! the end's grids) then teach the error model, so the next round's corrected surrogate knows
+//! that basin.
 
 use serde::{Deserialize, Serialize};
 
