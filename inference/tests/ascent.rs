@@ -115,7 +115,15 @@ fn an_ascent_finds_the_exact_models_better_basin_the_draws_miss() {
         "{:?}",
         result.samples.local_modes
     );
-    let (ascents, curves) = basin_ascents(&exact, &prior, &likelihood, &result, 2).unwrap();
+    let (ascents, curves) = basin_ascents(&exact, &prior, &likelihood, &result, None, 2).unwrap();
+    // With the mode's exact curve handed in (as the refinement loop does from its check), the
+    // same ascents without solving it again.
+    let mut x_mode = vec![0.0; prior.input_names.len()];
+    prior.expand(&result.mode, &mut x_mode);
+    let mut c_mode = vec![0.0; VOLTS.len()];
+    exact.curve(&x_mode, &mut c_mode).unwrap();
+    let (given, _) = basin_ascents(&exact, &prior, &likelihood, &result, Some(&c_mode), 2).unwrap();
+    assert_eq!(given, ascents);
     // The best ascent ends at the exact model's peak in the upper basin (the one from the
     // lower local mode climbs the exact model's own lower basin, whose shape differs too).
     let b = ascents
@@ -140,7 +148,7 @@ fn an_ascent_finds_the_exact_models_better_basin_the_draws_miss() {
         }
     }
     // The sampled model as its own "exact" model: its basins are where it says; nothing better.
-    let (same, _) = basin_ascents(&surrogate, &prior, &likelihood, &result, 2).unwrap();
+    let (same, _) = basin_ascents(&surrogate, &prior, &likelihood, &result, None, 2).unwrap();
     assert!(
         !same.is_empty() && same.iter().all(|a| !a.better),
         "{same:#?}"

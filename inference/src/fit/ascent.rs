@@ -81,7 +81,8 @@ pub fn away_from_mode(prior: &Prior, mode: &[f64], theta: &[f64]) -> bool {
 /// Ascents of the exact posterior from up to `n` of `result`'s local modes in other basins; the
 /// exact curves at each end and its finite-difference neighbours (inputs x, c) for the error
 /// model. An ascent whose exact solves fail recoverably, or whose Hessian is singular, is left
-/// out.
+/// out. `mode_curve`: the exact curve at `result.mode` when the caller has it (the exact
+/// check's last solved curve), else it is solved here.
 ///
 /// # Errors
 /// A model error other than a recoverable failed solve.
@@ -90,6 +91,7 @@ pub fn basin_ascents(
     prior: &Prior,
     likelihood: &Likelihood,
     result: &Fit,
+    mode_curve: Option<&[f64]>,
     n: usize,
 ) -> Result<(Vec<BasinAscent>, Vec<SolvedCurve>)> {
     let sd: Vec<f64> = result.summary.parameters.iter().map(|p| p.std).collect();
@@ -117,7 +119,11 @@ pub fn basin_ascents(
     }
     let exact_like = likelihood.with_sigma_rel(exact.sigma_rel());
     let posterior = Posterior::new(exact, prior, &exact_like)?;
-    let Some(at_mode) = unless_rejected(posterior.evaluate(&result.mode))? else {
+    let at_mode = match mode_curve {
+        Some(c) => Some(posterior.evaluate_curve(&result.mode, c.to_vec())?),
+        None => unless_rejected(posterior.evaluate(&result.mode))?,
+    };
+    let Some(at_mode) = at_mode else {
         return Ok((Vec::new(), Vec::new()));
     };
     let d = prior.dim();

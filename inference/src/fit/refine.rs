@@ -274,8 +274,22 @@ pub fn refine_fit(
                     // local modes in other basins; a better basin fails it.
                     if chk.pass && check.ascents > 0 {
                         let t_ascent = Instant::now();
-                        let (ascents, curves) =
-                            basin_ascents(m.exact, m.prior, m.likelihood, &result, check.ascents)?;
+                        // The check's last solved curve is the mode's (when it solved).
+                        let mut x_mode = vec![0.0; m.prior.input_names.len()];
+                        m.prior.expand(&result.mode, &mut x_mode);
+                        let mode_curve = chk
+                            .solved
+                            .last()
+                            .filter(|(x, _)| *x == x_mode)
+                            .map(|(_, c)| c.clone());
+                        let (ascents, curves) = basin_ascents(
+                            m.exact,
+                            m.prior,
+                            m.likelihood,
+                            &result,
+                            mode_curve.as_deref(),
+                            check.ascents,
+                        )?;
                         if ascents.iter().any(|a| a.better) {
                             chk.pass = false;
                             chk.solved.extend(curves);

@@ -85,10 +85,24 @@ impl<'a> Posterior<'a> {
     /// posterior is -inf (no model call); a model error (outside its domain, a failed solve) is
     /// returned for the caller to treat as a rejection.
     pub fn evaluate(&self, theta: &[f64]) -> Result<Evaluation> {
+        let mut c_p = vec![0.0; self.likelihood.len()];
+        if !self.prior.ln_density(theta).is_finite() {
+            return self.evaluate_curve(theta, c_p);
+        }
+        let mut x = vec![0.0; self.prior.input_names.len()];
+        self.prior.expand(theta, &mut x);
+        self.model.curve(&x, &mut c_p)?;
+        self.evaluate_curve(theta, c_p)
+    }
+
+    /// [`Posterior::evaluate`] with the model's curve at `theta` already solved (`c_p`, pF):
+    /// ln pi(theta) + ln L(c_p) with the model's per-point variance at theta; no curve solve.
+    ///
+    /// # Errors
+    /// The model's variance fails (as [`CvModel::curve_variance`]).
+    pub fn evaluate_curve(&self, theta: &[f64], c_p: Vec<f64>) -> Result<Evaluation> {
         let lp = self.prior.ln_density(theta);
-        let nv = self.likelihood.len();
-        let mut c_p = vec![0.0; nv];
-        let mut var_rel = vec![self.model.sigma_rel().powi(2); nv];
+        let mut var_rel = vec![self.model.sigma_rel().powi(2); c_p.len()];
         if !lp.is_finite() {
             return Ok(Evaluation {
                 ln_posterior: f64::NEG_INFINITY,
@@ -99,7 +113,6 @@ impl<'a> Posterior<'a> {
         }
         let mut x = vec![0.0; self.prior.input_names.len()];
         self.prior.expand(theta, &mut x);
-        self.model.curve(&x, &mut c_p)?;
         self.model.curve_variance(&x, &mut var_rel, None)?;
         let ll = self
             .likelihood
