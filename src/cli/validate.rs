@@ -4,7 +4,10 @@ use std::io::Write as _;
 
 use anyhow::{Context, Result};
 use hpge_inference::{CvModel, ExactModel};
-use hpge_validation::{CoverageOptions, coverage as run_coverage};
+use hpge_validation::studies::coverage_store::{TruthStore, study_fingerprint};
+use hpge_validation::{
+    CoverageModels, CoverageOptions, CoverageOutcome, CoverageRun, coverage as run_coverage,
+};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use super::fit::setup;
@@ -32,8 +35,14 @@ pub fn coverage(o: &CoverageOptions, as_json: bool) -> Result<()> {
     } else {
         (&s.surrogate, s.surrogate.sigma_rel())
     };
+    let shard = o.shard()?;
+    let store = TruthStore::open(
+        out,
+        study_fingerprint(&s.inputs, o.data_from(), &settings),
+        shard,
+    )?;
     eprintln!(
-        "coverage: {} truths from {}, data from {}, fitted with {} ({} sampler, ESS >= {}), seed {}",
+        "coverage: {} truths from {}, data from {}, fitted with {} ({} sampler, ESS >= {}{}), seed {}{}",
         o.truths,
         o.prior.display(),
         if o.exact {
@@ -44,37 +53,68 @@ pub fn coverage(o: &CoverageOptions, as_json: bool) -> Result<()> {
         s.surrogate.describe(),
         kind.as_str(),
         o.ess,
-        o.seed
+        match &settings.pipeline {
+            Some(p) => format!(
+                "; exact check of {} draws, up to {} rounds of refinement",
+                p.check.draws, p.refine.max_rounds
+            ),
+            None => String::new(),
+        },
+        o.seed,
+        if shard.m > 1 {
+            format!(", shard {}/{}", shard.k, shard.m)
+        } else {
+            String::new()
+        }
     );
-    let bar = ProgressBar::new(o.truths as u64);
+    let bar = ProgressBar::new(0);
     bar.set_style(
         ProgressStyle::with_template("{bar:40} {pos}/{len} truths, {elapsed} elapsed, eta {eta}")
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     let lines = !std::io::IsTerminal::is_terminal(&std::io::stderr());
-    let report = run_coverage(
-        &s.surrogate,
-        data_model,
-        data_sigma,
+    let outcome = run_coverage(
+        CoverageModels {
+            fit: &s.surrogate,
+            data: data_model,
+            data_sigma_rel: data_sigma,
+        },
         &s.prior,
         &s.likelihood,
         &settings,
+        CoverageRun {
+            store: Some(&store),
+            shard,
+        },
         &|done, total| {
+            bar.set_length(total as u64);
             bar.set_position(done as u64);
             if lines && (done % 10 == 0 || done == total) {
-                eprintln!("{done}/{total} truths");
+                eprintln!("{done}/{total} truths of this run");
             }
         },
     )?;
     bar.finish_and_clear();
+    let report = match outcome {
+        CoverageOutcome::Done(r) => r,
+        CoverageOutcome::Partial { done, total } => {
+            println!(
+                "shard {}/{} done; {done} of {total} truths of the study in {}: the report is \
+                 written when every shard has run (run any shard, or the study without --shard, \
+                 again then)",
+                shard.k,
+                shard.m,
+                out.join("truths").display()
+            );
+            return Ok(());
+        }
+    };
     let mut json = serde_json::to_value(&report)?;
     if let Some(obj) = json.as_object_mut() {
         obj.insert("program_version".into(), env!("CARGO_PKG_VERSION").into());
         obj.insert("inputs".into(), serde_json::to_value(&s.inputs)?);
-        obj.insert(
-            "data_from".into(),
-            if o.exact { "exact" } else { "surrogate" }.into(),
-        );
+        obj.insert("data_from".into(), o.data_from().into());
+        obj.insert("shard".into(), o.shard.clone().into());
         obj.insert("settings".into(), serde_json::to_value(settings)?);
         // ranks.csv's provenance (it is a plain table: one header row, no comment lines).
         obj.insert(
@@ -126,17 +166,28 @@ pub fn coverage(o: &CoverageOptions, as_json: bool) -> Result<()> {
             "unconverged": report.unconverged,
             "skipped": report.skipped,
             "seconds": report.seconds,
+            "resumed": report.resumed,
+            "truth_seconds": report.truth_seconds,
+            "exact_check": report.exact_check,
         });
         println!("{brief}");
     } else {
         println!(
-            "{} truths ({} skipped, {} fits unconverged) in {:.0} s: {}",
+            "{} truths ({} skipped, {} fits unconverged, {} taken back from an earlier run) in {:.0} s ({:.0} s of truths' work): {}",
             report.n_truths,
             report.skipped,
             report.unconverged,
+            report.resumed,
             report.seconds,
+            report.truth_seconds,
             if report.pass { "PASS" } else { "FAIL" }
         );
+        if let Some(c) = &report.exact_check {
+            println!(
+                "exact check of the fits: {} passed, {} failed after refinement; {:.2} rounds per fit on average, at most {}",
+                c.passed, c.failed, c.rounds_mean, c.rounds_max
+            );
+        }
         println!(
             "{:<10} {:>8} {:>10} {:>17} {:>10} {:>17}",
             "parameter", "KS p", "cov 68.3%", "99% expected", "cov 95.5%", "99% expected"

@@ -40,6 +40,8 @@ pub use problems::planar::PlanarPn;
 pub use problems::radial1d::{RadialReference, RadialSolution};
 pub use repo::repo_path;
 pub use studies::accuracy::{AccuracyCase, AccuracyRow, accuracy_cases, accuracy_row};
-pub use studies::coverage::{CoverageReport, CoverageSettings, coverage};
+pub use studies::coverage::{
+    CoverageModels, CoverageOutcome, CoverageReport, CoverageRun, CoverageSettings, coverage,
+};
 pub use studies::hidden::{HiddenEffect, HiddenOutcome, hidden_effects, run_hidden};
 pub use studies::options::{CoverageOptions, HiddenOptions};

@@ -21,8 +21,8 @@ use serde::Serialize;
 use serde::de::DeserializeOwned;
 
 use super::settings::Progress;
-use crate::fit::checkpoint::{folder_files, write_whole};
 use crate::fit::fingerprint;
+use crate::fit::{folder_files, write_whole};
 use crate::{Error, Result};
 
 /// The folder inside `discover`'s output folder that holds the finished stages.

@@ -118,11 +118,11 @@ impl Checkpoint {
 }
 
 /// The files in folder `dir`, which is made first if it does not exist (a checkpoint folder:
-/// `fit`'s rounds, `discover`'s stages).
+/// `fit`'s rounds, `discover`'s stages, a coverage study's truths).
 ///
 /// # Errors
 /// [`Error::Io`] when the folder cannot be made or read.
-pub(crate) fn folder_files(dir: &Path) -> Result<Vec<PathBuf>> {
+pub fn folder_files(dir: &Path) -> Result<Vec<PathBuf>> {
     std::fs::create_dir_all(dir).map_err(|source| Error::Io {
         file: dir.to_path_buf(),
         action: "cannot create the folder",
@@ -141,7 +141,7 @@ pub(crate) fn folder_files(dir: &Path) -> Result<Vec<PathBuf>> {
 ///
 /// # Errors
 /// [`Error::Io`] naming the file.
-pub(crate) fn write_whole(path: &Path, text: &str) -> Result<()> {
+pub fn write_whole(path: &Path, text: &str) -> Result<()> {
     let tmp = path.with_extension("json.tmp");
     std::fs::write(&tmp, text)
         .and_then(|()| std::fs::rename(&tmp, path))

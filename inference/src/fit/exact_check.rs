@@ -81,7 +81,7 @@ pub const SHIFT_LIMIT_SD: f64 = 0.25;
 pub const DEFAULT_GRID_CHECK: usize = 4;
 
 /// How the exact-solver check runs.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub struct ExactCheckSettings {
     /// Draws re-weighted (evenly thinned), at least 1.
     pub draws: usize,

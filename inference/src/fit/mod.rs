@@ -2,7 +2,7 @@
 //! the posterior predictive, the modes of a multimodal posterior, and the exact-solver check.
 
 mod ascent;
-pub(crate) mod checkpoint;
+mod checkpoint;
 mod exact_check;
 mod job;
 mod options;
@@ -19,7 +19,10 @@ pub use ascent::{
     ASCENT_MARGIN, AWAY_SD, BasinAscent, DEFAULT_ASCENTS, MIN_ASCENT_WEIGHT, away_from_mode,
     basin_ascents,
 };
-pub use checkpoint::{Checkpoint, FIT_LOCK, ROUNDS_DIR, SavedRound, fingerprint, lock_output};
+pub use checkpoint::{
+    Checkpoint, FIT_LOCK, ROUNDS_DIR, SavedRound, fingerprint, folder_files, lock_output,
+    write_whole,
+};
 pub use exact_check::{
     DEFAULT_GRID_CHECK, ExactCheck, ExactCheckSettings, ExactGrids, GridCheck, K_HAT_LIMIT,
     ParameterShift, SHIFT_LIMIT_SD, add_grid_check, exact_check,

@@ -41,7 +41,7 @@ pub const DEFAULT_REFINE_ROUNDS: usize = 5;
 pub const DEFAULT_HYPER_EVALS: usize = 600;
 
 /// How a fit refines.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct RefineSettings {
     /// Rounds at most, the first (plain surrogate) included; 1: no refinement.
     pub max_rounds: usize,

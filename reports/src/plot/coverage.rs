@@ -466,6 +466,9 @@ mod tests {
             skipped: 0,
             levels,
             seconds: 1.0,
+            resumed: 0,
+            truth_seconds: 2.0,
+            exact_check: None,
         }
     }
 

@@ -4,19 +4,21 @@
 //! is uniform on 0..=L, and the smallest intervals cover theta_i at their nominal rate.
 //!
 //! Data from the surrogate itself test the sampler and the summary; data from the exact solver
-//! (noise without the surrogate term) measure what the surrogate's error does to coverage.
+//! (noise without the surrogate term), fitted by the full pipeline of `fit` (exact check,
+//! ascents, refinement: [`PipelineSettings`]), measure whether what a user gets is calibrated.
+//! Each truth is written as it finishes and a study resumes ([`super::coverage_store`]).
 
 use std::time::Instant;
 
-use hpge_inference::fit::draw_range;
-use hpge_inference::summary::{interval_contains, smallest_intervals};
-use hpge_inference::{CvModel, FitSettings, Likelihood, Posterior, Prior, fit};
-use rand::RngExt;
-use rand::SeedableRng;
-use rand::rngs::StdRng;
+use hpge_inference::fit::{ExactCheckSettings, RefineSettings};
+use hpge_inference::{FitSettings, Likelihood, Prior};
+use hpge_surrogate::Shard;
 use rayon::prelude::*;
 use serde::Serialize;
 
+use super::coverage_store::{TruthCheck, TruthFit, TruthStore};
+pub use super::coverage_truth::CoverageModels;
+use super::coverage_truth::fit_truth;
 use crate::error::Result;
 
 /// Nominal levels of the coverage curve (the 0.683 and 0.955 of the pass test among them).
@@ -33,6 +35,18 @@ pub struct CoverageSettings {
     pub fit: FitSettings,
     /// L: posterior draws each truth is ranked among (evenly thinned).
     pub ranks: usize,
+    /// The full pipeline of `fit` (exact check, ascents, refinement) with these settings, the
+    /// data model as the exact solver; None: the surrogate fit alone.
+    pub pipeline: Option<PipelineSettings>,
+}
+
+/// The exact check and refinement of the full pipeline.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct PipelineSettings {
+    /// The exact check (as `fit`'s defaults: `FitOptions::exact_check`).
+    pub check: ExactCheckSettings,
+    /// The refinement (as `fit`'s: `FitOptions::refine`).
+    pub refine: RefineSettings,
 }
 
 /// One parameter's calibration.
@@ -73,8 +87,29 @@ pub struct CoverageReport {
     pub skipped: usize,
     /// Nominal levels of `coverage_curve`.
     pub levels: Vec<f64>,
-    /// Wall time, s.
+    /// Wall time of this run, s.
     pub seconds: f64,
+    /// Truths of this run's shard taken back from an earlier run (`OUT/truths/`).
+    pub resumed: usize,
+    /// Wall time of every truth's own work added up, s (the study's cost, however it was run).
+    pub truth_seconds: f64,
+    /// With the full pipeline: how the fits' exact checks ended.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub exact_check: Option<CheckTally>,
+}
+
+/// How the exact checks of a study's fits ended (studies with the full pipeline).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct CheckTally {
+    /// Fits whose last exact check passed.
+    pub passed: usize,
+    /// Fits whose check still failed after refinement (`fit` would exit 4 on them; they are in
+    /// the study, as a user with `--allow-exact-mismatch` would see them).
+    pub failed: usize,
+    /// Mean rounds of refinement per fit (1: the plain surrogate passed).
+    pub rounds_mean: f64,
+    /// Most rounds of one fit.
+    pub rounds_max: usize,
 }
 
 /// One-sample Kolmogorov-Smirnov test of `u` (in [0, 1]) against uniform: the asymptotic p-value
@@ -165,112 +200,122 @@ fn ln_gamma(x: f64) -> f64 {
     0.5 * (2.0 * std::f64::consts::PI).ln() + (x + 0.5) * t.ln() - t + a.ln()
 }
 
-/// What one truth contributed.
-struct TruthResult {
-    ranks: Vec<usize>,
-    jitter: Vec<f64>,
-    inside: Vec<Vec<bool>>,
-    converged: bool,
+/// What became of a study's run: the report when every truth is done, else how many are (other
+/// shards still to run).
+#[derive(Debug, Clone, PartialEq)]
+pub enum CoverageOutcome {
+    /// Every truth is done: the study's result.
+    Done(CoverageReport),
+    /// This shard's truths are done, others' not yet.
+    Partial {
+        /// Truths done (by any shard).
+        done: usize,
+        /// Truths of the study.
+        total: usize,
+    },
 }
 
-/// Runs the study: `data_model` simulates the data (with `template`'s noise; pass
-/// `data_sigma_rel` = 0 for exact-solver data, the surrogate's sigma_p for surrogate data; a
-/// `data_model` with a per-point uncertainty then draws its model error with that instead),
-/// `fit_model` is fitted. `progress(done, total)` after each truth.
-#[allow(clippy::too_many_arguments)]
+/// Where a study's truths are kept and which of them this process fits.
+#[derive(Clone, Copy)]
+pub struct CoverageRun<'a> {
+    /// The truths folder (None: nothing written, nothing resumed).
+    pub store: Option<&'a TruthStore>,
+    /// This process's share of the truths.
+    pub shard: Shard,
+}
+
+impl Default for CoverageRun<'_> {
+    fn default() -> Self {
+        Self {
+            store: None,
+            shard: Shard::WHOLE,
+        }
+    }
+}
+
+/// Runs the study (see the module text): `models.data` simulates the data with `template`'s
+/// noise, `models.fit` is fitted (with `settings.pipeline`, by the full pipeline with
+/// `models.data` as the exact solver). With a store, the truths done before are taken back and
+/// each new one is written as it finishes. `progress(done, total)` after each truth of this
+/// shard.
+///
+/// # Errors
+/// A model error other than a failed data curve, a fit that fails, a truth that cannot be
+/// written.
 pub fn coverage(
-    fit_model: &dyn CvModel,
-    data_model: &dyn CvModel,
-    data_sigma_rel: f64,
+    models: CoverageModels,
     prior: &Prior,
     template: &Likelihood,
     settings: &CoverageSettings,
+    run: CoverageRun,
     progress: &(dyn Fn(usize, usize) + Sync),
-) -> Result<CoverageReport> {
+) -> Result<CoverageOutcome> {
     let start = Instant::now();
-    let d = prior.dim();
-    let nv = template.len();
-    let done = std::sync::atomic::AtomicUsize::new(0);
     let n = settings.n_truths;
-    let results: Vec<Result<Option<TruthResult>>> = (0..n)
+    let fingerprint = run.store.map_or("", |s| s.fingerprint());
+    let mine = |i: &usize| *i as u64 % run.shard.m == run.shard.k;
+    let mut done = match run.store {
+        Some(s) => s.load()?,
+        None => Default::default(),
+    };
+    done.retain(|i, _| *i < n);
+    let resumed = done.keys().filter(|i| mine(i)).count();
+    let todo: Vec<usize> = (0..n)
+        .filter(|i| mine(i) && !done.contains_key(i))
+        .collect();
+    let total = resumed + todo.len();
+    let count = std::sync::atomic::AtomicUsize::new(resumed);
+    if resumed > 0 {
+        progress(resumed, total);
+    }
+    let fitted: Vec<Result<TruthFit>> = todo
         .into_par_iter()
         .map(|i| {
-            let mut rng =
-                StdRng::seed_from_u64(settings.seed.wrapping_mul(0x2545_F491_4F6C_DD1D) ^ i as u64);
-            let truth = prior.sample(&mut rng);
-            let mut x = vec![0.0; prior.input_names.len()];
-            prior.expand(&truth, &mut x);
-            let mut c = vec![0.0; nv];
-            let tick = || {
-                progress(
-                    done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1,
-                    n,
-                )
-            };
-            // A truth whose curve fails recoverably is skipped; any other error ends the study.
-            match data_model.curve(&x, &mut c) {
-                Ok(()) => {}
-                Err(e) if e.is_recoverable() => {
-                    tick();
-                    return Ok(None);
-                }
-                Err(e) => return Err(e.into()),
+            let t = fit_truth(i, models, prior, template, settings, fingerprint)?;
+            if let Some(s) = run.store {
+                s.save(&t)?;
             }
-            // Surrogate data with a calibrated per-point uncertainty draws its model error
-            // with sigma_s at the truth, as the likelihood assumes it.
-            let c_m = if data_sigma_rel > 0.0 && data_model.has_point_variance() {
-                let mut var = vec![0.0; nv];
-                data_model.curve_variance(&x, &mut var, None)?;
-                template.simulate_var(&c, &var, &mut rng)
-            } else {
-                template
-                    .with_sigma_rel(data_sigma_rel)
-                    .simulate(&c, &mut rng)
-            };
-            let like = template.with_data(c_m);
-            let posterior = Posterior::new(fit_model, prior, &like)?;
-            let mut fs = settings.fit;
-            fs.sample.seed = settings.seed.wrapping_add(i as u64 + 1);
-            fs.predictive_draws = 10;
-            fs.mode_draws = 200;
-            let f = fit(&posterior, &fs, Default::default(), &|_| {})?;
-            let all = f.samples.all();
-            let l = settings.ranks;
-            let idx: Vec<usize> = (0..l).map(|k| k * all.len() / l).collect();
-            let mut ranks = Vec::with_capacity(d);
-            let mut jitter = Vec::with_capacity(d);
-            let mut inside = Vec::with_capacity(d);
-            for (j, p) in prior.parameters.iter().enumerate() {
-                ranks.push(idx.iter().filter(|&&k| all[k][j] < truth[j]).count());
-                jitter.push(rng.random::<f64>());
-                let draws: Vec<f64> = all.iter().map(|t| t[j]).collect();
-                let range = draw_range(&draws, p.support);
-                let si = smallest_intervals(&draws, None, range, fs.bins, &COVERAGE_LEVELS);
-                inside.push(
-                    si.iter()
-                        .map(|iv| interval_contains(iv, truth[j]))
-                        .collect(),
-                );
-            }
-            tick();
-            Ok(Some(TruthResult {
-                ranks,
-                jitter,
-                inside,
-                converged: f.summary.converged,
-            }))
+            progress(
+                count.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1,
+                total,
+            );
+            Ok(t)
         })
         .collect();
-    let mut kept = Vec::new();
-    let mut skipped = 0;
-    for r in results {
-        match r? {
-            Some(t) => kept.push(t),
-            None => skipped += 1,
+    for t in fitted {
+        let t = t?;
+        done.insert(t.index, t);
+    }
+    // Other shards' truths finished meanwhile.
+    if let Some(s) = run.store {
+        for (i, t) in s.load()? {
+            if i < n {
+                done.entry(i).or_insert(t);
+            }
         }
     }
+    if done.len() < n {
+        return Ok(CoverageOutcome::Partial {
+            done: done.len(),
+            total: n,
+        });
+    }
+    let truths: Vec<&TruthFit> = done.values().collect();
+    let mut report = summarise(&truths, prior, settings.ranks);
+    report.resumed = resumed;
+    report.seconds = start.elapsed().as_secs_f64();
+    Ok(CoverageOutcome::Done(report))
+}
+
+/// The study's statistics over its truths (skipped ones left out).
+fn summarise(truths: &[&TruthFit], prior: &Prior, l: usize) -> CoverageReport {
+    let d = prior.dim();
+    let kept: Vec<&TruthFit> = truths
+        .iter()
+        .copied()
+        .filter(|t| t.skipped.is_none())
+        .collect();
     let m = kept.len();
-    let l = settings.ranks;
     let k683 = COVERAGE_LEVELS
         .iter()
         .position(|&x| x == 0.683)
@@ -309,16 +354,26 @@ pub fn coverage(
             ranks: kept.iter().map(|t| t.ranks[j]).collect(),
         });
     }
-    Ok(CoverageReport {
+    let checks: Vec<&TruthCheck> = kept.iter().filter_map(|t| t.check.as_ref()).collect();
+    let exact_check = (!checks.is_empty()).then(|| CheckTally {
+        passed: checks.iter().filter(|c| c.pass).count(),
+        failed: checks.iter().filter(|c| !c.pass).count(),
+        rounds_mean: checks.iter().map(|c| c.rounds as f64).sum::<f64>() / checks.len() as f64,
+        rounds_max: checks.iter().map(|c| c.rounds).max().unwrap_or(0),
+    });
+    CoverageReport {
         n_truths: m,
         parameters,
         pass,
         ranks: l,
         unconverged: kept.iter().filter(|t| !t.converged).count(),
-        skipped,
+        skipped: truths.len() - m,
         levels: COVERAGE_LEVELS.to_vec(),
-        seconds: start.elapsed().as_secs_f64(),
-    })
+        seconds: 0.0,
+        resumed: 0,
+        truth_seconds: truths.iter().map(|t| t.seconds).sum(),
+        exact_check,
+    }
 }
 
 #[cfg(test)]

@@ -7,13 +7,15 @@ use std::path::PathBuf;
 
 use hpge_inference::discover::WorkflowOptions;
 use hpge_inference::fit::{
-    DEFAULT_DATA, DEFAULT_DETECTOR, DEFAULT_MODEL, DEFAULT_PRIOR, noise_settings, sampler_kind,
+    DEFAULT_DATA, DEFAULT_DETECTOR, DEFAULT_MODEL, DEFAULT_PRIOR, DEFAULT_REFINE_ROUNDS,
+    FitOptions, RefineSettings, noise_settings, sampler_kind,
 };
 use hpge_inference::posterior::{NoiseKind, NoiseSettings};
 use hpge_inference::sampler::{DEFAULT_MODE_STARTS, DEFAULT_SEED};
 use hpge_inference::{DiscoverSettings, FitSettings, SampleSettings, SamplerKind};
+use hpge_surrogate::Shard;
 
-use super::coverage::CoverageSettings;
+use super::coverage::{CoverageSettings, PipelineSettings};
 use crate::error::Result;
 
 /// Target bulk and tail ESS of each fit of a coverage study: ranks among L draws need about L
@@ -72,10 +74,23 @@ pub struct CoverageOptions {
     /// Nelder-Mead starts of each fit's mode search.
     #[cfg_attr(feature = "clap", arg(long, default_value_t = DEFAULT_MODE_STARTS))]
     pub mode_starts: usize,
-    /// Output folder for coverage.json, ranks.csv and the figures
+    /// Output folder for coverage.json, ranks.csv, the figures and truths/ (each fitted truth,
+    /// written as it finishes: the same command again resumes, more --truths extend the study)
     /// [default: reports/coverage/<prior>[-exact]].
     #[cfg_attr(feature = "clap", arg(long, value_name = "DIR"))]
     pub out: Option<PathBuf>,
+    /// With --exact: fit each truth with the surrogate alone, without the exact check and
+    /// refinement of `fit`'s default pipeline (what the surrogate's error does on its own).
+    #[cfg_attr(feature = "clap", arg(long))]
+    pub no_exact_check: bool,
+    /// With --exact: rounds of refinement at most per fit, the first (plain surrogate)
+    /// included, as `fit --refine-rounds`.
+    #[cfg_attr(feature = "clap", arg(long, value_name = "N", default_value_t = DEFAULT_REFINE_ROUNDS))]
+    pub refine_rounds: usize,
+    /// This process's shard K of M: the truths i with i mod M = K (shards of one study share
+    /// --out; whichever finds every truth done writes the report).
+    #[cfg_attr(feature = "clap", arg(long, value_name = "K/M", default_value = "0/1"))]
+    pub shard: String,
 }
 
 impl CoverageOptions {
@@ -95,6 +110,9 @@ impl CoverageOptions {
             ranks: COVERAGE_RANKS,
             mode_starts: DEFAULT_MODE_STARTS,
             out: None,
+            no_exact_check: false,
+            refine_rounds: DEFAULT_REFINE_ROUNDS,
+            shard: "0/1".into(),
         }
     }
 
@@ -139,7 +157,33 @@ impl CoverageOptions {
                 "need at least 9 draws to rank among",
             );
         }
+        if self.refine_rounds == 0 {
+            return bad(
+                "--refine-rounds 0".into(),
+                "need at least 1 round (1: the plain surrogate, checked, not refined)",
+            );
+        }
+        self.shard()?;
         Ok(())
+    }
+
+    /// The shard `--shard` names.
+    ///
+    /// # Errors
+    /// Not K/M with 0 <= K < M.
+    pub fn shard(&self) -> Result<Shard> {
+        Shard::parse(&self.shard).map_err(|e| {
+            hpge_inference::Error::BadOption {
+                option: format!("--shard {}", self.shard),
+                message: e.to_string(),
+            }
+            .into()
+        })
+    }
+
+    /// Where the data come from, as coverage.json says it: `exact` or `surrogate`.
+    pub fn data_from(&self) -> &'static str {
+        if self.exact { "exact" } else { "surrogate" }
     }
 
     /// The noise model named by `likelihood`.
@@ -165,6 +209,7 @@ impl CoverageOptions {
         sample.max_draws = COVERAGE_FIT_MAX_DRAWS;
         sample.mode_starts = self.mode_starts;
         sample.validate()?;
+        let fit_defaults = FitOptions::default();
         Ok(CoverageSettings {
             n_truths: self.truths,
             seed: self.seed,
@@ -174,6 +219,15 @@ impl CoverageOptions {
                 ..FitSettings::default()
             },
             ranks: self.ranks,
+            pipeline: (self.exact && !self.no_exact_check).then(|| PipelineSettings {
+                check: fit_defaults
+                    .exact_check()
+                    .expect("fit's default check settings parse"),
+                refine: RefineSettings {
+                    max_rounds: self.refine_rounds,
+                    ..fit_defaults.refine()
+                },
+            }),
         })
     }
 }

@@ -1,0 +1,176 @@
+//! Nothing lost on interruption for a coverage study (issue 21, items 4 and 5): every fitted
+//! truth is written to `OUT/truths/truth-NNNNN.json` as it finishes. A study started again with
+//! the same arguments takes those truths back and fits only the rest; one with more `--truths`
+//! extends it (truth i depends on the seed and i only, never on how many truths there are).
+//!
+//! A file written with other inputs or settings is removed when the study opens the folder (the
+//! fingerprint in each file says which run wrote it), so two runs never mix; a file cut short by
+//! a kill is never read (each is written to a temporary name and renamed,
+//! [`hpge_inference::fit::write_whole`]).
+//!
+//! A long study (the exact-data one fits each truth with the full pipeline, a few CPU-minutes a
+//! truth) can be split over machines that share the folder: `--shard K/M` fits the truths i with
+//! i mod M = K. Each shard holds its own lock (`OUT/coverage-K-of-M.lock`; one for the whole
+//! study without shards), so one shard never runs twice at once, while different shards run
+//! side by side. Whichever process finds every truth done writes the report.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use hpge_inference::fit::{fingerprint, folder_files, write_whole};
+use hpge_surrogate::Shard;
+use hpge_surrogate::generate::FolderLock;
+use serde::{Deserialize, Serialize};
+
+use super::coverage::CoverageSettings;
+use crate::error::Result;
+
+/// The folder inside a study's output folder that holds its truths.
+pub const TRUTHS_DIR: &str = "truths";
+
+/// What the full pipeline's exact check said about one truth's fit (studies with refinement).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TruthCheck {
+    /// Whether the last round's exact check passed.
+    pub pass: bool,
+    /// Rounds of refinement run (1: the plain surrogate passed or nothing was refined).
+    pub rounds: usize,
+    /// Pareto k-hat of the last round's check.
+    #[serde(deserialize_with = "hpge_inference::fit::f64_or_nan")]
+    pub pareto_k: f64,
+    /// Its largest |mean shift| in posterior sd.
+    #[serde(deserialize_with = "hpge_inference::fit::f64_or_nan")]
+    pub max_abs_shift_sd: f64,
+}
+
+/// One truth of a study as written.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TruthFit {
+    /// Which run wrote it ([`study_fingerprint`]).
+    pub fingerprint: String,
+    /// Its index i (seeds: the truth and noise from (seed, i), the fit seed + i + 1).
+    pub index: usize,
+    /// The truth (the prior's parameters).
+    pub truth: Vec<f64>,
+    /// Why the data model gave no curve there (the truth then takes no part in the study).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub skipped: Option<String>,
+    /// Rank of the truth among the L thinned draws, per parameter.
+    pub ranks: Vec<usize>,
+    /// Uniform jitter of each rank (the KS test's continuous ranks).
+    pub jitter: Vec<f64>,
+    /// Per parameter, whether each level's smallest interval contains the truth.
+    pub inside: Vec<Vec<bool>>,
+    /// Whether the fit reached its R-hat and ESS targets.
+    pub converged: bool,
+    /// The exact check of a study with refinement.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub check: Option<TruthCheck>,
+    /// Wall time of this truth, s.
+    pub seconds: f64,
+}
+
+/// The fingerprint of a study: its inputs (files with their hashes), where its data come from
+/// and its settings without the number of truths (so a study can be extended).
+pub fn study_fingerprint(
+    inputs: &BTreeMap<String, String>,
+    data_from: &str,
+    settings: &CoverageSettings,
+) -> String {
+    let mut parts: Vec<String> = inputs.iter().map(|(k, v)| format!("{k}={v}")).collect();
+    parts.push(format!("data_from={data_from}"));
+    let mut s = serde_json::to_value(settings).unwrap_or_default();
+    if let Some(o) = s.as_object_mut() {
+        o.remove("n_truths");
+    }
+    parts.push(s.to_string());
+    fingerprint(&parts)
+}
+
+/// The truths folder of one study, locked for one shard.
+pub struct TruthStore {
+    dir: PathBuf,
+    fingerprint: String,
+    _lock: FolderLock,
+}
+
+impl TruthStore {
+    /// Takes the lock of `shard` in `out` (which must exist) and opens `out/truths` for the run
+    /// `fingerprint`: files another run wrote are removed.
+    ///
+    /// # Errors
+    /// The shard is running elsewhere (its lock is held), or the folder cannot be made, read or
+    /// cleared.
+    pub fn open(out: &Path, fingerprint: String, shard: Shard) -> Result<Self> {
+        let name = if shard.m == 1 {
+            "coverage.lock".to_string()
+        } else {
+            format!("coverage-{}-of-{}.lock", shard.k, shard.m)
+        };
+        let lock = FolderLock::acquire_named(out, &name).map_err(hpge_inference::Error::from)?;
+        let dir = out.join(TRUTHS_DIR);
+        for f in folder_files(&dir)? {
+            let other = std::fs::read_to_string(&f)
+                .ok()
+                .and_then(|t| serde_json::from_str::<TruthFit>(&t).ok())
+                .is_some_and(|t| t.fingerprint != fingerprint);
+            if other {
+                std::fs::remove_file(&f).map_err(|source| hpge_inference::Error::Io {
+                    file: f.clone(),
+                    action: "cannot remove a file of another run",
+                    source,
+                })?;
+            }
+        }
+        Ok(Self {
+            dir,
+            fingerprint,
+            _lock: lock,
+        })
+    }
+
+    /// The run's fingerprint.
+    pub fn fingerprint(&self) -> &str {
+        &self.fingerprint
+    }
+
+    fn path(&self, index: usize) -> PathBuf {
+        self.dir.join(format!("truth-{index:05}.json"))
+    }
+
+    /// The truths of this run written so far (by any shard), by index; unreadable files and
+    /// those of another run are left out.
+    ///
+    /// # Errors
+    /// The folder cannot be read.
+    pub fn load(&self) -> Result<BTreeMap<usize, TruthFit>> {
+        let mut done = BTreeMap::new();
+        for f in folder_files(&self.dir)? {
+            if f.extension().is_none_or(|e| e != "json") {
+                continue;
+            }
+            let Some(t) = std::fs::read_to_string(&f)
+                .ok()
+                .and_then(|t| serde_json::from_str::<TruthFit>(&t).ok())
+            else {
+                continue;
+            };
+            if t.fingerprint == self.fingerprint && f == self.path(t.index) {
+                done.insert(t.index, t);
+            }
+        }
+        Ok(done)
+    }
+
+    /// Writes a finished truth whole (temporary name, then renamed).
+    ///
+    /// # Errors
+    /// The file cannot be written.
+    pub fn save(&self, t: &TruthFit) -> Result<()> {
+        let text = serde_json::to_string(t).map_err(|e| hpge_inference::Error::Numerical {
+            what: "a coverage truth as JSON".into(),
+            message: e.to_string(),
+        })?;
+        Ok(write_whole(&self.path(t.index), &text)?)
+    }
+}
