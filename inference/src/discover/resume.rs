@@ -22,7 +22,7 @@ use serde::de::DeserializeOwned;
 
 use super::settings::Progress;
 use crate::fit::fingerprint;
-use crate::fit::{folder_files, write_whole};
+use crate::fit::{remove_stale, write_whole};
 use crate::{Error, Result};
 
 /// The folder inside `discover`'s output folder that holds the finished stages.
@@ -80,19 +80,7 @@ impl Stages {
     /// [`Error::Io`] when the folder cannot be made or read, or a stale file cannot be removed.
     pub fn open(out: &Path, fingerprint: String) -> Result<Self> {
         let dir = out.join(STAGES_DIR);
-        for f in folder_files(&dir)? {
-            let ours = std::fs::read_to_string(&f)
-                .ok()
-                .and_then(|t| serde_json::from_str::<Saved<serde_json::Value>>(&t).ok())
-                .is_some_and(|s| s.fingerprint == fingerprint);
-            if !ours {
-                std::fs::remove_file(&f).map_err(|source| Error::Io {
-                    file: f.clone(),
-                    action: "cannot remove a file of another run",
-                    source,
-                })?;
-            }
-        }
+        remove_stale(&dir, |f| f != Some(fingerprint.as_str()))?;
         Ok(Self {
             dir,
             fingerprint,

@@ -136,6 +136,32 @@ pub fn folder_files(dir: &Path) -> Result<Vec<PathBuf>> {
     Ok(entries.filter_map(|e| Some(e.ok()?.path())).collect())
 }
 
+/// Removes the files of checkpoint folder `dir` (made first if missing) whose recorded run is
+/// stale: `stale(fingerprint)` with the file's top-level `fingerprint` field, None for a file
+/// that cannot be read or parsed (cut short, or another program's).
+///
+/// # Errors
+/// [`Error::Io`] when the folder cannot be made or read, or a stale file cannot be removed.
+pub fn remove_stale(dir: &Path, stale: impl Fn(Option<&str>) -> bool) -> Result<()> {
+    #[derive(Deserialize)]
+    struct Recorded {
+        fingerprint: String,
+    }
+    for f in folder_files(dir)? {
+        let recorded = std::fs::read_to_string(&f)
+            .ok()
+            .and_then(|t| serde_json::from_str::<Recorded>(&t).ok());
+        if stale(recorded.as_ref().map(|r| r.fingerprint.as_str())) {
+            std::fs::remove_file(&f).map_err(|source| Error::Io {
+                file: f.clone(),
+                action: "cannot remove a file of another run",
+                source,
+            })?;
+        }
+    }
+    Ok(())
+}
+
 /// Writes `text` to `path` whole or not at all: to `path.json.tmp` first, then renamed into
 /// place, so a kill never leaves a file cut short under the real name.
 ///

@@ -21,7 +21,7 @@ pub use ascent::{
 };
 pub use checkpoint::{
     Checkpoint, FIT_LOCK, ROUNDS_DIR, SavedRound, fingerprint, folder_files, lock_output,
-    write_whole,
+    remove_stale, write_whole,
 };
 pub use exact_check::{
     DEFAULT_GRID_CHECK, ExactCheck, ExactCheckSettings, ExactGrids, GridCheck, K_HAT_LIMIT,

@@ -17,7 +17,7 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use hpge_inference::fit::{fingerprint, folder_files, write_whole};
+use hpge_inference::fit::{fingerprint, folder_files, remove_stale, write_whole};
 use hpge_surrogate::Shard;
 use hpge_surrogate::generate::FolderLock;
 use serde::{Deserialize, Serialize};
@@ -109,19 +109,8 @@ impl TruthStore {
         };
         let lock = FolderLock::acquire_named(out, &name).map_err(hpge_inference::Error::from)?;
         let dir = out.join(TRUTHS_DIR);
-        for f in folder_files(&dir)? {
-            let other = std::fs::read_to_string(&f)
-                .ok()
-                .and_then(|t| serde_json::from_str::<TruthFit>(&t).ok())
-                .is_some_and(|t| t.fingerprint != fingerprint);
-            if other {
-                std::fs::remove_file(&f).map_err(|source| hpge_inference::Error::Io {
-                    file: f.clone(),
-                    action: "cannot remove a file of another run",
-                    source,
-                })?;
-            }
-        }
+        // Only files another run wrote: a shard beside this one may be writing its own.
+        remove_stale(&dir, |f| f.is_some_and(|f| f != fingerprint))?;
         Ok(Self {
             dir,
             fingerprint,
