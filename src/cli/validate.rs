@@ -4,7 +4,7 @@ use std::io::Write as _;
 
 use anyhow::{Context, Result};
 use hpge_inference::{CvModel, ExactModel};
-use hpge_validation::studies::coverage_store::{TruthStore, study_fingerprint};
+use hpge_validation::studies::coverage::store::{TruthStore, study_fingerprint};
 use hpge_validation::{
     CoverageModels, CoverageOptions, CoverageOutcome, CoverageRun, coverage as run_coverage,
 };

@@ -9,7 +9,7 @@ use hpge_inference::sampler::{SampleSettings, SamplerKind};
 use hpge_inference::{CvData, CvModel, Likelihood, NoiseSettings, Prior, PriorSpec, Result};
 use hpge_surrogate::Shard;
 use hpge_validation::studies::coverage::PipelineSettings;
-use hpge_validation::studies::coverage_store::TruthStore;
+use hpge_validation::studies::coverage::store::TruthStore;
 use hpge_validation::{
     CoverageModels, CoverageOutcome, CoverageReport, CoverageRun, CoverageSettings, coverage,
 };

@@ -2,13 +2,11 @@
 //!
 //! - [`accuracy`]: c12 on every shipped detector type against a 4x finer reference.
 //! - [`coverage`]: simulation-based calibration of the fit (rank uniformity, interval coverage);
-//!   [`coverage_store`]: its truths written as they finish (resume, shards).
+//!   [`coverage::store`]: its truths written as they finish (resume, shards).
 //! - [`hidden`]: hidden-effect tests of model discovery.
 //! - [`options`]: the options of the coverage and hidden-effect studies as a user states them.
 
 pub mod accuracy;
 pub mod coverage;
-pub mod coverage_store;
-mod coverage_truth;
 pub mod hidden;
 pub mod options;

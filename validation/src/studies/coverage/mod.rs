@@ -6,48 +6,25 @@
 //! Data from the surrogate itself test the sampler and the summary; data from the exact solver
 //! (noise without the surrogate term), fitted by the full pipeline of `fit` (exact check,
 //! ascents, refinement: [`PipelineSettings`]), measure whether what a user gets is calibrated.
-//! Each truth is written as it finishes and a study resumes ([`super::coverage_store`]).
+//! Each truth is written as it finishes and a study resumes ([`store`]).
 
 use std::time::Instant;
 
-use hpge_inference::fit::{ExactCheckSettings, RefineSettings};
-use hpge_inference::{FitSettings, Likelihood, Prior};
+use hpge_inference::{Likelihood, Prior};
 use hpge_surrogate::Shard;
 use rayon::prelude::*;
 use serde::Serialize;
 
-use super::coverage_store::{TruthCheck, TruthFit, TruthStore};
-pub use super::coverage_truth::CoverageModels;
-use super::coverage_truth::fit_truth;
+mod settings;
+pub mod store;
+mod truth;
+
+pub use settings::{COVERAGE_LEVELS, CoverageSettings, PipelineSettings};
+use store::{TruthCheck, TruthFit, TruthStore};
+pub use truth::CoverageModels;
+use truth::fit_truth;
+
 use crate::error::Result;
-
-/// Nominal levels of the coverage curve (the 0.683 and 0.955 of the pass test among them).
-pub const COVERAGE_LEVELS: [f64; 11] = [0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.683, 0.8, 0.9, 0.955, 0.99];
-
-/// Settings of a study.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct CoverageSettings {
-    /// Number of truths.
-    pub n_truths: usize,
-    /// Seed of the truths and the noise (fit i uses seed + i).
-    pub seed: u64,
-    /// The fit (sampling targets lower than a real fit's: ranks need ~L independent draws).
-    pub fit: FitSettings,
-    /// L: posterior draws each truth is ranked among (evenly thinned).
-    pub ranks: usize,
-    /// The full pipeline of `fit` (exact check, ascents, refinement) with these settings, the
-    /// data model as the exact solver; None: the surrogate fit alone.
-    pub pipeline: Option<PipelineSettings>,
-}
-
-/// The exact check and refinement of the full pipeline.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct PipelineSettings {
-    /// The exact check (as `fit`'s defaults: `FitOptions::exact_check`).
-    pub check: ExactCheckSettings,
-    /// The refinement (as `fit`'s: `FitOptions::refine`).
-    pub refine: RefineSettings,
-}
 
 /// One parameter's calibration.
 #[derive(Debug, Clone, PartialEq, Serialize)]

@@ -12,8 +12,8 @@ use rand::RngExt;
 use rand::SeedableRng;
 use rand::rngs::StdRng;
 
-use super::coverage::{COVERAGE_LEVELS, CoverageSettings};
-use super::coverage_store::{TruthCheck, TruthFit};
+use super::settings::{COVERAGE_LEVELS, CoverageSettings};
+use super::store::{TruthCheck, TruthFit};
 use crate::error::Result;
 
 /// The models of a study.

@@ -22,7 +22,7 @@ use hpge_surrogate::Shard;
 use hpge_surrogate::generate::FolderLock;
 use serde::{Deserialize, Serialize};
 
-use super::coverage::CoverageSettings;
+use super::settings::CoverageSettings;
 use crate::error::Result;
 
 /// The folder inside a study's output folder that holds its truths.
