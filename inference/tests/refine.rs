@@ -170,12 +170,7 @@ fn refinement_turns_a_failing_exact_check_into_a_passing_one() {
             ..RefineSettings::default()
         },
         &Default::default(),
-        RefineProgress {
-            sampling: &|_| {},
-            sampled: &|_| {},
-            exact: &|_, _| {},
-            round: &|_| {},
-        },
+        RefineProgress::quiet(),
         None,
     )
     .unwrap();

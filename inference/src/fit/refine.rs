@@ -137,6 +137,18 @@ pub struct RefineProgress<'a> {
     pub round: &'a (dyn Fn(&RefineRound) + Sync),
 }
 
+impl RefineProgress<'static> {
+    /// Reports nothing (a fit inside a study, a test).
+    pub fn quiet() -> Self {
+        RefineProgress {
+            sampling: &|_| {},
+            sampled: &|_| {},
+            exact: &|_, _| {},
+            round: &|_| {},
+        }
+    }
+}
+
 /// Rounds a previous run of the same fit finished, and where this run writes its own
 /// ([`Checkpoint`]).
 pub struct Resume<'a> {

@@ -85,14 +85,7 @@ impl<'a> Posterior<'a> {
     /// posterior is -inf (no model call); a model error (outside its domain, a failed solve) is
     /// returned for the caller to treat as a rejection.
     pub fn evaluate(&self, theta: &[f64]) -> Result<Evaluation> {
-        let mut c_p = vec![0.0; self.likelihood.len()];
-        if !self.prior.ln_density(theta).is_finite() {
-            return self.evaluate_curve(theta, c_p);
-        }
-        let mut x = vec![0.0; self.prior.input_names.len()];
-        self.prior.expand(theta, &mut x);
-        self.model.curve(&x, &mut c_p)?;
-        self.evaluate_curve(theta, c_p)
+        self.evaluate_with(theta, None)
     }
 
     /// [`Posterior::evaluate`] with the model's curve at `theta` already solved (`c_p`, pF):
@@ -101,18 +94,32 @@ impl<'a> Posterior<'a> {
     /// # Errors
     /// The model's variance fails (as [`CvModel::curve_variance`]).
     pub fn evaluate_curve(&self, theta: &[f64], c_p: Vec<f64>) -> Result<Evaluation> {
+        self.evaluate_with(theta, Some(c_p))
+    }
+
+    /// ln pi + ln L at `theta`, the curve solved by the model unless given.
+    fn evaluate_with(&self, theta: &[f64], given: Option<Vec<f64>>) -> Result<Evaluation> {
         let lp = self.prior.ln_density(theta);
-        let mut var_rel = vec![self.model.sigma_rel().powi(2); c_p.len()];
+        let nv = self.likelihood.len();
+        let mut var_rel = vec![self.model.sigma_rel().powi(2); nv];
         if !lp.is_finite() {
             return Ok(Evaluation {
                 ln_posterior: f64::NEG_INFINITY,
                 ln_likelihood: f64::NEG_INFINITY,
-                c_p,
+                c_p: given.unwrap_or_else(|| vec![0.0; nv]),
                 var_rel,
             });
         }
         let mut x = vec![0.0; self.prior.input_names.len()];
         self.prior.expand(theta, &mut x);
+        let c_p = match given {
+            Some(c) => c,
+            None => {
+                let mut c = vec![0.0; nv];
+                self.model.curve(&x, &mut c)?;
+                c
+            }
+        };
         self.model.curve_variance(&x, &mut var_rel, None)?;
         let ll = self
             .likelihood

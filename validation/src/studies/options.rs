@@ -210,6 +210,17 @@ impl CoverageOptions {
         sample.mode_starts = self.mode_starts;
         sample.validate()?;
         let fit_defaults = FitOptions::default();
+        let pipeline = if self.exact && !self.no_exact_check {
+            Some(PipelineSettings {
+                check: fit_defaults.exact_check()?,
+                refine: RefineSettings {
+                    max_rounds: self.refine_rounds,
+                    ..fit_defaults.refine()
+                },
+            })
+        } else {
+            None
+        };
         Ok(CoverageSettings {
             n_truths: self.truths,
             seed: self.seed,
@@ -219,15 +230,7 @@ impl CoverageOptions {
                 ..FitSettings::default()
             },
             ranks: self.ranks,
-            pipeline: (self.exact && !self.no_exact_check).then(|| PipelineSettings {
-                check: fit_defaults
-                    .exact_check()
-                    .expect("fit's default check settings parse"),
-                refine: RefineSettings {
-                    max_rounds: self.refine_rounds,
-                    ..fit_defaults.refine()
-                },
-            }),
+            pipeline,
         })
     }
 }

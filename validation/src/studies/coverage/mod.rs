@@ -201,15 +201,6 @@ pub struct CoverageRun<'a> {
     pub shard: Shard,
 }
 
-impl Default for CoverageRun<'_> {
-    fn default() -> Self {
-        Self {
-            store: None,
-            shard: Shard::WHOLE,
-        }
-    }
-}
-
 /// Runs the study (see the module text): `models.data` simulates the data with `template`'s
 /// noise, `models.fit` is fitted (with `settings.pipeline`, by the full pipeline with
 /// `models.data` as the exact solver). With a store, the truths done before are taken back and

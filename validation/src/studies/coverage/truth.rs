@@ -4,8 +4,7 @@
 
 use std::time::Instant;
 
-use hpge_inference::fit::{RefineInputs, RefineProgress, RefineRound, draw_range, refine_fit};
-use hpge_inference::sampler::Status;
+use hpge_inference::fit::{RefineInputs, RefineProgress, draw_range, refine_fit};
 use hpge_inference::summary::{interval_contains, smallest_intervals};
 use hpge_inference::{CvModel, Likelihood, Posterior, Prior, fit};
 use rand::RngExt;
@@ -49,7 +48,6 @@ pub(super) fn fit_truth(
     fingerprint: &str,
 ) -> Result<TruthFit> {
     let start = Instant::now();
-    let d = prior.dim();
     let nv = template.len();
     let mut rng = StdRng::seed_from_u64(truth_seed(settings.seed, i));
     let truth = prior.sample(&mut rng);
@@ -103,19 +101,13 @@ pub(super) fn fit_truth(
                 prior,
                 likelihood: &like,
             };
-            let quiet = RefineProgress {
-                sampling: &|_: &Status| {},
-                sampled: &|_: usize| {},
-                exact: &|_: usize, _: usize| {},
-                round: &|_: &RefineRound| {},
-            };
             let r = refine_fit(
                 m,
                 &fs,
                 &p.check,
                 &p.refine,
                 &Default::default(),
-                quiet,
+                RefineProgress::quiet(),
                 None,
             )?;
             record.check = r.fit.summary.exact_check.as_ref().map(|c| TruthCheck {
@@ -144,7 +136,6 @@ pub(super) fn fit_truth(
                 .collect(),
         );
     }
-    debug_assert_eq!(record.ranks.len(), d);
     record.converged = f.summary.converged;
     record.seconds = start.elapsed().as_secs_f64();
     Ok(record)
