@@ -7,9 +7,9 @@
 
 use hpge_solver::drift::Carrier;
 use hpge_solver::field::{
-    Termination, deepest_depression_v, deepest_empty_depression_v, solve_fast,
+    MAX_POCKET_ROUNDS, Termination, deepest_depression_v, deepest_empty_depression_v, solve_fast,
 };
-use hpge_solver::{FieldSettings, solve_potential};
+use hpge_solver::{FieldSettings, solve_point, solve_potential};
 use hpge_surrogate::{ExactSolver, ParameterSpace, Sequence, SequenceKind};
 use hpge_validation::repo_path;
 use rayon::prelude::*;
@@ -168,4 +168,54 @@ fn touching_hole_and_electron_pockets_settle() {
             .count();
     }
     assert!(cycles > 0, "the cycle's path is exercised");
+}
+
+/// Held-out row 104700 (d_Li 4.69 mm, a p-type layer along the mantle at the bottom, 453 V): on
+/// the finest adaptive grid the pocket rounds wandered between sets of 5500-6200 tied nodes
+/// without repeating (depressions of 0-30 mV, i.e. below 1e-4 of the bias) until the round
+/// limit, and the row failed with "the fast solver did not converge after 40 iterations". The
+/// round limit now takes the round with the shallowest depression, as a cycle does. Checked
+/// against the same point's neighbours in bias (`generate` on a space narrowed to this point,
+/// U_B in 400..500 V, release build): 47.821 pF at 450 V and 47.623 pF at 453.302 V, which
+/// interpolate to 47.666 pF here.
+#[test]
+fn heldout_row_104700_pocket_rounds_end_at_their_limit() {
+    let ex = exact();
+    let x = [
+        4.692463238257915,
+        0.3104060481161192,
+        0.24099344414518484,
+        -0.7698111665667966,
+        0.9825297390052583,
+        0.4270291273229341,
+        0.3968656598026557,
+        -0.5250409222935559,
+        0.13532040476275142,
+        452.5792311924306,
+    ];
+    let det = ex.detector(&x[..9]).unwrap();
+    let p =
+        solve_point(&det, x[9], &ex.settings, None).unwrap_or_else(|e| panic!("row 104700: {e}"));
+    let limited: Vec<_> = p
+        .reports
+        .iter()
+        .filter(|r| r.termination == Termination::PocketRoundLimit)
+        .collect();
+    assert!(!limited.is_empty(), "the round limit's path is exercised");
+    for r in &limited {
+        assert_eq!(r.pocket_rounds, MAX_POCKET_ROUNDS);
+        assert!(r.residual_v <= 1e-4 * x[9], "depth {} V", r.residual_v);
+    }
+    let s = &p.potential;
+    for side in [Carrier::Hole, Carrier::Electron] {
+        let (empty, _) =
+            deepest_empty_depression_v(&p.mesh, &s.phi_v, &s.undepleted, side, s.bounds_v);
+        assert!(empty <= 1e-4 * x[9], "{side:?} empty well {empty} V");
+    }
+    let interpolated = 47.821 + (47.623 - 47.821) * (x[9] - 450.0) / (453.302 - 450.0);
+    assert!(
+        (p.c12_pf / interpolated - 1.0).abs() < 0.005,
+        "c12 = {} pF against {interpolated} pF from the neighbouring biases",
+        p.c12_pf
+    );
 }

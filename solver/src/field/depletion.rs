@@ -283,34 +283,22 @@ pub(crate) fn solve_with_band_steps(
             continue;
         }
         history.push((std::mem::take(&mut ties), x, state.clone()));
-        if let Some(first) = history.iter().position(|(t, _, _)| *t == next) {
-            // The floods cycle: a hole and an electron pocket touching at a p-n junction inside
-            // the crystal have two pour points of (nearly) the same level, and each round's
-            // flood picks the other one. Measured on the paper's space (e.g. a p-type mantle
-            // layer under a thin n-type skin), one round of such a cycle is flat to round-off
-            // (depth 4e-14 V) while the other leaves a few mV. Take the round with the
-            // shallowest depression, the same whatever the cycle's entry point; a cycle with
-            // no empty well below the tolerance is an error (a full one is a junction's reverse
-            // bias, see `deepest_empty_depression_v`).
-            let undepleted = |st: &[Bound]| -> Vec<bool> {
-                (0..mesh.kind.len())
-                    .map(|k| {
-                        sys.node_unknown[k].is_some_and(|u| bounded[u] && st[u] != Bound::Free)
-                    })
-                    .collect()
-            };
-            let (k, (depth, _)) = (first..history.len())
-                .map(|k| {
-                    let (_, x, st) = &history[k];
-                    let d = depression_depths_v(mesh, &sys.to_nodes(x), &undepleted(st), (lo, hi));
-                    (k, d)
-                })
-                .min_by(|a, b| {
-                    (a.1.0.total_cmp(&b.1.0))
-                        .then(a.1.1.total_cmp(&b.1.1))
-                        .then(a.0.cmp(&b.0))
-                })
-                .unwrap_or((first, (f64::INFINITY, f64::INFINITY)));
+        // The floods cycle: a hole and an electron pocket touching at a p-n junction inside
+        // the crystal have two pour points of (nearly) the same level, and each round's flood
+        // picks the other one. Measured on the paper's space (e.g. a p-type mantle layer under
+        // a thin n-type skin), one round of such a cycle is flat to round-off (depth 4e-14 V)
+        // while the other leaves a few mV. Take the round with the shallowest depression, the
+        // same whatever the cycle's entry point; a cycle with no empty well below the tolerance
+        // is an error (a full one is a junction's reverse bias, see
+        // `deepest_empty_depression_v`). Where the floods wander without repeating until the
+        // round limit (a large pocket whose pour points move by a few cells from round to
+        // round: held-out index 104700, d_Li 4.69 mm at 453 V, 40 rounds of 5500-6200 tied
+        // nodes with depressions of 0-30 mV), the same rule over all the rounds gives the
+        // answer.
+        let cycle_start = history.iter().position(|(t, _, _)| *t == next);
+        if cycle_start.is_some() || rounds >= MAX_POCKET_ROUNDS {
+            let first = cycle_start.unwrap_or(0);
+            let (k, depth) = shallowest_round(mesh, &sys, &bounded, (lo, hi), &history, first);
             if depth > POCKET_CYCLE_TOL * span {
                 return Err(Error::NotConverged {
                     method: Method::Fast.as_str(),
@@ -320,16 +308,13 @@ pub(crate) fn solve_with_band_steps(
             }
             let (t, x, st) = history.swap_remove(k);
             ties = t;
-            termination = Termination::PocketCycle;
+            termination = if cycle_start.is_some() {
+                Termination::PocketCycle
+            } else {
+                Termination::PocketRoundLimit
+            };
             cycle_depth_v = depth;
             break (x, st);
-        }
-        if rounds >= MAX_POCKET_ROUNDS {
-            return Err(Error::NotConverged {
-                method: Method::Fast.as_str(),
-                iterations: rounds,
-                residual_v: f64::NAN,
-            });
         }
         ties = next;
         prev_phi = Some(phi);
@@ -359,6 +344,37 @@ pub(crate) fn solve_with_band_steps(
             seconds: start.elapsed().as_secs_f64(),
         },
     })
+}
+
+/// The round of `history[first..]` (each a round's ties, solution and active set) whose
+/// potential has the shallowest depression: the smallest deepest empty well, then the smallest
+/// deepest well of either carrier, then the earliest (`pockets::depression_depths_v`, V).
+/// Returns its index and its empty well's depth.
+fn shallowest_round(
+    mesh: &Mesh,
+    sys: &System,
+    bounded: &[bool],
+    bounds_v: (f64, f64),
+    history: &[(Ties, Vec<f64>, Vec<Bound>)],
+    first: usize,
+) -> (usize, f64) {
+    let undepleted = |st: &[Bound]| -> Vec<bool> {
+        (0..mesh.kind.len())
+            .map(|k| sys.node_unknown[k].is_some_and(|u| bounded[u] && st[u] != Bound::Free))
+            .collect()
+    };
+    (first..history.len())
+        .map(|k| {
+            let (_, x, st) = &history[k];
+            let d = depression_depths_v(mesh, &sys.to_nodes(x), &undepleted(st), bounds_v);
+            (k, d)
+        })
+        .min_by(|a, b| {
+            (a.1.0.total_cmp(&b.1.0))
+                .then(a.1.1.total_cmp(&b.1.1))
+                .then(a.0.cmp(&b.0))
+        })
+        .map_or((first, f64::INFINITY), |(k, (depth, _))| (k, depth))
 }
 
 /// max_u |x_u - P(x_u - g_u / A_uu)| in V, g = A x - f, P the projection onto each unknown's

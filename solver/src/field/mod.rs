@@ -30,7 +30,7 @@ pub use capacitance::CapacitanceMatrix;
 pub use charge::{contact_charge_c, quasi_static_c12_pf};
 pub use convergence::{ConvergenceRow, convergence_study};
 pub use curve::{Continuation, CvCurve, CvPoint, cv_curve, cv_curve_with, normalise_voltages};
-pub use depletion::{PotentialSolution, solve_fast, solve_fast_with};
+pub use depletion::{MAX_POCKET_ROUNDS, PotentialSolution, solve_fast, solve_fast_with};
 pub use full_depletion::full_depletion_voltage;
 pub use mesh::{Mesh, NodeKind};
 pub use near::{NearCurves, NearEach, cv_curves_near, cv_curves_near_each};

@@ -61,6 +61,10 @@ pub enum Termination {
     /// junction inside the crystal): the round of the cycle with the shallowest remaining
     /// depression is the answer, its depth in `residual_v`.
     PocketCycle,
+    /// The pocket rounds reached `MAX_POCKET_ROUNDS` without repeating (the floods of a large
+    /// pocket wandering between nearly equal sets of ties): the round with the shallowest
+    /// remaining depression is the answer, as for a cycle, its depth in `residual_v`.
+    PocketRoundLimit,
 }
 
 /// Report of one solve.
