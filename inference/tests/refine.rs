@@ -236,3 +236,99 @@ fn refinement_turns_a_failing_exact_check_into_a_passing_one() {
         "the surrogate's posterior is only {worst:.2} sd off"
     );
 }
+
+/// A model that cannot describe the data (as B_Z cannot the shipped curve: chi^2 about 5 per
+/// degree of freedom at the exact optimum): the data are the exact curve at a = 1.2, b = 0.8
+/// with a 15% ripple no (a, b) reproduces (chi^2 above 3 per point at the exact optimum).
+fn misfit_data(exact: &Exact) -> CvData {
+    let mut c = vec![0.0; VOLTS.len()];
+    exact.curve(&[1.2, 0.8], &mut c).unwrap();
+    let c12_pf: Vec<f64> = c
+        .iter()
+        .zip(VOLTS)
+        .map(|(v, u)| v * (1.0 + 0.15 * (u / 60.0).sin()))
+        .collect();
+    CvData {
+        voltage_v: VOLTS.to_vec(),
+        sigma_pf: c12_pf.iter().map(|v| 0.01 * v).collect(),
+        c12_pf,
+        covariance_pf2: None,
+        source: "toy-misfit.csv".into(),
+    }
+}
+
+/// With a misfitting model the refined rounds take the error model's variance at the best exact
+/// curve (`RefineVariance::Best`, the default): the loop still ends with a passing check whose
+/// posterior is the exact model's, and each refined round records where its variance came from.
+#[test]
+fn a_misfitting_model_refines_to_the_exact_posterior() {
+    let (exact, surrogate) = (Exact, Surrogate);
+    let prior = prior(&exact);
+    let data = misfit_data(&exact);
+    let likelihood =
+        Likelihood::new(&data, NoiseSettings::default(), surrogate.sigma_rel()).unwrap();
+    let check = ExactCheckSettings {
+        draws: 100,
+        grids: ExactGrids::Own,
+        grid_check: 0,
+        ascents: 0,
+    };
+    let refined = refine_fit(
+        RefineInputs {
+            surrogate: &surrogate,
+            exact: &exact,
+            prior: &prior,
+            likelihood: &likelihood,
+        },
+        &settings(1),
+        &check,
+        &RefineSettings {
+            max_rounds: 4,
+            ..RefineSettings::default()
+        },
+        &Default::default(),
+        RefineProgress::quiet(),
+        None,
+    )
+    .unwrap();
+    let rounds = &refined.rounds;
+    assert!(
+        !rounds[0].pass && rounds[0].variance_at.is_none(),
+        "{rounds:?}"
+    );
+    assert!(rounds.last().unwrap().pass, "{rounds:?}");
+    assert!(
+        rounds[1..].iter().all(|r| r.variance_at.is_some()),
+        "{rounds:?}"
+    );
+    let exact_like = likelihood.with_sigma_rel(0.0);
+    let posterior = Posterior::new(&exact, &prior, &exact_like).unwrap();
+    let direct = fit(&posterior, &settings(2), Default::default(), &|_| {}).unwrap();
+    let chi2 = exact_like.chi2(&{
+        let mut c = vec![0.0; VOLTS.len()];
+        exact.curve(&direct.mode, &mut c).unwrap();
+        c
+    });
+    assert!(
+        chi2 > 3.0 * VOLTS.len() as f64,
+        "the model must misfit: chi^2 {chi2}"
+    );
+    for (r, e) in refined
+        .fit
+        .summary
+        .parameters
+        .iter()
+        .zip(&direct.summary.parameters)
+    {
+        let shift = (r.mean - e.mean) / e.std;
+        assert!(
+            shift.abs() <= 2.0 * SHIFT_LIMIT_SD && (r.std / e.std - 1.0).abs() < 0.3,
+            "{}: refined {:.4} +- {:.4}, exact {:.4} +- {:.4}",
+            r.name,
+            r.mean,
+            r.std,
+            e.mean,
+            e.std
+        );
+    }
+}

@@ -701,7 +701,7 @@ fn fit<'py>(
                 job.run_refined(
                     &settings,
                     &o.exact_check()?,
-                    &o.refine(),
+                    &o.refine()?,
                     hpge_inference::fit::RefineProgress {
                         sampling: &sampling,
                         sampled: &|_| {},

@@ -36,7 +36,7 @@ pub use predictive::thin_indices;
 pub use predictive::{Predictive, predictive};
 pub use refine::{
     DEFAULT_HYPER_EVALS, DEFAULT_REFINE_ROUNDS, MAX_LOCAL_MODE_CURVES, RefineInputs,
-    RefineProgress, RefineSettings, RefinedFit, Resume, refine_fit,
+    RefineProgress, RefineSettings, RefineVariance, RefinedFit, Resume, refine_fit,
 };
 pub use round::{RefineRound, f64_or_nan};
 pub use run::{Fit, FitSettings, draw_range, fit};

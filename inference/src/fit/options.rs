@@ -9,7 +9,7 @@ use hpge_solver::GridOverrides;
 use super::ascent::DEFAULT_ASCENTS;
 use super::exact_check::{DEFAULT_GRID_CHECK, ExactCheckSettings, ExactGrids};
 use super::job::FitFiles;
-use super::refine::{DEFAULT_REFINE_ROUNDS, RefineSettings};
+use super::refine::{DEFAULT_REFINE_ROUNDS, RefineSettings, RefineVariance};
 use super::run::FitSettings;
 use crate::posterior::{NoiseKind, NoiseSettings};
 use crate::sampler::{
@@ -97,6 +97,12 @@ pub struct FitOptions {
     /// surrogate, whose uncertainty enters the likelihood point by point (1: no refinement).
     #[cfg_attr(feature = "clap", arg(long, default_value_t = DEFAULT_REFINE_ROUNDS))]
     pub refine_rounds: usize,
+    /// Point variance of a refined round's corrected surrogate: best (the error model's
+    /// variance at the exact curve of highest exact likelihood so far, the same at every input)
+    /// or local (its variance at each input: wider where no exact curve taught it, which a
+    /// model that misfits the data runs to).
+    #[cfg_attr(feature = "clap", arg(long, default_value = RefineVariance::default().as_str()))]
+    pub refine_variance: String,
     /// Exit with 0 even when the exact-solver check fails after refinement (otherwise exit
     /// code 4).
     #[cfg_attr(feature = "clap", arg(long))]
@@ -154,6 +160,7 @@ impl Default for FitOptions {
             exact_grid_check: DEFAULT_GRID_CHECK,
             exact_ascents: DEFAULT_ASCENTS,
             refine_rounds: DEFAULT_REFINE_ROUNDS,
+            refine_variance: RefineVariance::default().as_str().into(),
             allow_exact_mismatch: false,
             likelihood: NoiseKind::default().as_str().into(),
             constant_sigma: false,
@@ -224,12 +231,16 @@ impl FitOptions {
         })
     }
 
-    /// The refinement's settings (`--refine-rounds`).
-    pub fn refine(&self) -> RefineSettings {
-        RefineSettings {
+    /// The refinement's settings (`--refine-rounds`, `--refine-variance`).
+    ///
+    /// # Errors
+    /// [`Error::BadOption`] for an unknown `--refine-variance`.
+    pub fn refine(&self) -> Result<RefineSettings> {
+        Ok(RefineSettings {
             max_rounds: self.refine_rounds,
+            variance: RefineVariance::parse(&self.refine_variance)?,
             ..RefineSettings::default()
-        }
+        })
     }
 
     /// Checks the numbers a user gives, naming the flag: `--max-seconds` and `--ess` must be
@@ -242,6 +253,7 @@ impl FitOptions {
         self.sampler_kind()?;
         self.noise()?;
         self.exact_check()?;
+        self.refine()?;
         if self.chains < 2 {
             return Err(Error::BadOption {
                 option: format!("--chains {}", self.chains),

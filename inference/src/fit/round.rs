@@ -55,4 +55,9 @@ pub struct RefineRound {
     /// ([`crate::fit::basin_ascents`]); absent when none did or none ran.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub better_basin: Option<super::BasinAscent>,
+    /// The model inputs of the exact curve whose error-model variance was this round's point
+    /// variance at every input (`--refine-variance best`, rounds after the first); absent
+    /// otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub variance_at: Option<Vec<f64>>,
 }

@@ -13,6 +13,9 @@ pub struct CorrectedModel<'a> {
     gp: GpCorrection,
     sigma_centre: f64,
     describe: String,
+    /// The error model's variance at one reference point, used at every input (see
+    /// [`CorrectedModel::variance_fixed_at`]); None: its variance at each input.
+    fixed_var: Option<Vec<f64>>,
 }
 
 impl<'a> CorrectedModel<'a> {
@@ -46,7 +49,15 @@ impl<'a> CorrectedModel<'a> {
             gp,
             sigma_centre,
             describe,
+            fixed_var: None,
         })
+    }
+
+    /// This model with the error model's variance at `x_ref` as every input's point variance
+    /// (var_k(x) = var_k(x_ref), zero derivatives).
+    pub fn variance_fixed_at(mut self, x_ref: &[f64]) -> Self {
+        self.fixed_var = Some(self.gp.predict(x_ref, false).var);
+        self
     }
 
     /// The error model.
@@ -117,6 +128,13 @@ impl CvModel for CorrectedModel<'_> {
         var_rel: &mut [f64],
         jac: Option<&mut [f64]>,
     ) -> Result<()> {
+        if let Some(v) = &self.fixed_var {
+            var_rel.copy_from_slice(v);
+            if let Some(j) = jac {
+                j.fill(0.0);
+            }
+            return Ok(());
+        }
         let p = self.gp.predict(x, jac.is_some());
         var_rel.copy_from_slice(&p.var);
         if let (Some(j), Some(dv)) = (jac, p.d_var) {

@@ -173,3 +173,29 @@ fn posterior_gradient_with_a_per_point_variance_matches_finite_differences() {
     let ev = post.evaluate(&theta).unwrap();
     assert!((ev.ln_likelihood - like.ln_likelihood(&ev.c_p, None)).abs() > 1e-6);
 }
+
+#[test]
+fn a_variance_fixed_at_a_reference_is_that_point_variance_everywhere() {
+    let x_ref = [1.1, 1.0];
+    let local = corrected();
+    let fixed = corrected().variance_fixed_at(&x_ref);
+    assert!(fixed.has_point_variance());
+    let at_ref = local.correction().predict(&x_ref, false).var;
+    for x in [[1.3, 0.9], [0.2, 1.9], [3.0, -1.0]] {
+        let mut v = vec![0.0; 5];
+        let mut jv = vec![1.0; 10];
+        fixed.curve_variance(&x, &mut v, Some(&mut jv)).unwrap();
+        assert_eq!(v, at_ref, "at {x:?}");
+        assert!(jv.iter().all(|&d| d == 0.0));
+        // The mean correction still varies with the input.
+        let (mut a, mut b) = (vec![0.0; 5], vec![0.0; 5]);
+        fixed.curve(&x, &mut a).unwrap();
+        local.curve(&x, &mut b).unwrap();
+        assert_eq!(a, b);
+    }
+    // Far from the exact curves the local variance grows (the misfit there costs less); the
+    // fixed one does not.
+    let mut far = vec![0.0; 5];
+    local.curve_variance(&[3.0, -1.0], &mut far, None).unwrap();
+    assert!(far.iter().zip(&at_ref).all(|(f, r)| f > r));
+}

@@ -87,7 +87,7 @@ pub fn run_fit(o: &FitOptions, observer: &dyn FitObserver) -> Result<FitRun> {
         observer.sampling_done();
         (fit, None)
     } else {
-        let (check, refine) = (o.exact_check()?, o.refine());
+        let (check, refine) = (o.exact_check()?, o.refine()?);
         // Rounds an interrupted run of the same fit finished (OUT/rounds/), taken back.
         let (checkpoint, saved) =
             Checkpoint::open(&out, job.fingerprint(&settings, &check, &refine))?;

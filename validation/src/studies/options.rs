@@ -215,7 +215,7 @@ impl CoverageOptions {
                 check: fit_defaults.exact_check()?,
                 refine: RefineSettings {
                     max_rounds: self.refine_rounds,
-                    ..fit_defaults.refine()
+                    ..fit_defaults.refine()?
                 },
             })
         } else {
