@@ -7,7 +7,7 @@ use std::path::Path;
 
 use hpge_inference::fit::{
     ExactCheckSettings, ExactGrids, FitSettings, RefineInputs, RefineProgress, RefineSettings,
-    SHIFT_LIMIT_SD, fit, refine_fit,
+    RefinedFit, SHIFT_LIMIT_SD, fit, refine_fit,
 };
 use hpge_inference::sampler::{SampleSettings, SamplerKind};
 use hpge_inference::{
@@ -124,6 +124,35 @@ fn settings(seed: u64) -> FitSettings {
     }
 }
 
+/// Up to four rounds of refinement of the toy surrogate against the closed form, each check on
+/// 100 draws solved on their own (closed-form) curves, no ascents.
+fn refined(prior: &Prior, likelihood: &Likelihood) -> RefinedFit {
+    let check = ExactCheckSettings {
+        draws: 100,
+        grids: ExactGrids::Own,
+        grid_check: 0,
+        ascents: 0,
+    };
+    refine_fit(
+        RefineInputs {
+            surrogate: &Surrogate,
+            exact: &Exact,
+            prior,
+            likelihood,
+        },
+        &settings(1),
+        &check,
+        &RefineSettings {
+            max_rounds: 4,
+            ..RefineSettings::default()
+        },
+        &Default::default(),
+        RefineProgress::quiet(),
+        None,
+    )
+    .unwrap()
+}
+
 #[test]
 fn refinement_turns_a_failing_exact_check_into_a_passing_one() {
     let (exact, surrogate) = (Exact, Surrogate);
@@ -150,30 +179,7 @@ fn refinement_turns_a_failing_exact_check_into_a_passing_one() {
     };
     let likelihood =
         Likelihood::new(&data, NoiseSettings::default(), surrogate.sigma_rel()).unwrap();
-    let check = ExactCheckSettings {
-        draws: 100,
-        grids: ExactGrids::Own,
-        grid_check: 0,
-        ascents: 0,
-    };
-    let refined = refine_fit(
-        RefineInputs {
-            surrogate: &surrogate,
-            exact: &exact,
-            prior: &prior,
-            likelihood: &likelihood,
-        },
-        &settings(1),
-        &check,
-        &RefineSettings {
-            max_rounds: 4,
-            ..RefineSettings::default()
-        },
-        &Default::default(),
-        RefineProgress::quiet(),
-        None,
-    )
-    .unwrap();
+    let refined = refined(&prior, &likelihood);
     let rounds = &refined.rounds;
     eprintln!("{rounds:#?}");
     assert!(
@@ -267,30 +273,7 @@ fn a_misfitting_model_refines_to_the_exact_posterior() {
     let data = misfit_data(&exact);
     let likelihood =
         Likelihood::new(&data, NoiseSettings::default(), surrogate.sigma_rel()).unwrap();
-    let check = ExactCheckSettings {
-        draws: 100,
-        grids: ExactGrids::Own,
-        grid_check: 0,
-        ascents: 0,
-    };
-    let refined = refine_fit(
-        RefineInputs {
-            surrogate: &surrogate,
-            exact: &exact,
-            prior: &prior,
-            likelihood: &likelihood,
-        },
-        &settings(1),
-        &check,
-        &RefineSettings {
-            max_rounds: 4,
-            ..RefineSettings::default()
-        },
-        &Default::default(),
-        RefineProgress::quiet(),
-        None,
-    )
-    .unwrap();
+    let refined = refined(&prior, &likelihood);
     let rounds = &refined.rounds;
     assert!(
         !rounds[0].pass && rounds[0].variance_at.is_none(),
