@@ -9,6 +9,7 @@ mod options;
 pub mod outputs;
 mod predictive;
 mod refine;
+mod refine_settings;
 mod round;
 mod run;
 mod summary;
