@@ -320,9 +320,7 @@ pub(crate) fn solve_with_band_steps(
         prev_phi = Some(phi);
     };
     let phi_v = sys.to_nodes(&x);
-    let undepleted: Vec<bool> = (0..mesh.kind.len())
-        .map(|k| sys.node_unknown[k].is_some_and(|u| bounded[u] && state[u] != Bound::Free))
-        .collect();
+    let undepleted = undepleted_nodes(mesh, &sys, &bounded, &state);
     let residual_v = tied_residual(&sys, &x, &bounded, (lo, hi), &ties).max(cycle_depth_v);
     let pockets = find_pockets(mesh, &phi_v, &undepleted);
     // Only worth keeping where a later round changed the answer.
@@ -346,6 +344,13 @@ pub(crate) fn solve_with_band_steps(
     })
 }
 
+/// The undepleted nodes of active set `state`: semiconductor unknowns at a bound (per mesh node).
+fn undepleted_nodes(mesh: &Mesh, sys: &System, bounded: &[bool], state: &[Bound]) -> Vec<bool> {
+    (0..mesh.kind.len())
+        .map(|k| sys.node_unknown[k].is_some_and(|u| bounded[u] && state[u] != Bound::Free))
+        .collect()
+}
+
 /// The round of `history[first..]` (each a round's ties, solution and active set) whose
 /// potential has the shallowest depression: the smallest deepest empty well, then the smallest
 /// deepest well of either carrier, then the earliest (`pockets::depression_depths_v`, V).
@@ -358,15 +363,11 @@ fn shallowest_round(
     history: &[(Ties, Vec<f64>, Vec<Bound>)],
     first: usize,
 ) -> (usize, f64) {
-    let undepleted = |st: &[Bound]| -> Vec<bool> {
-        (0..mesh.kind.len())
-            .map(|k| sys.node_unknown[k].is_some_and(|u| bounded[u] && st[u] != Bound::Free))
-            .collect()
-    };
     (first..history.len())
         .map(|k| {
             let (_, x, st) = &history[k];
-            let d = depression_depths_v(mesh, &sys.to_nodes(x), &undepleted(st), bounds_v);
+            let undepleted = undepleted_nodes(mesh, sys, bounded, st);
+            let d = depression_depths_v(mesh, &sys.to_nodes(x), &undepleted, bounds_v);
             (k, d)
         })
         .min_by(|a, b| {
