@@ -230,3 +230,53 @@ fn bad_input_is_a_clear_error() {
     assert!(String::from_utf8_lossy(&o.stderr).contains("/proc/hpge-cv-cannot-write"));
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// The B_Z slice: four sampled dimensions written in the full space's ten columns, every knot of
+/// a face at its face's value, and the rows read by `train`'s reader for the full space.
+#[test]
+fn the_bz_slice_writes_the_full_spaces_columns_with_tied_knots() {
+    let out = temp("slice");
+    let o = run(&[
+        "generate",
+        "--space",
+        "spaces/super-siegfried-bz-slice.toml",
+        "--detector",
+        "detectors/super-siegfried-k1.toml",
+        "--n",
+        "3",
+        "--offset",
+        "1000000",
+        "--grid",
+        "adaptive=false",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = std::fs::read_to_string(out.join("rows.csv")).unwrap();
+    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let mut n = 0;
+    for line in text.lines().skip(1) {
+        let f: Vec<&str> = line.split(',').collect();
+        assert_eq!(f[col("status")], "ok", "{line}");
+        for face in ["bot", "top"] {
+            for k in 2..=4 {
+                assert_eq!(
+                    f[col(&format!("y{k}_{face}"))],
+                    f[col(&format!("y1_{face}"))]
+                );
+            }
+        }
+        n += 1;
+    }
+    assert_eq!(n, 3);
+    let space = hpge_surrogate::ParameterSpace::from_file(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("spaces/super-siegfried-rz.toml"),
+    )
+    .unwrap();
+    let set = hpge_surrogate::DataSet::read(&out.join("rows.csv"), &space).unwrap();
+    let mut index = set.index.clone();
+    index.sort();
+    assert_eq!(index, vec![1000000, 1000001, 1000002]);
+    let _ = std::fs::remove_dir_all(&out);
+}

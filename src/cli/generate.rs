@@ -24,7 +24,8 @@ pub fn generate(o: &GenerateOptions) -> Result<()> {
         o.n,
         o.shard,
     )?
-    .with_curve_points(o.curve_points)?;
+    .with_curve_points(o.curve_points)?
+    .with_retry_failed(o.retry_failed);
     let bar = ProgressBar::new(0);
     bar.set_style(
         ProgressStyle::with_template(
@@ -42,6 +43,12 @@ pub fn generate(o: &GenerateOptions) -> Result<()> {
     let seconds = start.elapsed().as_secs_f64();
     if report.repaired {
         eprintln!("note: cut off a torn last line left by an interrupted run");
+    }
+    if report.retried > 0 {
+        eprintln!(
+            "note: solved again {} rows that had failed before (--retry-failed)",
+            report.retried
+        );
     }
     for (i, status) in &report.failed {
         eprintln!("sample {i}: {status}");

@@ -26,8 +26,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let p = solve_point(&det, bias, &ex.settings, None)?;
     for r in &p.reports {
         println!(
-            "  pass: {} iterations, {} factorisations, {} pocket rounds, {:.3} s",
-            r.iterations, r.factorisations, r.pocket_rounds, r.seconds
+            "  pass: {} iterations, {} factorisations, {} pocket rounds ({} with fixed levels), {:?}, {:.3} s",
+            r.iterations,
+            r.factorisations,
+            r.pocket_rounds,
+            r.fixed_level_rounds,
+            r.termination,
+            r.seconds
         );
     }
     // The independent checks: the deepest depression of each carrier's landscape, and of

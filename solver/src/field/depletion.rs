@@ -225,6 +225,7 @@ pub(crate) fn solve_with_band_steps(
     let mut termination = Termination::ActiveSetStationary;
     let mut cycle_depth_v = 0.0;
     let mut untied: Option<Vec<f64>> = None;
+    let mut fixed_level_rounds = 0;
     let (x, state) = loop {
         rounds += 1;
         let ctx = Round {
@@ -234,7 +235,9 @@ pub(crate) fn solve_with_band_steps(
             ties: pocket_ties(&sys, &ties, prev_phi.as_deref()),
             band_steps,
         };
-        let (x, fell_back) = ctx.solve(&sym, &mut factor, &mut state, &mut iterations)?;
+        let end = ctx.solve(&sym, &mut factor, &mut state, &mut iterations)?;
+        let (x, fell_back) = (end.x, end.fell_back);
+        fixed_level_rounds += usize::from(end.fixed_levels);
         let phi = sys.to_nodes(&x);
         if rounds == 1 {
             untied = Some(phi.clone());
@@ -338,6 +341,7 @@ pub(crate) fn solve_with_band_steps(
             residual_v,
             termination,
             pocket_rounds: rounds,
+            fixed_level_rounds,
             factorisations: factor.as_ref().map_or(0, |f| f.factorisations),
             seconds: start.elapsed().as_secs_f64(),
         },

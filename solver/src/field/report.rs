@@ -86,6 +86,11 @@ pub struct SolveReport {
     /// pocket formed. A work counter of the `fast` method; 0 in reports written before it.
     #[serde(default)]
     pub pocket_rounds: usize,
+    /// Pocket rounds whose active sets cycled, so that the round held every pocket level at
+    /// the previous round's pour-point value (`field::round`): a work counter of the `fast`
+    /// method, 0 almost always.
+    #[serde(default)]
+    pub fixed_level_rounds: usize,
     /// Numeric sparse Cholesky factorisations (`fast`): at most `iterations`, fewer where a
     /// pocket round starts from the active set the previous one ended on. 0 for `sor`.
     #[serde(default)]

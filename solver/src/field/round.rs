@@ -74,6 +74,16 @@ pub(super) fn pocket_ties(sys: &System, ties: &Ties, prev_phi: Option<&[f64]>) -
     (member, pockets)
 }
 
+/// How a round ended.
+pub(super) struct RoundEnd {
+    /// The unknowns at the stationary active set, V.
+    pub(super) x: Vec<f64>,
+    /// Some pocket levels are the fallback (the previous round's pour points), not solved.
+    pub(super) fell_back: bool,
+    /// The active sets cycled, so every level was held at its fallback from then on.
+    pub(super) fixed_levels: bool,
+}
+
 /// One round: the active-set iteration with fixed ties.
 pub(super) struct Round<'a> {
     pub(super) sys: &'a System,
@@ -108,13 +118,16 @@ impl Round<'_> {
         factor: &mut Option<Factored>,
         state: &mut [Bound],
         iterations: &mut usize,
-    ) -> Result<(Vec<f64>, bool)> {
+    ) -> Result<RoundEnd> {
         let sys = self.sys;
         let n = sys.n;
         let (lo, hi) = self.bounds;
         let (member, pockets) = &self.ties;
         let mut local = 0;
         let mut fell_back = false;
+        // Active sets of the plain steps so far, and whether the levels are held fixed (below).
+        let mut seen: Vec<Vec<Bound>> = Vec::new();
+        let mut fixed_levels = false;
         let mut val = sys.val.clone();
         loop {
             *iterations += 1;
@@ -228,9 +241,15 @@ impl Round<'_> {
             // Singular when pockets pour into each other (a hole and an electron pocket at a p-n
             // junction): their levels then stay where the last flood found them, and the next
             // flood decides.
-            let lv = dense_solve(a, b, m).unwrap_or_else(|| {
+            let fallback = || act.iter().map(|&p| pockets[p].fallback_v).collect();
+            let solved = if fixed_levels {
+                None
+            } else {
+                dense_solve(a, b, m)
+            };
+            let lv: Vec<f64> = solved.unwrap_or_else(|| {
                 fell_back = true;
-                act.iter().map(|&p| pockets[p].fallback_v).collect()
+                fallback()
             });
             let mut x = x0;
             for (y, l) in ys.iter().zip(&lv) {
@@ -274,7 +293,11 @@ impl Round<'_> {
                 };
             }
             if next == state {
-                return Ok((x, fell_back));
+                return Ok(RoundEnd {
+                    x,
+                    fell_back,
+                    fixed_levels,
+                });
             }
             // Early on, let the front move as far as the band's local solve says (`band.rs`;
             // tied unknowns bounded by the present levels); later, plain steps.
@@ -282,6 +305,22 @@ impl Round<'_> {
                 let proposed = self.band_step(&x, &next, &levels);
                 if proposed != state {
                     next = proposed;
+                }
+            } else if !fixed_levels {
+                // A plain step's next active set is a function of the present one, so a repeat
+                // is a cycle that never ends. Measured on the paper's space (training index
+                // 34554: d_Li 2.27 mm, a p-type layer under the mantle's skin, 20.1 V; four
+                // pockets), the cycle passes through an active set whose levels' system is
+                // singular (pockets pouring into each other), so the levels jump between their
+                // solved values and the fallback. The round then holds every level at its
+                // fallback: with fixed bounds the problem is the plain obstacle problem with an
+                // M-matrix, whose iteration converges (Hintermueller et al. 2003), and the
+                // rounds' fixed-point iteration on the levels (`depletion.rs`) settles them.
+                if seen.contains(&next) {
+                    fixed_levels = true;
+                    seen.clear();
+                } else {
+                    seen.push(state.to_vec());
                 }
             }
             state.copy_from_slice(&next);

@@ -54,6 +54,8 @@ pub struct RunReport {
     pub failed: Vec<(u64, String)>,
     /// A torn last line was cut off.
     pub repaired: bool,
+    /// Failed rows from before dropped to be solved again (`Generator::retry_failed`).
+    pub retried: usize,
 }
 
 /// One row as CSV (no newline): floats in Rust's shortest round-trip form.
@@ -203,13 +205,23 @@ pub fn run(
         (Vec::new(), false)
     };
     let mut done: HashSet<u64> = existing.iter().map(|r| r.0).collect();
+    // With `retry_failed`, the rows whose solve failed (status other than `ok`).
+    let status_column = info.header.split(',').position(|h| h == "status");
+    let failed_before: HashSet<u64> = existing
+        .iter()
+        .filter(|_| g.retry_failed)
+        .filter(|(_, line)| status_column.and_then(|c| line.split(',').nth(c)) != Some("ok"))
+        .map(|r| r.0)
+        .collect();
     // Curve mode writes a point's rows in one write, so only a cut-off last write leaves a
-    // point with some of its rows: those are removed and the point solved again.
+    // point with some of its rows: those are removed and the point solved again, as are the
+    // points with a failed row under `retry_failed`.
     let partial: Vec<u64> = g
         .units()
         .filter(|&p| {
             let have = g.rows_of(p).filter(|i| done.contains(i)).count();
-            have > 0 && (have as u64) < g.curve_points()
+            (have > 0 && (have as u64) < g.curve_points())
+                || g.rows_of(p).any(|i| failed_before.contains(&i))
         })
         .collect();
     let mut repaired = repaired;
@@ -226,7 +238,9 @@ pub fn run(
         std::fs::write(&tmp, text).map_err(io(&tmp, "cannot write"))?;
         std::fs::rename(&tmp, &rows_path).map_err(io(&rows_path, "cannot replace"))?;
         done.retain(|i| !drop.contains(i));
-        repaired = true;
+        repaired |= partial
+            .iter()
+            .any(|&p| !g.rows_of(p).any(|i| failed_before.contains(&i)));
     }
     let mut file = OpenOptions::new()
         .create(true)
@@ -299,6 +313,7 @@ pub fn run(
         total,
         failed,
         repaired,
+        retried: failed_before.len(),
     })
 }
 

@@ -113,6 +113,9 @@ pub struct Generator {
     pub fingerprint: Fingerprint,
     /// The space's points solved with the exact solver.
     pub exact: ExactSolver,
+    /// On resume, solve again the points whose rows failed (`--retry-failed`; not part of the
+    /// fingerprint: a retry adds rows of the same run, e.g. after a solver fix).
+    pub retry_failed: bool,
 }
 
 /// The outcome of one sample.
@@ -155,7 +158,7 @@ impl Generator {
                 "the number of samples must be at least 1".into(),
             ));
         }
-        let sequence = Sequence::new(kind, space.dim(), seed);
+        let sequence = Sequence::new(kind, space.sampled_dim(), seed);
         if offset
             .checked_add(n)
             .is_none_or(|end| end > sequence.max_points())
@@ -201,8 +204,16 @@ impl Generator {
             shard,
             fingerprint,
             exact,
+            retry_failed: false,
         };
         Ok(g)
+    }
+
+    /// On resume, drop the rows whose solve failed and solve their points again (see
+    /// [`Generator::retry_failed`]).
+    pub fn with_retry_failed(mut self, on: bool) -> Self {
+        self.retry_failed = on;
+        self
     }
 
     /// Curve mode: every quasi-random parameter point gets `k` rows, its own set of `k` biases
@@ -282,13 +293,17 @@ impl Generator {
             return vec![self.sample(p)];
         };
         let start = std::time::Instant::now();
-        let u0 = self.sequence.point(p);
+        let v0 = self.sequence.point(p);
+        // The bias's place among the sampled dimensions (a bias is never `same_as`).
+        let bs = self.space.dimensions[..b]
+            .iter()
+            .filter(|d| d.same_as.is_none())
+            .count();
         let rows: Vec<(Vec<f64>, Vec<f64>)> = (0..k)
             .map(|j| {
-                let mut u = u0.clone();
-                u[b] = (j as f64 + u0[b]) / k as f64;
-                let x = self.space.from_unit(&u);
-                (u, x)
+                let mut v = v0.clone();
+                v[bs] = (j as f64 + v0[bs]) / k as f64;
+                self.space.from_sampled_unit(&v)
             })
             .collect();
         let params: Vec<f64> = rows[0]
@@ -347,8 +362,7 @@ impl Generator {
     /// the reason in `status`, not an error.
     pub fn sample(&self, index: u64) -> Sample {
         let start = std::time::Instant::now();
-        let u = self.sequence.point(index);
-        let x = self.space.from_unit(&u);
+        let (u, x) = self.space.from_sampled_unit(&self.sequence.point(index));
         let result = self.exact.solve(&x);
         let (c12_pf, status) = match result {
             Ok(c) => (c, "ok".to_string()),

@@ -128,3 +128,51 @@ fn a_point_cut_off_mid_curve_is_solved_again_without_duplicates() {
     assert_eq!(sorted(&now), sorted(&full));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn retry_failed_solves_failed_rows_again_and_keeps_the_others() {
+    let dir = std::env::temp_dir().join(format!("hpge-retry-failed-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let g = generator(3, 1);
+    run(&g, &dir, Some(1), |_, _| {}).unwrap();
+    let rows_path = dir.join("rows.csv");
+    let full = std::fs::read_to_string(&rows_path).unwrap();
+    // Row 1 as a failed solve would have written it: NaN c12 and the reason.
+    let failed_line = |l: &str| {
+        let f: Vec<&str> = l.split(',').collect();
+        let n = f.len();
+        let mut g: Vec<String> = f.iter().map(|s| s.to_string()).collect();
+        g[n - 3] = "NaN".into();
+        g[n - 2] = "failed: the fast solver did not converge".into();
+        g.join(",")
+    };
+    let hurt: Vec<String> = full
+        .lines()
+        .map(|l| {
+            if l.starts_with("1,") {
+                failed_line(l)
+            } else {
+                l.to_string()
+            }
+        })
+        .collect();
+    std::fs::write(&rows_path, hurt.join("\n") + "\n").unwrap();
+    // A plain resume keeps the failed row.
+    let plain = run(&g, &dir, Some(1), |_, _| {}).unwrap();
+    assert_eq!((plain.written, plain.retried), (0, 0));
+    // With the retry, row 1 is solved again; the others are untouched.
+    let retry = run(&g.with_retry_failed(true), &dir, Some(1), |_, _| {}).unwrap();
+    assert_eq!((retry.resumed, retry.written, retry.retried), (2, 1, 1));
+    assert!(!retry.repaired);
+    let now = std::fs::read_to_string(&rows_path).unwrap();
+    let without_seconds = |t: &str| {
+        let mut v: Vec<String> = t
+            .lines()
+            .map(|l| l[..l.rfind(',').unwrap()].to_string())
+            .collect();
+        v.sort();
+        v
+    };
+    assert_eq!(without_seconds(&now), without_seconds(&full));
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -56,6 +56,10 @@ pub struct GenerateOptions {
     /// and must be multiples of K). 1: every row its own point.
     #[cfg_attr(feature = "clap", arg(long, value_name = "K", default_value_t = 1))]
     pub curve_points: u64,
+    /// On resume, solve again the samples whose rows say the solve failed (e.g. after a solver
+    /// fix); the other rows are kept.
+    #[cfg_attr(feature = "clap", arg(long))]
+    pub retry_failed: bool,
     /// The exact solver's grid and accuracy.
     #[cfg_attr(feature = "clap", command(flatten))]
     pub grid: GridOverrides,

@@ -69,6 +69,11 @@ pub struct Dimension {
     pub distribution: Distribution,
     /// Where it enters the simulation: `bias`, `parameter:NAME`, `y_bot[K]`, `y_top[K]`.
     pub target: String,
+    /// The name of an earlier dimension whose physical value this one takes instead of being
+    /// sampled: a slice of a space that keeps the full space's columns (e.g. the B_Z slice of
+    /// the rz space, every knot of a face at one value, `spaces/super-siegfried-bz-slice.toml`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub same_as: Option<String>,
 }
 
 /// A parameter space.
@@ -185,8 +190,78 @@ impl ParameterSpace {
             if self.dimensions[..k].iter().any(|e| e.target == d.target) {
                 return Err(bad(k, "target", format!("`{}` appears twice", d.target)));
             }
+            if let Some(name) = &d.same_as {
+                if Target::parse(&d.target) == Some(Target::Bias) {
+                    return Err(bad(
+                        k,
+                        "same_as",
+                        "the bias is always sampled (a C-V curve runs along it)".into(),
+                    ));
+                }
+                let Some(src) = self.dimensions[..k].iter().find(|e| &e.name == name) else {
+                    return Err(bad(
+                        k,
+                        "same_as",
+                        format!("`{name}` is not the name of an earlier dimension"),
+                    ));
+                };
+                if src.same_as.is_some() {
+                    return Err(bad(
+                        k,
+                        "same_as",
+                        format!(
+                            "`{name}` takes its value from another dimension itself; name that one"
+                        ),
+                    ));
+                }
+                let [slo, shi] = src.range;
+                if slo < lo || shi > hi {
+                    return Err(bad(
+                        k,
+                        "range",
+                        format!(
+                            "[{lo}, {hi}] does not hold the range [{slo}, {shi}] of `{name}`, whose values it takes"
+                        ),
+                    ));
+                }
+            }
         }
         Ok(())
+    }
+
+    /// Number of sampled dimensions (those without `same_as`): the dimension of the sequence
+    /// a run draws from.
+    pub fn sampled_dim(&self) -> usize {
+        self.dimensions
+            .iter()
+            .filter(|d| d.same_as.is_none())
+            .count()
+    }
+
+    /// Unit-cube and physical coordinates of every dimension from those of the sampled ones
+    /// (`v`, in column order): a sampled dimension maps v as [`Self::from_unit`]; one with
+    /// `same_as` takes the physical value of its source, and u = `to_unit` of it in its own
+    /// range. Without `same_as` anywhere, (v, from_unit(v)).
+    pub fn from_sampled_unit(&self, v: &[f64]) -> (Vec<f64>, Vec<f64>) {
+        let mut next = v.iter();
+        let mut u = Vec::with_capacity(self.dim());
+        let mut x: Vec<f64> = Vec::with_capacity(self.dim());
+        for d in &self.dimensions {
+            let (ud, xd) = match &d.same_as {
+                None => {
+                    let ud = next.next().copied().unwrap_or(0.5);
+                    (ud, map_from_unit(d, ud))
+                }
+                Some(name) => {
+                    let j = self.dimensions.iter().position(|e| &e.name == name);
+                    let xd = j.map_or(f64::NAN, |j| x[j]);
+                    (map_to_unit(d, xd), xd)
+                }
+            };
+            u.push(ud);
+            x.push(xd);
+        }
+        (u, x)
     }
 
     /// Number of dimensions d.
@@ -208,13 +283,7 @@ impl ParameterSpace {
         self.dimensions
             .iter()
             .zip(u)
-            .map(|(d, &u)| {
-                let [lo, hi] = d.range;
-                match d.distribution {
-                    Distribution::Uniform => lo + u * (hi - lo),
-                    Distribution::LogUniform => lo * (hi / lo).powf(u),
-                }
-            })
+            .map(|(d, &u)| map_from_unit(d, u))
             .collect()
     }
 
@@ -223,13 +292,7 @@ impl ParameterSpace {
         self.dimensions
             .iter()
             .zip(x)
-            .map(|(d, &x)| {
-                let [lo, hi] = d.range;
-                match d.distribution {
-                    Distribution::Uniform => (x - lo) / (hi - lo),
-                    Distribution::LogUniform => (x / lo).ln() / (hi / lo).ln(),
-                }
-            })
+            .map(|(d, &x)| map_to_unit(d, x))
             .collect()
     }
 
@@ -241,5 +304,23 @@ impl ParameterSpace {
     /// Unit-cube coordinates u = Phi(z) of standard-normal ones.
     pub fn normal_to_unit(z: &[f64]) -> Vec<f64> {
         z.iter().map(|&z| normal_cdf(z)).collect()
+    }
+}
+
+/// x = lo + u (hi - lo), or lo (hi / lo)^u for log-uniform.
+fn map_from_unit(d: &Dimension, u: f64) -> f64 {
+    let [lo, hi] = d.range;
+    match d.distribution {
+        Distribution::Uniform => lo + u * (hi - lo),
+        Distribution::LogUniform => lo * (hi / lo).powf(u),
+    }
+}
+
+/// The inverse of [`map_from_unit`].
+fn map_to_unit(d: &Dimension, x: f64) -> f64 {
+    let [lo, hi] = d.range;
+    match d.distribution {
+        Distribution::Uniform => (x - lo) / (hi - lo),
+        Distribution::LogUniform => (x / lo).ln() / (hi / lo).ln(),
     }
 }

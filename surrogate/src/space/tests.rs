@@ -82,3 +82,71 @@ proptest! {
         prop_assert!((normal_cdf(a) + normal_cdf(-a) - 1.0).abs() < 1e-15);
     }
 }
+
+#[test]
+fn the_bz_slice_keeps_the_full_spaces_columns_and_ties_each_face() {
+    let full = shipped();
+    let slice = ParameterSpace::from_file(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("../spaces/super-siegfried-bz-slice.toml"),
+    )
+    .unwrap();
+    assert_eq!((slice.dim(), slice.sampled_dim()), (10, 4));
+    assert_eq!(full.sampled_dim(), 10);
+    let names = |s: &ParameterSpace| -> Vec<String> {
+        s.dimensions.iter().map(|d| d.name.clone()).collect()
+    };
+    assert_eq!(names(&slice), names(&full));
+    assert_eq!(slice.targets(), full.targets());
+    let (u, x) = slice.from_sampled_unit(&[0.25, 0.5, 0.75, 0.1]);
+    assert_eq!(x[0], 0.2 + 0.25 * 4.8);
+    for k in 1..5 {
+        assert_eq!(x[k], x[1], "bottom knot {k}");
+        assert_eq!(x[k + 4], x[5], "top knot {k}");
+    }
+    assert_eq!(x[9], 10.0 + 0.1 * 2990.0);
+    // The unit coordinates are those of the full space at the same physical point.
+    let u_full = full.to_unit(&x);
+    for (a, b) in u.iter().zip(&u_full) {
+        assert!((a - b).abs() < 1e-15, "{a} vs {b}");
+    }
+    // Without ties, the sampled map is from_unit.
+    let v = [0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 0.05];
+    assert_eq!(full.from_sampled_unit(&v), (v.to_vec(), full.from_unit(&v)));
+}
+
+#[test]
+fn same_as_errors_name_the_key() {
+    let two = |extra: &str, range_b: &str, target_b: &str| {
+        format!(
+            "name = \"x\"\n[[dimensions]]\nname = \"a\"\nunit = \"1\"\nrange = [0.1, 0.5]\ntarget = \"y_bot[0]\"\n\
+             [[dimensions]]\nname = \"b\"\nunit = \"1\"\nrange = {range_b}\ntarget = \"{target_b}\"\n{extra}"
+        )
+    };
+    let err = |t: String| {
+        ParameterSpace::from_toml_str(&t, Path::new("s.toml"))
+            .unwrap_err()
+            .to_string()
+    };
+    let e = err(two("same_as = \"c\"\n", "[0, 1]", "y_bot[1]"));
+    assert!(
+        e.contains("dimensions[1].same_as") && e.contains("`c`"),
+        "{e}"
+    );
+    let e = err(two("same_as = \"a\"\n", "[0.2, 1]", "y_bot[1]"));
+    assert!(
+        e.contains("dimensions[1].range") && e.contains("`a`"),
+        "{e}"
+    );
+    let e = err(two("same_as = \"a\"\n", "[10, 100]", "bias"));
+    assert!(
+        e.contains("dimensions[1].same_as") && e.contains("bias"),
+        "{e}"
+    );
+    assert!(
+        ParameterSpace::from_toml_str(
+            &two("same_as = \"a\"\n", "[0, 1]", "y_bot[1]"),
+            Path::new("s.toml")
+        )
+        .is_ok()
+    );
+}

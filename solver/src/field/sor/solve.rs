@@ -227,6 +227,7 @@ pub fn solve_sor_with(
             residual_v,
             termination: Termination::ToleranceReached,
             pocket_rounds: rounds,
+            fixed_level_rounds: 0,
             factorisations: 0,
             seconds: start.elapsed().as_secs_f64(),
         },

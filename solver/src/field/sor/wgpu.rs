@@ -170,6 +170,7 @@ pub(crate) fn solve_sor_wgpu_with(
             residual_v,
             termination: Termination::ToleranceReached,
             pocket_rounds: rounds,
+            fixed_level_rounds: 0,
             factorisations: 0,
             seconds: start.elapsed().as_secs_f64(),
         },
