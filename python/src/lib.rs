@@ -603,7 +603,8 @@ fn measure<'py>(
 /// `max_seconds` (s), `exact_check` (re-weight `exact_draws` draws with the field solver; off by
 /// default here, on in the command line; `exact_grids` "mode" or "own" and `exact_grid_check`,
 /// as `--exact-grids` and `--exact-grid-check`; while the check fails, up to `refine_rounds`
-/// rounds of posterior-adaptive refinement, as `--refine-rounds`),
+/// rounds of posterior-adaptive refinement, as `--refine-rounds`, the refined likelihood's
+/// variance `refine_variance` "best" or "local", as `--refine-variance`),
 /// `out` (a folder: also write every file and figure
 /// `hpge-cv fit --out` writes), `progress`, `extrapolate` (fit a curve with voltages outside the
 /// surrogate's support, as `--extrapolate`), `constant_sigma` (the model's constant sigma_p in
@@ -619,7 +620,7 @@ fn measure<'py>(
     data=None, model=None, prior=None, detector=None, seed=None, sampler=None, likelihood=None,
     chains=None, ess=None, rhat=None, max_seconds=None, exact_check=false, exact_draws=None,
     out=None, progress=None, extrapolate=false, exact_grids=None, exact_grid_check=None,
-    refine_rounds=None, constant_sigma=false, exact_ascents=None
+    refine_rounds=None, constant_sigma=false, exact_ascents=None, refine_variance=None
 ))]
 #[allow(clippy::too_many_arguments)]
 fn fit<'py>(
@@ -645,6 +646,7 @@ fn fit<'py>(
     refine_rounds: Option<usize>,
     constant_sigma: bool,
     exact_ascents: Option<usize>,
+    refine_variance: Option<String>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let d = FitOptions::default();
     let o = FitOptions {
@@ -661,6 +663,7 @@ fn fit<'py>(
         exact_grid_check: exact_grid_check.unwrap_or(d.exact_grid_check),
         exact_ascents: exact_ascents.unwrap_or(d.exact_ascents),
         refine_rounds: refine_rounds.unwrap_or(d.refine_rounds),
+        refine_variance: refine_variance.unwrap_or(d.refine_variance),
         likelihood: likelihood.unwrap_or(d.likelihood),
         chains: chains.unwrap_or(d.chains),
         ess: ess.unwrap_or(d.ess),

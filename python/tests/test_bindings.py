@@ -114,6 +114,11 @@ def test_errors_are_hpge_errors_naming_the_input(tmp_path):
                     prior=ROOT / "priors/b-z.toml",
                     detector=ROOT / "detectors/super-siegfried-k1.toml", exact_check=True,
                     exact_grids="nearest", progress=False)
+    with pytest.raises(hpge_cv.HpgeError, match="--refine-variance widest"):
+        hpge_cv.fit(data=ROOT / "data/super-siegfried-k1/cv.csv", model=MODEL,
+                    prior=ROOT / "priors/b-z.toml",
+                    detector=ROOT / "detectors/super-siegfried-k1.toml", exact_check=True,
+                    refine_variance="widest", progress=False)
     # A curve starting below the surrogate's support (13.4 V for the shipped models) is refused
     # before sampling, as `hpge-cv fit` refuses it without --extrapolate.
     low = tmp_path / "low.csv"
