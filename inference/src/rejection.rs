@@ -21,6 +21,15 @@ pub(crate) fn unless_rejected<T>(evaluation: Result<T>) -> Result<Option<T>> {
     }
 }
 
+/// [`unless_rejected`] that keeps the reason: a recoverable failure is `Ok(Err(message))`.
+pub(crate) fn with_reason<T>(evaluation: Result<T>) -> Result<std::result::Result<T, String>> {
+    match evaluation {
+        Ok(v) => Ok(Ok(v)),
+        Err(e) if e.is_recoverable() => Ok(Err(e.to_string())),
+        Err(e) => Err(e),
+    }
+}
+
 /// Log densities for an optimiser that takes a plain `Fn(&[f64]) -> f64` (Nelder-Mead, finite
 /// differences): a recoverable error gives -inf; the first other error is kept, every later
 /// call returns NaN without evaluating (so the optimiser winds down cheaply), and

@@ -7,11 +7,11 @@ use std::path::Path;
 
 use hpge_inference::fit::{
     ExactCheckSettings, ExactGrids, FitSettings, RefineInputs, RefineProgress, RefineSettings,
-    RefinedFit, SHIFT_LIMIT_SD, fit, refine_fit,
+    RefinedFit, SHIFT_LIMIT_SD, exact_check, fit, refine_fit,
 };
 use hpge_inference::sampler::{SampleSettings, SamplerKind};
 use hpge_inference::{
-    CvData, CvModel, Likelihood, NoiseSettings, Posterior, Prior, PriorSpec, Result,
+    CvData, CvModel, Error, Likelihood, NoiseSettings, Posterior, Prior, PriorSpec, Result,
 };
 
 const VOLTS: [f64; 12] = [
@@ -314,4 +314,78 @@ fn a_misfitting_model_refines_to_the_exact_posterior() {
             e.std
         );
     }
+}
+
+/// The closed form, except that it "fails to converge" (recoverably) above b = 0.8, as a field
+/// solve can at a point of a posterior.
+struct Flaky;
+
+impl CvModel for Flaky {
+    common!();
+    fn sigma_rel(&self) -> f64 {
+        0.0
+    }
+    fn curve(&self, x: &[f64], c: &mut [f64]) -> Result<()> {
+        if x[1] > 0.8 {
+            return Err(Error::Numerical {
+                what: format!("the flaky solve at b = {}", x[1]),
+                message: "did not converge".into(),
+            });
+        }
+        exact_curve(x, c, None);
+        Ok(())
+    }
+    fn curve_jacobian(&self, x: &[f64], c: &mut [f64], jac: &mut [f64]) -> Result<()> {
+        self.curve(x, c)?;
+        exact_curve(x, c, Some(jac));
+        Ok(())
+    }
+}
+
+/// A draw whose exact solve fails gets weight 0 and is listed with its inputs and the reason.
+#[test]
+fn failed_exact_solves_are_listed_with_their_reason() {
+    let prior = prior(&Exact);
+    let data = misfit_data(&Exact);
+    let likelihood =
+        Likelihood::new(&data, NoiseSettings::default(), Surrogate.sigma_rel()).unwrap();
+    let posterior = Posterior::new(&Surrogate, &prior, &likelihood).unwrap();
+    let f = fit(&posterior, &settings(3), Default::default(), &|_| {}).unwrap();
+    let check = ExactCheckSettings {
+        draws: 100,
+        grids: ExactGrids::Own,
+        grid_check: 0,
+        ascents: 0,
+    };
+    let c = exact_check(
+        &Surrogate,
+        &Flaky,
+        &prior,
+        &likelihood,
+        &f.samples,
+        &f.mode,
+        &check,
+        &|_, _| {},
+    )
+    .unwrap();
+    let failed_draws = c.failures.iter().filter(|x| x.inputs[1] > 0.8).count();
+    assert!(
+        c.failed > 0 && c.failed < c.draws,
+        "{} of {}",
+        c.failed,
+        c.draws
+    );
+    // The mode's own failure (if any) is listed too, but not counted among the draws.
+    assert!(failed_draws == c.failed || failed_draws == c.failed + 1);
+    for x in &c.failures {
+        assert!(x.inputs[1] > 0.8, "{x:?}");
+        assert!(
+            x.reason.contains("flaky solve") && x.reason.contains("did not converge"),
+            "{}",
+            x.reason
+        );
+    }
+    assert_eq!(c.solved.len() + c.failures.len(), c.draws + 1);
+    let json = serde_json::to_string(&c).unwrap();
+    assert!(json.contains("\"failures\""), "{json}");
 }

@@ -24,6 +24,23 @@ fn exact() -> ExactSolver {
     .unwrap()
 }
 
+/// Solves a row of the space (its 9 parameters and the bias), panicking with `what` on failure.
+fn solve_row(ex: &ExactSolver, x: &[f64; 10], what: &str) -> hpge_solver::PointResult {
+    let det = ex.detector(&x[..9]).unwrap();
+    solve_point(&det, x[9], &ex.settings, None).unwrap_or_else(|e| panic!("{what}: {e}"))
+}
+
+/// No empty well (a depleted depression that carriers would fill) deeper than `limit_v`, for
+/// either carrier.
+fn assert_no_empty_well(p: &hpge_solver::PointResult, limit_v: f64) {
+    let s = &p.potential;
+    for side in [Carrier::Hole, Carrier::Electron] {
+        let (empty, _) =
+            deepest_empty_depression_v(&p.mesh, &s.phi_v, &s.undepleted, side, s.bounds_v);
+        assert!(empty <= limit_v, "{side:?} empty well {empty} V");
+    }
+}
+
 /// The example: held-out row 100004 (p-type layer at the top of the mantle, on the PTFE).
 #[test]
 fn heldout_row_100004_solves() {
@@ -193,9 +210,7 @@ fn heldout_row_104700_pocket_rounds_end_at_their_limit() {
         0.13532040476275142,
         452.5792311924306,
     ];
-    let det = ex.detector(&x[..9]).unwrap();
-    let p =
-        solve_point(&det, x[9], &ex.settings, None).unwrap_or_else(|e| panic!("row 104700: {e}"));
+    let p = solve_row(&ex, &x, "held-out row 104700");
     let limited: Vec<_> = p
         .reports
         .iter()
@@ -206,12 +221,7 @@ fn heldout_row_104700_pocket_rounds_end_at_their_limit() {
         assert_eq!(r.pocket_rounds, MAX_POCKET_ROUNDS);
         assert!(r.residual_v <= 1e-4 * x[9], "depth {} V", r.residual_v);
     }
-    let s = &p.potential;
-    for side in [Carrier::Hole, Carrier::Electron] {
-        let (empty, _) =
-            deepest_empty_depression_v(&p.mesh, &s.phi_v, &s.undepleted, side, s.bounds_v);
-        assert!(empty <= 1e-4 * x[9], "{side:?} empty well {empty} V");
-    }
+    assert_no_empty_well(&p, 1e-4 * x[9]);
     let interpolated = 47.821 + (47.623 - 47.821) * (x[9] - 450.0) / (453.302 - 450.0);
     assert!(
         (p.c12_pf / interpolated - 1.0).abs() < 0.005,
@@ -244,17 +254,10 @@ fn training_row_34554_active_set_cycle_holds_the_levels() {
         0.8753759433238884,
         20.100217327853898,
     ];
-    let det = ex.detector(&x[..9]).unwrap();
-    let p =
-        solve_point(&det, x[9], &ex.settings, None).unwrap_or_else(|e| panic!("row 34554: {e}"));
+    let p = solve_row(&ex, &x, "training row 34554");
     let fixed: usize = p.reports.iter().map(|r| r.fixed_level_rounds).sum();
     assert!(fixed > 0, "the cycle's path is exercised");
-    let s = &p.potential;
-    for side in [Carrier::Hole, Carrier::Electron] {
-        let (empty, _) =
-            deepest_empty_depression_v(&p.mesh, &s.phi_v, &s.undepleted, side, s.bounds_v);
-        assert!(empty <= 1e-4 * x[9], "{side:?} empty well {empty} V");
-    }
+    assert_no_empty_well(&p, 1e-4 * x[9]);
     let interpolated = 396.394 + (386.270 - 396.394) * (x[9] - 19.5) / (20.2 - 19.5);
     let rel_err = p.accuracy.c12_err_pf / p.c12_pf;
     assert!(

@@ -26,7 +26,7 @@ use super::predictive::thin_indices;
 use crate::model::CvModel;
 use crate::posterior::Likelihood;
 use crate::prior::Prior;
-use crate::rejection::unless_rejected;
+use crate::rejection::{unless_rejected, with_reason};
 use crate::sampler::Samples;
 use crate::summary::psis;
 use crate::{Error, Result};
@@ -169,10 +169,22 @@ pub struct ExactCheck {
     /// passing check; one that found a better basin fails it).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub ascents: Vec<super::BasinAscent>,
+    /// The draws whose exact solve failed (weight 0; `failed` of them), with the reason.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub failures: Vec<FailedSolve>,
     /// The model inputs x and the exact curve of every draw whose solve succeeded, the mode's
     /// last (what posterior-adaptive refinement learns from; not in the summary).
     #[serde(skip)]
     pub solved: Vec<(Vec<f64>, Vec<f64>)>,
+}
+
+/// A draw of the check whose exact curve the field solver could not give.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FailedSolve {
+    /// The model inputs x (the surrogate's columns, e.g. d_li_mm, y1_bot, ...).
+    pub inputs: Vec<f64>,
+    /// The solver's message.
+    pub reason: String,
 }
 
 /// Runs the check on at most `settings.draws` draws (evenly thinned) and at the global mode
@@ -232,9 +244,9 @@ pub fn exact_check(
             Some((c_mode, near)) => {
                 let mut v = near
                     .into_iter()
-                    .map(unless_rejected)
+                    .map(with_reason)
                     .collect::<Result<Vec<_>>>()?;
-                v.push(Some(c_mode));
+                v.push(Ok(c_mode));
                 exact_curves = Some(v);
             }
             None => grids = ExactGrids::Own,
@@ -248,7 +260,7 @@ pub fn exact_check(
             points
                 .par_iter()
                 .map(|theta| {
-                    let c = unless_rejected(eval(exact, theta));
+                    let c = with_reason(eval(exact, theta));
                     let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
                     progress(k + 1, points.len());
                     c
@@ -259,12 +271,23 @@ pub fn exact_check(
     let solved: Vec<(Vec<f64>, Vec<f64>)> = points
         .iter()
         .zip(&exact_curves)
-        .filter_map(|(theta, ce)| ce.as_ref().map(|c| (expand(theta), c.clone())))
+        .filter_map(|(theta, ce)| ce.as_ref().ok().map(|c| (expand(theta), c.clone())))
+        .collect();
+    let failures: Vec<FailedSolve> = points
+        .iter()
+        .zip(&exact_curves)
+        .filter_map(|(theta, ce)| {
+            ce.as_ref().err().map(|reason| FailedSolve {
+                inputs: expand(theta),
+                reason: reason.clone(),
+            })
+        })
         .collect();
     let results: Vec<(f64, Option<Vec<f64>>, Vec<f64>)> = exact_curves
         .into_iter()
         .zip(surrogate_curves)
         .map(|(ce, (cs, var))| {
+            let ce = ce.ok();
             let lr = match &ce {
                 Some(c) => {
                     exact_like.ln_likelihood(c, None)
@@ -325,6 +348,7 @@ pub fn exact_check(
         grid_check: None,
         solver_tolerance: None,
         ascents: Vec::new(),
+        failures,
         solved,
     })
     .and_then(|mut check| {

@@ -25,8 +25,8 @@ pub use checkpoint::{
     remove_stale, write_whole,
 };
 pub use exact_check::{
-    DEFAULT_GRID_CHECK, ExactCheck, ExactCheckSettings, ExactGrids, GridCheck, K_HAT_LIMIT,
-    ParameterShift, SHIFT_LIMIT_SD, add_grid_check, exact_check,
+    DEFAULT_GRID_CHECK, ExactCheck, ExactCheckSettings, ExactGrids, FailedSolve, GridCheck,
+    K_HAT_LIMIT, ParameterShift, SHIFT_LIMIT_SD, add_grid_check, exact_check,
 };
 pub use job::{EXACT_CHECK_TOLERANCE, FitFiles, FitJob, file_hash};
 pub use options::{

@@ -231,6 +231,15 @@ pub fn write_report(
             hpge_inference::fit::SHIFT_LIMIT_SD,
             hpge_inference::fit::ASCENT_MARGIN
         );
+        for f in &c.failures {
+            let x: Vec<String> = f.inputs.iter().map(|v| format!("{v:.4}")).collect();
+            let _ = writeln!(
+                r,
+                "- failed exact solve (weight 0) at x = ({}): {}\n",
+                x.join(", "),
+                f.reason
+            );
+        }
         if !c.ascents.is_empty() {
             let _ = writeln!(
                 r,
