@@ -5,24 +5,32 @@
 //! (model discovery's, d_Li = 2.67 mm, y_bot > y_top) has an exact chi^2 lower by 3.7; the
 //! sampler's local mode in that basin sat at d_Li = 1.2 mm, where the exact density is lower.
 //!
-//! So a passing check also climbs the exact posterior (Levenberg-Marquardt, [`laplace_fit`] on
-//! the exact solver, a few steps) from the sampler's local modes in other basins (weight at least
+//! So a passing check also climbs the exact posterior (Levenberg-Marquardt on the exact solver
+//! with the sampled model's Jacobian, [`laplace_fit_guided`]: one exact curve a step) from the
+//! sampler's local modes in other basins (weight at least
 //! [`MIN_ASCENT_WEIGHT`], away from the global mode by more than 1% of a parameter's support and
 //! more than [`AWAY_SD`] posterior sd, best first). It fails when an ascent ends at an exact
 //! ln p above the exact ln p at the global mode by more than [`ASCENT_MARGIN`]: the exact
 //! posterior is e^margin times denser there than at the fit's best point. (An ascent that climbs
 //! back into the fitted basin cannot do that while the check passes: its exact peak then lies
 //! within a quarter sd of the fitted mode in every parameter, which is 0.03 d below it in ln p
-//! for a Gaussian.) The ascent's end and its d finite-difference neighbours (solved anyway, on
-//! the end's grids) then teach the error model, so the next round's corrected surrogate knows
-//! that basin.
+//! for a Gaussian.) Every exact curve the ascent solved then teaches the error model, so the
+//! next round's corrected surrogate knows that basin.
+//!
+//! The Jacobian: with exact forward differences a step cost d + 1 exact curves (the shipped B_RZ
+//! fit's two ascents 99 curves, about 130 s of its 5 min). The sampled model's derivatives,
+//! scaled to the exact curve point by point, cost nothing and point the same way wherever the
+//! model's error varies slowly; a step is still kept only when the exact ln p rises, so an
+//! ascent's end is an exact point at least as high as its start, and a better basin it reports
+//! is there. It may stop short of the exact peak where the model's derivatives are off, which
+//! can only hide a basin, never invent one.
 
 use serde::{Deserialize, Serialize};
 
 use super::round::f64_or_nan;
 use super::run::Fit;
 use crate::model::CvModel;
-use crate::posterior::{LaplaceSettings, Likelihood, Posterior, fd_steps, laplace_fit};
+use crate::posterior::{LaplaceSettings, Likelihood, Posterior, laplace_fit_guided};
 use crate::prior::Prior;
 use crate::rejection::unless_rejected;
 use crate::{Error, Result};
@@ -42,9 +50,8 @@ pub const MIN_ASCENT_WEIGHT: f64 = 0.01;
 /// Ascents from the sampler's local modes after a passing check (0: none).
 pub const DEFAULT_ASCENTS: usize = 2;
 
-/// Levenberg-Marquardt steps of one ascent at most, and exact curves per parameter (an
-/// accepted step costs d + 2 curves: the step and its d forward differences).
-const ASCENT_STEPS: usize = 8;
+/// Levenberg-Marquardt steps of one ascent at most (one exact curve each, kept or not).
+const ASCENT_STEPS: usize = 16;
 
 /// Model inputs x and the exact curve there, pF.
 pub type SolvedCurve = (Vec<f64>, Vec<f64>);
@@ -78,16 +85,17 @@ pub fn away_from_mode(prior: &Prior, mode: &[f64], theta: &[f64]) -> bool {
         .any(|((a, b), p)| (a - b).abs() > 0.01 * (p.support[1] - p.support[0]))
 }
 
-/// Ascents of the exact posterior from up to `n` of `result`'s local modes in other basins; the
-/// exact curves at each end and its finite-difference neighbours (inputs x, c) for the error
-/// model. An ascent whose exact solves fail recoverably, or whose Hessian is singular, is left
-/// out. `mode_curve`: the exact curve at `result.mode` when the caller has it (the exact
-/// check's last solved curve), else it is solved here.
+/// Ascents of the exact posterior from up to `n` of `result`'s local modes in other basins,
+/// each guided by the Jacobian of `sampled` (the model the sampler used); every exact curve
+/// they solved (inputs x, c) for the error model. An ascent whose start fails to solve, or whose
+/// Hessian is singular, is left out. `mode_curve`: the exact curve at `result.mode` when the
+/// caller has it (the exact check's last solved curve), else it is solved here.
 ///
 /// # Errors
 /// A model error other than a recoverable failed solve.
 pub fn basin_ascents(
     exact: &dyn CvModel,
+    sampled: &dyn CvModel,
     prior: &Prior,
     likelihood: &Likelihood,
     result: &Fit,
@@ -126,42 +134,22 @@ pub fn basin_ascents(
     let Some(at_mode) = at_mode else {
         return Ok((Vec::new(), Vec::new()));
     };
-    let d = prior.dim();
     let settings = LaplaceSettings {
         max_steps: ASCENT_STEPS,
-        max_evaluations: 1 + ASCENT_STEPS * (d + 2),
+        max_evaluations: 1 + ASCENT_STEPS,
         ..LaplaceSettings::default()
     };
     let mut ascents = Vec::new();
     let mut curves = Vec::new();
     for start in starts {
         // A failed solve or a singular Hessian at the end: no ascent from here.
-        let lf = match laplace_fit(&posterior, &start, &settings) {
-            Ok(lf) => lf,
+        let (lf, visited) = match laplace_fit_guided(&posterior, sampled, &start, &settings) {
+            Ok(r) => r,
             Err(e) if e.is_recoverable() || matches!(e, Error::Numerical { .. }) => continue,
             Err(e) => return Err(e),
         };
         let better = lf.ln_posterior > at_mode.ln_posterior + ASCENT_MARGIN;
-        // The end's curve and its forward-difference neighbours c + h_j dc/dtheta_j (the
-        // Jacobian is their difference quotient, so these are the curves the ascent solved).
-        let nx = prior.input_names.len();
-        let nv = lf.c_p.len();
-        let mut x = vec![0.0; nx];
-        prior.expand(&lf.theta, &mut x);
-        curves.push((x, lf.c_p.clone()));
-        for (j, h) in fd_steps(prior, &lf.theta, settings.fd_step)
-            .into_iter()
-            .enumerate()
-        {
-            let mut t = lf.theta.clone();
-            t[j] += h;
-            let mut xj = vec![0.0; nx];
-            prior.expand(&t, &mut xj);
-            let cj = (0..nv)
-                .map(|k| lf.c_p[k] + h * lf.jacobian[k * d + j])
-                .collect();
-            curves.push((xj, cj));
-        }
+        curves.extend(visited);
         ascents.push(BasinAscent {
             start,
             theta: lf.theta,

@@ -302,6 +302,7 @@ pub fn refine_fit(
                             .map(|(_, c)| c.clone());
                         let (ascents, curves) = basin_ascents(
                             m.exact,
+                            model,
                             m.prior,
                             m.likelihood,
                             &result,

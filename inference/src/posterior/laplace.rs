@@ -198,7 +198,74 @@ pub fn laplace_fit(
     start: &[f64],
     settings: &LaplaceSettings,
 ) -> Result<LaplaceFit> {
+    levenberg_marquardt(posterior, None, start, settings, &mut Vec::new())
+}
+
+/// Model inputs x and the model's curve there, pF.
+pub type VisitedCurve = (Vec<f64>, Vec<f64>);
+
+/// [`laplace_fit`] on `posterior` (e.g. the exact solver's) with the Jacobian of `guide` (e.g.
+/// the corrected surrogate the sampler used): row k of the guide's dc/dtheta scaled by
+/// c_p,k / c_guide,k, so that a multiplicative error of the guide cancels. One curve of
+/// `posterior`'s model per step instead of d + 1. A step is kept only when `posterior`'s ln p
+/// rises, so the end is a point of `posterior` at least as high as the start; where the guide's
+/// derivatives are off, the end may stop short of `posterior`'s own mode (its ln p a lower
+/// bound of that mode's). The Laplace part (covariance, evidence) uses the guide's Jacobian.
+/// Returns also every curve of `posterior`'s model it solved, the start's first.
+///
+/// # Errors
+/// As [`laplace_fit`]; also a failure of the guide's curve or Jacobian.
+pub fn laplace_fit_guided(
+    posterior: &Posterior,
+    guide: &dyn crate::CvModel,
+    start: &[f64],
+    settings: &LaplaceSettings,
+) -> Result<(LaplaceFit, Vec<VisitedCurve>)> {
+    let guide = Posterior {
+        model: guide,
+        prior: posterior.prior,
+        likelihood: posterior.likelihood,
+    };
+    let mut visited = Vec::new();
+    let lf = levenberg_marquardt(posterior, Some(&guide), start, settings, &mut visited)?;
+    Ok((lf, visited))
+}
+
+/// c_p at theta (the evaluation's) and the guide's Jacobian scaled to it (see
+/// [`laplace_fit_guided`]); the guide's work is not counted in `evaluations`.
+fn guided_jacobian(
+    guide: &Posterior,
+    theta: &[f64],
+    c_p: &[f64],
+    fd_step: f64,
+) -> Result<(Vec<f64>, Vec<f64>)> {
+    let d = theta.len();
+    let (cg, mut jg) = curve_and_jacobian(guide, theta, fd_step, &mut 0)?;
+    for (k, (cp, cgk)) in c_p.iter().zip(&cg).enumerate() {
+        let f = if *cgk != 0.0 { cp / cgk } else { 1.0 };
+        for v in &mut jg[k * d..(k + 1) * d] {
+            *v *= f;
+        }
+    }
+    Ok((c_p.to_vec(), jg))
+}
+
+/// The Levenberg-Marquardt ascent of [`laplace_fit`], with the Jacobian of `guide` where given
+/// (then each curve of `posterior`'s model it solves is pushed to `visited`).
+fn levenberg_marquardt(
+    posterior: &Posterior,
+    guide: Option<&Posterior>,
+    start: &[f64],
+    settings: &LaplaceSettings,
+    visited: &mut Vec<VisitedCurve>,
+) -> Result<LaplaceFit> {
     let d = posterior.dim();
+    let nx = posterior.prior.input_names.len();
+    let inputs = |theta: &[f64]| {
+        let mut x = vec![0.0; nx];
+        posterior.prior.expand(theta, &mut x);
+        x
+    };
     let mut theta = start.to_vec();
     clamp(posterior, &mut theta);
     let mut evaluations = 0;
@@ -210,8 +277,14 @@ pub fn laplace_fit(
             message: format!("the start point {theta:?} has zero posterior density"),
         });
     }
-    let (mut c, mut jc) =
-        curve_and_jacobian(posterior, &theta, settings.fd_step, &mut evaluations)?;
+    if guide.is_some() {
+        visited.push((inputs(&theta), current.c_p.clone()));
+    }
+    let jacobian = |theta: &[f64], c_p: &[f64], evaluations: &mut usize| match guide {
+        Some(g) => guided_jacobian(g, theta, c_p, settings.fd_step),
+        None => curve_and_jacobian(posterior, theta, settings.fd_step, evaluations),
+    };
+    let (mut c, mut jc) = jacobian(&theta, &current.c_p, &mut evaluations)?;
     let mut lambda = 1e-3;
     let mut steps = 0;
     for _ in 0..settings.max_steps {
@@ -234,13 +307,15 @@ pub fn laplace_fit(
         // A recoverable failure at the trial point rejects the step; any other error is returned.
         let ev = unless_rejected(posterior.evaluate(&trial))?;
         evaluations += 1;
+        if let (Some(ev), Some(_)) = (&ev, guide) {
+            visited.push((inputs(&trial), ev.c_p.clone()));
+        }
         match ev {
             Some(ev) if ev.ln_posterior > current.ln_posterior => {
                 let gain = ev.ln_posterior - current.ln_posterior;
                 theta = trial;
                 current = ev;
-                (c, jc) =
-                    curve_and_jacobian(posterior, &theta, settings.fd_step, &mut evaluations)?;
+                (c, jc) = jacobian(&theta, &current.c_p, &mut evaluations)?;
                 lambda = (lambda / 3.0).max(1e-9);
                 steps += 1;
                 if gain < settings.tolerance {

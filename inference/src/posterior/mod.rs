@@ -6,7 +6,9 @@ mod laplace;
 mod likelihood;
 
 pub use density::{Evaluation, Posterior};
-pub use laplace::{LaplaceFit, LaplaceSettings, fd_steps, laplace_fit};
+pub use laplace::{
+    LaplaceFit, LaplaceSettings, VisitedCurve, fd_steps, laplace_fit, laplace_fit_guided,
+};
 pub use likelihood::{Likelihood, NoiseKind, NoiseSettings};
 
 #[cfg(test)]
