@@ -389,3 +389,90 @@ fn failed_exact_solves_are_listed_with_their_reason() {
     let json = serde_json::to_string(&c).unwrap();
     assert!(json.contains("\"failures\""), "{json}");
 }
+
+/// The closed form, whose solves on another point's grids (`curves_near`) fail above b = 0.8,
+/// as a grid made for the mode can miss a draw's thin depleted layer; on their own they solve.
+struct GridFlaky;
+
+impl CvModel for GridFlaky {
+    common!();
+    fn sigma_rel(&self) -> f64 {
+        0.0
+    }
+    fn curve(&self, x: &[f64], c: &mut [f64]) -> Result<()> {
+        exact_curve(x, c, None);
+        Ok(())
+    }
+    fn curve_jacobian(&self, x: &[f64], c: &mut [f64], jac: &mut [f64]) -> Result<()> {
+        exact_curve(x, c, Some(jac));
+        Ok(())
+    }
+    fn curves_near(
+        &self,
+        x: &[f64],
+        near: &[Vec<f64>],
+        _: &(dyn Fn(usize, usize) + Sync),
+    ) -> Result<hpge_inference::model::NearCurves> {
+        let mut c = vec![0.0; VOLTS.len()];
+        exact_curve(x, &mut c, None);
+        let others = near
+            .iter()
+            .map(|xn| {
+                if xn[1] > 0.8 {
+                    return Err(Error::Numerical {
+                        what: "a solve on the mode's grid".into(),
+                        message: "shorted".into(),
+                    });
+                }
+                let mut cn = vec![0.0; VOLTS.len()];
+                exact_curve(xn, &mut cn, None);
+                Ok(cn)
+            })
+            .collect();
+        Ok((c, others))
+    }
+}
+
+/// A draw that fails on the mode's grids is solved again on its own: no failed solve is left,
+/// and the check counts the retries.
+#[test]
+fn draws_failing_on_the_modes_grids_are_solved_on_their_own() {
+    let prior = prior(&Exact);
+    let data = misfit_data(&Exact);
+    let likelihood =
+        Likelihood::new(&data, NoiseSettings::default(), Surrogate.sigma_rel()).unwrap();
+    let posterior = Posterior::new(&Surrogate, &prior, &likelihood).unwrap();
+    let f = fit(&posterior, &settings(3), Default::default(), &|_| {}).unwrap();
+    let check = ExactCheckSettings {
+        draws: 100,
+        grids: ExactGrids::Mode,
+        grid_check: 0,
+        ascents: 0,
+    };
+    let run = |exact: &dyn CvModel| {
+        exact_check(
+            &Surrogate,
+            exact,
+            &prior,
+            &likelihood,
+            &f.samples,
+            &f.mode,
+            &check,
+            &|_, _| {},
+        )
+        .unwrap()
+    };
+    let c = run(&GridFlaky);
+    assert_eq!(c.grids, ExactGrids::Mode);
+    assert!(
+        c.own_grid_retries > 0 && c.own_grid_retries < c.draws,
+        "{}",
+        c.own_grid_retries
+    );
+    assert_eq!((c.failed, c.failures.len()), (0, 0));
+    // The same check as with a model whose every solve succeeds.
+    let plain = run(&Exact);
+    assert_eq!(plain.own_grid_retries, 0);
+    assert_eq!(c.pareto_k, plain.pareto_k);
+    assert_eq!(c.solved, plain.solved);
+}

@@ -294,6 +294,18 @@ pub fn summary_text(fit: &Fit, out: &Path) -> String {
 
 /// Where the check solved its draws, in words, with the grid check's numbers.
 pub(crate) fn grids_text(c: &hpge_inference::fit::ExactCheck) -> String {
+    let text = grids_text_plain(c);
+    if c.own_grid_retries > 0 {
+        format!(
+            "{text}; {} that failed there solved again on their own",
+            c.own_grid_retries
+        )
+    } else {
+        text
+    }
+}
+
+fn grids_text_plain(c: &hpge_inference::fit::ExactCheck) -> String {
     match (&c.grids, &c.grid_check) {
         (ExactGrids::Own, _) => "their own grids".into(),
         (ExactGrids::Mode, None) => "the mode's grids".into(),
