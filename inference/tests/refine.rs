@@ -342,15 +342,23 @@ impl CvModel for Flaky {
     }
 }
 
-/// A draw whose exact solve fails gets weight 0 and is listed with its inputs and the reason.
-#[test]
-fn failed_exact_solves_are_listed_with_their_reason() {
+/// The plain surrogate's fit of the misfitting data (seed 3), for the checks' tests.
+fn plain_surrogate_fit() -> (Prior, Likelihood, hpge_inference::fit::Fit) {
     let prior = prior(&Exact);
     let data = misfit_data(&Exact);
     let likelihood =
         Likelihood::new(&data, NoiseSettings::default(), Surrogate.sigma_rel()).unwrap();
-    let posterior = Posterior::new(&Surrogate, &prior, &likelihood).unwrap();
-    let f = fit(&posterior, &settings(3), Default::default(), &|_| {}).unwrap();
+    let f = {
+        let posterior = Posterior::new(&Surrogate, &prior, &likelihood).unwrap();
+        fit(&posterior, &settings(3), Default::default(), &|_| {}).unwrap()
+    };
+    (prior, likelihood, f)
+}
+
+/// A draw whose exact solve fails gets weight 0 and is listed with its inputs and the reason.
+#[test]
+fn failed_exact_solves_are_listed_with_their_reason() {
+    let (prior, likelihood, f) = plain_surrogate_fit();
     let check = ExactCheckSettings {
         draws: 100,
         grids: ExactGrids::Own,
@@ -437,12 +445,7 @@ impl CvModel for GridFlaky {
 /// and the check counts the retries.
 #[test]
 fn draws_failing_on_the_modes_grids_are_solved_on_their_own() {
-    let prior = prior(&Exact);
-    let data = misfit_data(&Exact);
-    let likelihood =
-        Likelihood::new(&data, NoiseSettings::default(), Surrogate.sigma_rel()).unwrap();
-    let posterior = Posterior::new(&Surrogate, &prior, &likelihood).unwrap();
-    let f = fit(&posterior, &settings(3), Default::default(), &|_| {}).unwrap();
+    let (prior, likelihood, f) = plain_surrogate_fit();
     let check = ExactCheckSettings {
         draws: 100,
         grids: ExactGrids::Mode,
