@@ -254,22 +254,18 @@ pub fn exact_check(
                     .map(with_reason)
                     .collect::<Result<Vec<_>>>()?;
                 // A draw that failed on the mode's grids: once more on its own.
-                let retried: Vec<(usize, std::result::Result<Vec<f64>, String>)> = v
-                    .par_iter()
+                own_grid_retries = v.iter().filter(|c| c.is_err()).count();
+                v.par_iter_mut()
                     .enumerate()
-                    .filter(|(_, c)| c.is_err())
-                    .map(|(i, _)| Ok((i, with_reason(eval(exact, points[i]))?)))
-                    .collect::<Result<_>>()?;
-                own_grid_retries = retried.len();
-                for (i, c) in retried {
-                    v[i] = match (c, &v[i]) {
-                        (Ok(c), _) => Ok(c),
-                        (Err(own), Err(mode)) => {
-                            Err(format!("on the mode's grids: {mode}; on its own: {own}"))
+                    .try_for_each(|(i, c)| -> Result<()> {
+                        if let Err(mode) = c {
+                            let mode = std::mem::take(mode);
+                            *c = with_reason(eval(exact, points[i]))?.map_err(|own| {
+                                format!("on the mode's grids: {mode}; on its own: {own}")
+                            });
                         }
-                        (Err(own), Ok(_)) => Err(own),
-                    };
-                }
+                        Ok(())
+                    })?;
                 v.push(Ok(c_mode));
                 exact_curves = Some(v);
             }

@@ -241,7 +241,6 @@ impl Round<'_> {
             // Singular when pockets pour into each other (a hole and an electron pocket at a p-n
             // junction): their levels then stay where the last flood found them, and the next
             // flood decides.
-            let fallback = || act.iter().map(|&p| pockets[p].fallback_v).collect();
             let solved = if fixed_levels {
                 None
             } else {
@@ -249,7 +248,7 @@ impl Round<'_> {
             };
             let lv: Vec<f64> = solved.unwrap_or_else(|| {
                 fell_back = true;
-                fallback()
+                act.iter().map(|&p| pockets[p].fallback_v).collect()
             });
             let mut x = x0;
             for (y, l) in ys.iter().zip(&lv) {
