@@ -17,13 +17,51 @@ enum ReportKind {
     /// Every paper figure the project can produce, with its own numbers, and README.md listing
     /// each beside the paper's statement and whether this project agrees (about 10 min on 2 cores).
     Paper(PaperOptions),
+    /// The status table of the README, derived from the shipped results files (fits, coverage
+    /// studies, the default surrogate's held-out figures, the solver's accuracy).
+    Status(StatusArgs),
+}
+
+/// `report status`.
+#[derive(Debug, clap::Args)]
+struct StatusArgs {
+    /// The repository whose results files are read.
+    #[arg(long, default_value = ".")]
+    root: std::path::PathBuf,
+    /// Also write the table into this file, between its status markers (e.g. README.md).
+    #[arg(long)]
+    write: Option<std::path::PathBuf>,
 }
 
 /// Runs `report`.
 pub fn run(a: &ReportArgs) -> Result<()> {
     match &a.what {
         ReportKind::Paper(p) => paper(p),
+        ReportKind::Status(s) => status(s),
     }
+}
+
+/// Runs `report status`: prints the table and, with `--write`, puts it into the file.
+fn status(a: &StatusArgs) -> Result<()> {
+    use hpge_reports::status::{status_rows, status_table, with_table};
+    let rows = status_rows(&a.root, hpge_inference::fit::DEFAULT_MODEL)?;
+    let table = status_table(&rows);
+    // A file without the markers is refused before anything is printed.
+    let written = match &a.write {
+        Some(file) => {
+            let text = std::fs::read_to_string(file)
+                .map_err(|e| anyhow::anyhow!("{}: cannot read: {e}", file.display()))?;
+            Some((file, with_table(&text, &table, file)?))
+        }
+        None => None,
+    };
+    print!("{table}");
+    if let Some((file, new)) = written {
+        std::fs::write(file, new)
+            .map_err(|e| anyhow::anyhow!("{}: cannot write: {e}", file.display()))?;
+        eprintln!("status table written into {}", file.display());
+    }
+    Ok(())
 }
 
 /// Runs `report paper` with progress on stderr and the fits' summaries on stdout.

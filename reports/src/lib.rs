@@ -15,6 +15,7 @@
 //! - [`paper`]: the steps of `report paper` that draw the paper's figures from shipped inputs
 //!   (C-V curve, transform and example density, training samples, surrogate), the impurity
 //!   models of section 9, and the README and report.json of a run.
+//! - [`status`]: the README's status table, derived from the shipped results files.
 //!
 //! Every failure is an [`Error`] naming the file at fault.
 //!
@@ -47,6 +48,7 @@ pub mod fit;
 pub mod paper;
 pub mod plot;
 mod provenance;
+pub mod status;
 
 pub use error::{Error, Result};
 pub use plot::{Corner, Curve, Format, LineFigure, check_output, line_figure};

@@ -1,0 +1,418 @@
+//! The status table of the README, derived from the results files the repository ships: the
+//! main job's exact-solver check and wall time, the B_Z check, the truth of the stand-in data,
+//! the coverage studies, the default surrogate's held-out accuracy and the solver's accuracy,
+//! each beside its target and a verdict computed from the two.
+//!
+//! `hpge-cv report status` prints the table; `--write README.md` puts it between the markers
+//! [`BEGIN`] and [`END`]. A test regenerates it and fails when the README disagrees.
+
+use std::path::{Path, PathBuf};
+
+use serde_json::Value;
+
+use crate::{Error, Result};
+
+/// The line before the table in the README.
+pub const BEGIN: &str =
+    "<!-- status: begin; made by `cargo run --release -- report status --write README.md` -->";
+/// The line after it.
+pub const END: &str = "<!-- status: end -->";
+
+/// Wall-time target of the main job, s (issue acceptance: the B_RZ fit with its refinement).
+pub const MAIN_JOB_SECONDS: f64 = 300.0;
+/// Largest Pareto k-hat of a passing exact check (Vehtari et al. 2024).
+pub const K_HAT_LIMIT: f64 = 0.7;
+/// Largest shift of a posterior mean, in posterior sd, of a passing exact check.
+pub const SHIFT_LIMIT_SD: f64 = 0.25;
+/// Truths a coverage study needs: exact-solver data, surrogate data.
+pub const COVERAGE_TRUTHS: (u64, u64) = (100, 200);
+/// Held-out targets of the default surrogate: Gaussian sigma, q99 of |error|, coverage of 2 sigma.
+pub const HELDOUT_TARGET: (f64, f64, [f64; 2]) = (0.005, 0.02, [0.93, 0.97]);
+
+/// A row's verdict.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Verdict {
+    /// The result meets its target.
+    Pass,
+    /// It does not.
+    Fail,
+    /// A fact with no target (a limitation the reader should know).
+    Note,
+}
+
+impl Verdict {
+    fn of(ok: bool) -> Self {
+        if ok { Self::Pass } else { Self::Fail }
+    }
+
+    /// The word in the table.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Self::Pass => "pass",
+            Self::Fail => "**fail**",
+            Self::Note => "note",
+        }
+    }
+}
+
+/// One row of the table.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StatusRow {
+    /// What is measured.
+    pub what: String,
+    /// The result, with its numbers.
+    pub result: String,
+    /// The target it is judged by.
+    pub target: String,
+    /// Pass, fail or note.
+    pub verdict: Verdict,
+    /// The results file (relative to the repository root), or the report that states the fact.
+    pub source: String,
+}
+
+fn read_json(root: &Path, rel: &str) -> Result<Value> {
+    let file = root.join(rel);
+    let text = std::fs::read_to_string(&file).map_err(|source| Error::Read {
+        file: file.clone(),
+        what: "a results file of the status table",
+        source,
+    })?;
+    serde_json::from_str(&text).map_err(|source| Error::Json {
+        file,
+        what: "not JSON",
+        source,
+    })
+}
+
+/// A number at `key` (a JSON pointer) of `v`, or an error naming the file and the key.
+fn num(v: &Value, rel: &str, key: &str) -> Result<f64> {
+    v.pointer(key)
+        .and_then(Value::as_f64)
+        .ok_or_else(|| Error::Content {
+            file: PathBuf::from(rel),
+            message: format!("no number at {key}"),
+        })
+}
+
+fn flag(v: &Value, rel: &str, key: &str) -> Result<bool> {
+    v.pointer(key)
+        .and_then(Value::as_bool)
+        .ok_or_else(|| Error::Content {
+            file: PathBuf::from(rel),
+            message: format!("no true/false at {key}"),
+        })
+}
+
+fn pct(x: f64) -> String {
+    format!("{:.2}%", 100.0 * x)
+}
+
+/// The exact check of a fit (`reports/fits/NAME/summary.json`) and, for the main job, its wall
+/// time: the rounds' sampling, exact solves and error-model fits summed.
+fn fit_rows(root: &Path, name: &str, what: &str, main: bool) -> Result<Vec<StatusRow>> {
+    let rel = format!("reports/fits/{name}/summary.json");
+    let s = read_json(root, &rel)?;
+    let k = num(&s, &rel, "/exact_check/pareto_k")?;
+    let shift = num(&s, &rel, "/exact_check/max_abs_shift_sd")?;
+    let rounds = s
+        .get("refinement")
+        .and_then(Value::as_array)
+        .cloned()
+        .unwrap_or_default();
+    let pass = flag(&s, &rel, "/exact_check/pass")?;
+    let after = if rounds.is_empty() {
+        String::new()
+    } else {
+        format!(
+            ", {} after {} round(s)",
+            if pass { "passed" } else { "failed" },
+            rounds.len()
+        )
+    };
+    let mut rows = vec![StatusRow {
+        what: format!("{what}: exact-solver check"),
+        result: format!("k-hat {k:.2}, largest mean shift {shift:.2} sd{after}"),
+        target: format!("k-hat <= {K_HAT_LIMIT}, shift <= {SHIFT_LIMIT_SD} sd"),
+        verdict: Verdict::of(pass && k <= K_HAT_LIMIT && shift <= SHIFT_LIMIT_SD),
+        source: rel.clone(),
+    }];
+    if main && !rounds.is_empty() {
+        let sum = |key: &str| -> f64 {
+            rounds
+                .iter()
+                .filter_map(|r| r.get(key).and_then(Value::as_f64))
+                .sum()
+        };
+        let (sampling, exact, gp) = (
+            sum("sampling_seconds"),
+            sum("exact_seconds"),
+            sum("error_model_seconds"),
+        );
+        let total = sampling + exact + gp;
+        rows.push(StatusRow {
+            what: format!("{what}: wall time on 2 cores"),
+            result: format!(
+                "{total:.0} s ({sampling:.0} s sampling, {exact:.0} s exact solves, {gp:.0} s error model)"
+            ),
+            target: format!("<= {MAIN_JOB_SECONDS:.0} s"),
+            verdict: Verdict::of(total <= MAIN_JOB_SECONDS),
+            source: rel.clone(),
+        });
+    }
+    if let Some(truth) = s.get("truth").and_then(Value::as_array) {
+        let inside = truth
+            .iter()
+            .filter(|t| t.get("inside_955").and_then(Value::as_bool) == Some(true))
+            .count();
+        rows.push(StatusRow {
+            what: format!("{what}: truth of the stand-in data"),
+            result: format!(
+                "inside the 95.5% smallest interval for {inside} of {} parameters",
+                truth.len()
+            ),
+            target: "every parameter".into(),
+            verdict: Verdict::of(inside == truth.len() && !truth.is_empty()),
+            source: rel,
+        });
+    }
+    Ok(rows)
+}
+
+/// A coverage study (`reports/coverage/NAME/coverage.json`) against the truths it needs.
+fn coverage_row(root: &Path, name: &str, what: &str, needed: u64) -> Result<StatusRow> {
+    let rel = format!("reports/coverage/{name}/coverage.json");
+    let s = read_json(root, &rel)?;
+    let n = num(&s, &rel, "/n_truths")? as u64;
+    let pass = flag(&s, &rel, "/pass")?;
+    let failing: Vec<String> = s
+        .get("parameters")
+        .and_then(Value::as_array)
+        .map(|ps| {
+            ps.iter()
+                .filter(|p| !parameter_passes(p))
+                .filter_map(|p| p.get("name").and_then(Value::as_str).map(String::from))
+                .collect()
+        })
+        .unwrap_or_default();
+    let detail = if failing.is_empty() {
+        "every parameter inside its bands".to_string()
+    } else {
+        format!("outside: {}", failing.join(", "))
+    };
+    Ok(StatusRow {
+        what: what.into(),
+        result: format!(
+            "{n} truths, {} ({detail})",
+            if pass { "passes" } else { "fails" }
+        ),
+        target: format!(">= {needed} truths, rank KS p > 0.01, coverage in 99% bands"),
+        verdict: Verdict::of(pass && n >= needed),
+        source: rel,
+    })
+}
+
+/// Whether one parameter of a coverage study passes: KS p > 0.01 and both coverages inside their
+/// expected bands.
+fn parameter_passes(p: &Value) -> bool {
+    let inside = |c: &str, band: &str| -> bool {
+        match (
+            p.get(c).and_then(Value::as_f64),
+            p.get(band).and_then(Value::as_array),
+        ) {
+            (Some(x), Some(b)) if b.len() == 2 => {
+                let lo = b[0].as_f64().unwrap_or(f64::NAN);
+                let hi = b[1].as_f64().unwrap_or(f64::NAN);
+                x >= lo && x <= hi
+            }
+            _ => false,
+        }
+    };
+    p.get("ks_p")
+        .and_then(Value::as_f64)
+        .is_some_and(|k| k > 0.01)
+        && inside("coverage_683", "expected_683")
+        && inside("coverage_955", "expected_955")
+}
+
+/// The default surrogate's held-out figures (`models/NAME.heldout.json`).
+fn heldout_row(root: &Path, model: &str) -> Result<StatusRow> {
+    let rel = model.replace(".safetensors", ".heldout.json");
+    let s = read_json(root, &rel)?;
+    let sigma = num(&s, &rel, "/rel_sigma")?;
+    let q99 = num(&s, &rel, "/abs_rel_q99")?;
+    let cov2 = num(&s, &rel, "/coverage_2sigma")?;
+    let n = num(&s, &rel, "/n")?;
+    let (ts, tq, tc) = HELDOUT_TARGET;
+    Ok(StatusRow {
+        what: "default surrogate on the held-out set".into(),
+        result: format!(
+            "sigma {}, q99 {}, coverage of 2 sigma {cov2:.3} ({n:.0} rows)",
+            pct(sigma),
+            pct(q99)
+        ),
+        target: format!(
+            "sigma <= {}, q99 <= {}, coverage in [{}, {}]",
+            pct(ts),
+            pct(tq),
+            tc[0],
+            tc[1]
+        ),
+        verdict: Verdict::of(sigma <= ts && q99 <= tq && cov2 >= tc[0] && cov2 <= tc[1]),
+        source: rel,
+    })
+}
+
+/// The field solver against grids 4x finer (`reports/accuracy/table.json`), judged by the
+/// tolerance it was run at.
+fn accuracy_row(root: &Path) -> Result<StatusRow> {
+    let rel = "reports/accuracy/table.json";
+    let s = read_json(root, rel)?;
+    let tol = num(&s, rel, "/settings/grid/tolerance")?;
+    let rows = s
+        .get("rows")
+        .and_then(Value::as_array)
+        .ok_or_else(|| Error::Content {
+            file: PathBuf::from(rel),
+            message: "no rows".into(),
+        })?;
+    let worst = rows
+        .iter()
+        .filter_map(|r| r.get("actual_rel").and_then(Value::as_f64))
+        .fold(0.0, f64::max);
+    let mut types: Vec<&str> = rows
+        .iter()
+        .filter_map(|r| r.get("detector").and_then(Value::as_str))
+        .collect();
+    types.sort_unstable();
+    types.dedup();
+    Ok(StatusRow {
+        what: "field solver: c12 against a 4x finer grid".into(),
+        result: format!(
+            "largest difference {} over {} points on {} detectors",
+            pct(worst),
+            rows.len(),
+            types.len()
+        ),
+        target: format!("<= the tolerance, {}", pct(tol)),
+        verdict: Verdict::of(worst <= tol),
+        source: rel.into(),
+    })
+}
+
+/// Every row, read from the results files under `root` (the repository); `model` is the default
+/// surrogate's file, relative to `root`.
+///
+/// # Errors
+/// A results file that is missing or lacks a number the table needs ([`Error::Read`],
+/// [`Error::Json`], [`Error::Content`], each naming the file).
+pub fn status_rows(root: &Path, model: &str) -> Result<Vec<StatusRow>> {
+    let (exact_n, surrogate_n) = COVERAGE_TRUTHS;
+    let mut rows = fit_rows(root, "b-rz", "main job (B_RZ fit)", true)?;
+    rows.extend(fit_rows(root, "b-z", "B_Z fit", false)?);
+    rows.push(coverage_row(
+        root,
+        "b-rz-exact",
+        "coverage, B_RZ, exact-solver data",
+        exact_n,
+    )?);
+    rows.push(coverage_row(
+        root,
+        "b-rz",
+        "coverage, B_RZ, surrogate data",
+        surrogate_n,
+    )?);
+    rows.push(coverage_row(
+        root,
+        "b-z",
+        "coverage, B_Z, surrogate data",
+        surrogate_n,
+    )?);
+    rows.push(heldout_row(root, model)?);
+    rows.push(accuracy_row(root)?);
+    rows.push(StatusRow {
+        what: "geometry".into(),
+        result:
+            "2D axisymmetric (r, z) field solver; the paper solves in 3D (SolidStateDetectors.jl)"
+                .into(),
+        target: "-".into(),
+        verdict: Verdict::Note,
+        source: "reports/solver-status.md".into(),
+    });
+    rows.push(StatusRow {
+        what: "GPU backend (wgpu)".into(),
+        result: "tested only on Mesa's software Vulkan (lavapipe), never on a hardware GPU".into(),
+        target: "-".into(),
+        verdict: Verdict::Note,
+        source: "reports/gpu-backend.md".into(),
+    });
+    Ok(rows)
+}
+
+/// The rows as a Markdown table, each source a link (relative to the README at the root).
+pub fn status_table(rows: &[StatusRow]) -> String {
+    let mut t = String::from("| what | result | target | status |\n|---|---|---|---|\n");
+    for r in rows {
+        t.push_str(&format!(
+            "| {} | {} ([source]({})) | {} | {} |\n",
+            r.what,
+            r.result,
+            r.source,
+            r.target,
+            r.verdict.as_str()
+        ));
+    }
+    t
+}
+
+/// The table between [`BEGIN`] and [`END`] in `text` (without the markers), if both are there.
+pub fn table_in(text: &str) -> Option<&str> {
+    let start = text.find(BEGIN)? + BEGIN.len();
+    let end = start + text[start..].find(END)?;
+    Some(text[start..end].trim_matches('\n'))
+}
+
+/// `text` with the table between the markers replaced by `table`.
+///
+/// # Errors
+/// [`Error::Content`] naming `file` when the markers are missing.
+pub fn with_table(text: &str, table: &str, file: &Path) -> Result<String> {
+    let start = text.find(BEGIN).map(|i| i + BEGIN.len());
+    let end = start.and_then(|s| text[s..].find(END).map(|e| s + e));
+    match (start, end) {
+        (Some(s), Some(e)) => Ok(format!(
+            "{}\n{}\n{}",
+            &text[..s],
+            table.trim_end_matches('\n'),
+            &text[e..]
+        )),
+        _ => Err(Error::Content {
+            file: file.to_path_buf(),
+            message: format!("no status table: the lines {BEGIN} and {END} are missing"),
+        }),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_table_is_replaced_between_the_markers_only() {
+        let text = format!("# title\n\n{BEGIN}\nold\n{END}\n\nrest\n");
+        let new = with_table(&text, "| a |\n", Path::new("R.md")).unwrap();
+        assert_eq!(table_in(&new), Some("| a |"));
+        assert!(new.starts_with("# title\n\n"));
+        assert!(new.ends_with(&format!("{END}\n\nrest\n")));
+        assert!(with_table("no markers", "x", Path::new("R.md")).is_err());
+    }
+
+    #[test]
+    fn a_coverage_parameter_outside_a_band_fails() {
+        let p = serde_json::json!({"ks_p": 0.5, "coverage_683": 0.6, "expected_683": [0.62, 0.74],
+            "coverage_955": 0.95, "expected_955": [0.92, 0.98]});
+        assert!(!parameter_passes(&p));
+        let q = serde_json::json!({"ks_p": 0.5, "coverage_683": 0.7, "expected_683": [0.62, 0.74],
+            "coverage_955": 0.95, "expected_955": [0.92, 0.98]});
+        assert!(parameter_passes(&q));
+    }
+}

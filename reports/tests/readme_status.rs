@@ -1,0 +1,24 @@
+//! The README's status table is the one the shipped results files give (`hpge-cv report status
+//! --write README.md` remakes it): a result that changes without the README fails here.
+
+use std::path::Path;
+
+use hpge_reports::status::{status_rows, status_table, table_in};
+
+#[test]
+fn readme_status_table_agrees_with_the_results_files() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let rows = status_rows(&root, hpge_inference::fit::DEFAULT_MODEL).unwrap();
+    let want = status_table(&rows);
+    let readme = std::fs::read_to_string(root.join("README.md")).unwrap();
+    let have = table_in(&readme).expect("README.md has no status table between the markers");
+    assert_eq!(
+        have.trim(),
+        want.trim(),
+        "README.md's status table is out of date: cargo run --release -- report status --write README.md"
+    );
+    // Every row's source exists.
+    for r in &rows {
+        assert!(root.join(&r.source).exists(), "{} is missing", r.source);
+    }
+}
