@@ -89,6 +89,10 @@ fn quick_report_makes_every_figure() {
     assert_eq!(json["version"], env!("CARGO_PKG_VERSION"));
     assert_eq!(json["steps"].as_array().unwrap().len(), 8);
     assert_eq!(json["figures"].as_array().unwrap().len(), 2 * QUICK.len());
+    // Every verdict follows from the criteria printed beside it.
+    let faults = hpge_reports::paper::inconsistent_rows(&json);
+    assert!(faults.is_empty(), "{faults:#?}");
+    assert!(readme.contains("| criterion | verdict |"));
     let _ = std::fs::remove_dir_all(out.parent().unwrap());
 }
 

@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 
 use hpge_measurement::{CvData, Data, load_data};
 
+use super::criterion::Judgement;
 use crate::error::{Error, Result};
 
 /// The shipped inputs the report reads (paths relative to the repository root).
@@ -28,6 +29,9 @@ pub struct Inputs {
     pub prior_bz: PathBuf,
     /// The prior of the B_RZ fit.
     pub prior_brz: PathBuf,
+    /// The exact solver's B_Z fit of the same data (a model discovery's `discovery.json`),
+    /// read where the surrogate's B_Z fit differs from the paper; optional.
+    pub exact_bz: PathBuf,
 }
 
 impl Default for Inputs {
@@ -42,6 +46,7 @@ impl Default for Inputs {
             fit_model: "models/super-siegfried-rz-split.safetensors".into(),
             prior_bz: "priors/b-z.toml".into(),
             prior_brz: "priors/b-rz.toml".into(),
+            exact_bz: "reports/discovery/super-siegfried/discovery.json".into(),
         }
     }
 }
@@ -70,6 +75,7 @@ impl Inputs {
             &self.fit_model,
             &self.prior_bz,
             &self.prior_brz,
+            &self.exact_bz,
         ]
     }
 }
@@ -85,8 +91,15 @@ pub struct Row {
     pub statement: String,
     /// This run's numbers.
     pub ours: String,
-    /// "agrees", "differs (why)" or "not run (why)".
-    pub verdict: String,
+    /// The verdict and the criteria it is derived from.
+    pub judgement: Judgement,
+}
+
+impl Row {
+    /// The verdict's text ([`Judgement::verdict`]).
+    pub fn verdict(&self) -> String {
+        self.judgement.verdict()
+    }
 }
 
 /// What a run collects: its rows, figure files, step times and numbers for report.json.
@@ -159,27 +172,30 @@ impl Ctx {
     }
 
     /// Adds a README row.
-    pub fn row(&mut self, stem: &str, paper: &str, statement: &str, ours: String, verdict: String) {
+    pub fn row(
+        &mut self,
+        stem: &str,
+        paper: &str,
+        statement: &str,
+        ours: String,
+        judgement: Judgement,
+    ) {
         self.rows.push(Row {
             stem: stem.into(),
             paper: paper.into(),
             statement: statement.into(),
             ours,
-            verdict,
+            judgement,
         });
+    }
+
+    /// A number recorded by an earlier step: `numbers[key][field]`.
+    pub fn recorded(&self, key: &str, field: &str) -> Option<f64> {
+        self.numbers.get(key)?.get(field)?.as_f64()
     }
 
     /// Records a number for report.json.
     pub fn number(&mut self, key: &str, v: serde_json::Value) {
         self.numbers.insert(key.into(), v);
-    }
-}
-
-/// "agrees" when `ok`, else "differs (`why`)".
-pub fn verdict(ok: bool, why: &str) -> String {
-    if ok {
-        "agrees".into()
-    } else {
-        format!("differs ({why})")
     }
 }

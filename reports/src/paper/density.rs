@@ -6,7 +6,8 @@ use hpge_solver::impurity::LogTransform;
 use hpge_solver::{Detector, Parameters};
 use serde_json::json;
 
-use super::ctx::{Ctx, verdict};
+use super::criterion::{Cmp, Criterion, Judgement};
+use super::ctx::Ctx;
 use crate::error::Result;
 use crate::plot::{self, Corner, Curve, LineFigure};
 
@@ -30,7 +31,10 @@ pub fn run(ctx: &mut Ctx) -> Result<()> {
             det.contacts.len(),
             det.passives.len()
         ),
-        "agrees (same detector description; the paper's 3D holder is modelled in r-z)".into(),
+        Judgement::Shown(
+            "the detector description the solver uses; the paper's 3D holder is modelled in r-z"
+                .into(),
+        ),
     );
     Ok(())
 }
@@ -81,9 +85,12 @@ fn transform(ctx: &mut Ctx) -> Result<()> {
             t.x_of_y(1.0),
             t.zeta_cm3_of_y(0.001)
         ),
-        verdict(
-            (z_l / 1e8 - 1.0).abs() < 1e-3 && (z_u / 1e11 - 1.0).abs() < 1e-9,
-            "the bounds do not map to 1e8 and 1e11",
+        Judgement::by(
+            vec![
+                Criterion::new("|zeta(y_l) / 1e8 cm^-3 - 1|", (z_l / 1e8 - 1.0).abs(), Cmp::Lt, 1e-3),
+                Criterion::new("|zeta(1) / 1e11 cm^-3 - 1|", (z_u / 1e11 - 1.0).abs(), Cmp::Lt, 1e-9),
+            ],
+            "",
         ),
     );
     ctx.number(
@@ -169,7 +176,11 @@ fn example(ctx: &mut Ctx) -> Result<()> {
         bulk, mantle_bot, mantle_top
     );
     let statement = "With p_zeta,E the bulk is n-type and the volume near the mantle p-type (the model allows a type boundary).";
-    let ok = bulk > 0.0 && mantle_bot < 0.0 && mantle_top < 0.0;
+    let criteria = vec![
+        Criterion::new("zeta(20 mm, mid-height) (cm^-3)", bulk, Cmp::Gt, 0.0),
+        Criterion::new("zeta(37.5 mm, bottom) (cm^-3)", mantle_bot, Cmp::Lt, 0.0),
+        Criterion::new("zeta(37.5 mm, top) (cm^-3)", mantle_top, Cmp::Lt, 0.0),
+    ];
     for (stem, paper) in [
         ("example-density-z", "Fig. 15a (sec. 6)"),
         ("example-density-r", "Fig. 15b (sec. 6)"),
@@ -183,7 +194,7 @@ fn example(ctx: &mut Ctx) -> Result<()> {
             paper,
             statement,
             ours.clone(),
-            verdict(ok, "the signs differ"),
+            Judgement::by(criteria.clone(), ""),
         );
     }
     ctx.number(

@@ -8,6 +8,7 @@
 //! - [`samples`]: Fig. 16, the distributions of the training and test samples.
 //! - [`surrogate`]: Figs. 17-19, the learning curves and held-out errors of the surrogate.
 //! - [`readme`]: `README.md` and `report.json` of a run.
+//! - [`criterion`]: the numeric criteria each verdict is derived from.
 //! - [`models`]: the impurity models of section 9 as detectors (the manufacturer's model and the
 //!   global modes of fits).
 //!
@@ -19,6 +20,7 @@
 //! [`run_paper`] runs the steps in order; [`Ctx`] carries a run's state between them;
 //! [`PaperOptions`] are the options a user gives it.
 
+pub mod criterion;
 pub mod ctx;
 pub mod cv;
 pub mod density;
@@ -33,7 +35,8 @@ pub mod section9_compute;
 pub mod sensitivity;
 pub mod surrogate;
 
-pub use ctx::{Ctx, Inputs, Row, verdict};
+pub use criterion::{Cmp, Criterion, Judgement, inconsistent_rows};
+pub use ctx::{Ctx, Inputs, Row};
 pub use models::{ModeDetectors, NamedModel};
 pub use options::{PAPER_OUT, PaperOptions, SECTION9_OUT, Section9Options};
 pub use run::{PaperRun, run_paper};

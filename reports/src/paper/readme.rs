@@ -7,6 +7,7 @@ use std::path::PathBuf;
 use hpge_surrogate::hash::fnv1a;
 use serde_json::json;
 
+use super::criterion::{Criterion, Judgement};
 use super::ctx::Ctx;
 use crate::error::{Error, Result};
 
@@ -54,37 +55,35 @@ pub fn write(ctx: &Ctx, total_s: f64) -> Result<PathBuf> {
     )?;
     writeln!(
         t,
-        "| figure | paper | the paper says | this run | verdict |\n|---|---|---|---|---|"
+        "| figure | paper | the paper says | this run | criterion | verdict |\n|---|---|---|---|---|---|"
     )?;
     for r in &ctx.rows {
-        let link = if r.verdict.starts_with("not run") {
+        let link = if matches!(r.judgement, Judgement::NotRun(_)) {
             format!("`{}`", r.stem)
         } else {
             format!("[{0}](figures/{0}.png) ([svg](figures/{0}.svg))", r.stem)
         };
         writeln!(
             t,
-            "| {link} | {} | {} | {} | {} |",
+            "| {link} | {} | {} | {} | {} | {} |",
             cell(&r.paper),
             cell(&r.statement),
             cell(&r.ours),
-            cell(&r.verdict)
+            cell(&r.judgement.criteria_text()),
+            cell(&r.verdict())
         )?;
     }
-    let agree = ctx
-        .rows
-        .iter()
-        .filter(|r| r.verdict.starts_with("agrees"))
-        .count();
-    let differ = ctx
-        .rows
-        .iter()
-        .filter(|r| r.verdict.starts_with("differs"))
-        .count();
+    let count =
+        |f: &dyn Fn(&Judgement) -> bool| ctx.rows.iter().filter(|r| f(&r.judgement)).count();
     writeln!(
         t,
-        "\n{agree} rows agree, {differ} differ, {} not run.\n",
-        ctx.rows.len() - agree - differ
+        "\n{} rows agree, {} differ, {} are shown without a numeric statement, {} not run. A verdict \
+         agrees when every criterion beside it holds; a row that differs names the criteria that \
+         fail.\n",
+        count(&|j| j.agrees() == Some(true)),
+        count(&|j| j.agrees() == Some(false)),
+        count(&|j| matches!(j, Judgement::Shown(_))),
+        count(&|j| matches!(j, Judgement::NotRun(_))),
     )?;
     writeln!(t, "Not made: {NOT_MADE}.\n")?;
     writeln!(t, "## Settings\n")?;
@@ -134,7 +133,7 @@ pub fn write(ctx: &Ctx, total_s: f64) -> Result<PathBuf> {
         "quick": ctx.quick,
         "exact_check": ctx.exact_check,
         "inputs": ctx.inputs.all().iter().map(|p| json!({"file": p.display().to_string(), "hash": hash(p)})).collect::<Vec<_>>(),
-        "rows": ctx.rows.iter().map(|r| json!({"figure": r.stem, "paper": r.paper, "statement": r.statement, "ours": r.ours, "verdict": r.verdict})).collect::<Vec<_>>(),
+        "rows": ctx.rows.iter().map(|r| json!({"figure": r.stem, "paper": r.paper, "statement": r.statement, "ours": r.ours, "criteria": r.judgement.criteria().iter().map(Criterion::json).collect::<Vec<_>>(), "agrees": r.judgement.agrees(), "verdict": r.verdict()})).collect::<Vec<_>>(),
         "figures": ctx.files.iter().map(|p| p.display().to_string()).collect::<Vec<_>>(),
         "steps": ctx.steps.iter().map(|(n, s)| json!({"step": n, "seconds": s})).collect::<Vec<_>>(),
         "total_seconds": total_s,

@@ -86,7 +86,7 @@ pub fn run_paper(
         figures: ctx
             .rows
             .iter()
-            .filter(|r| !r.verdict.starts_with("not run"))
+            .filter(|r| !matches!(r.judgement, super::Judgement::NotRun(_)))
             .count(),
         files: ctx.files.len(),
         figures_dir: ctx.figures.clone(),

@@ -5,7 +5,7 @@ use hpge_solver::scan::sensitivity_scan;
 use hpge_solver::{Detector, FieldSettings, Parameters};
 use serde_json::json;
 
-use super::{Ctx, verdict};
+use super::{Cmp, Criterion, Ctx, Judgement};
 use crate::{Error, Result, plot};
 
 pub const STEM: &str = "sensitivity-25V";
@@ -51,18 +51,22 @@ pub fn run(ctx: &mut Ctx) -> Result<()> {
         p11.c12_pf,
         c_m
     );
-    let ok = p8.fully_depleted && near_limit < 0.01 && p11.c12_pf > 1.5 * c_m;
-    let why = if !p8.fully_depleted || near_limit >= 0.01 {
-        "here a constant 1e8 cm^-3 is not yet depleted at 25 V: c12 is still well above its limit, so the insensitive range ends lower than the paper's zeta_l"
+    let criteria = vec![
+        Criterion::flag("1e8 cm^-3 fully depleted at 25 V", p8.fully_depleted, true),
+        Criterion::new("c12(1e8) / c12(1e7) - 1", near_limit, Cmp::Lt, 0.01),
+        Criterion::new("c12(1e11) / c12^m(25 V)", p11.c12_pf / c_m, Cmp::Gt, 1.5),
+    ];
+    let reading = if !p8.fully_depleted || near_limit >= 0.01 {
+        "here a constant 1e8 cm^-3 does not yet deplete the detector at 25 V: c12 is still above its 1e7 value, so the insensitive range ends lower than the paper's zeta_l"
     } else {
-        "c12 at 1e11 cm^-3 is not far above the data at 25 V"
+        ""
     };
     ctx.row(
         STEM,
         "Fig. 13 (sec. 6)",
         "At 25 V (d_Li = 1 mm) a constant 1e8 cm^-3 already depletes the detector (c12 ~ its limit), 1e11 gives c12 far above the measured value; between them c12 changes linearly in log zeta.",
         ours,
-        verdict(ok, why),
+        Judgement::by(criteria, reading),
     );
     ctx.number(
         "sensitivity",
