@@ -1,9 +1,11 @@
 //! Probe for issue 21: replays one refinement round of a fit offline. Reads the exact curves a
 //! fit's rounds solved (`FITDIR/rounds/round-K.json`), fits the error model to the curves of
-//! rounds 0..T (as round T + 1 did), and scores it on the check draws of round T + 1: the
-//! log-ratios ln L_exact - ln L_corrected that the check re-weights with, their PSIS k-hat and
-//! ESS, the shift of each mean, and the error model's calibration there. No exact solve.
-//! `cargo run --release -p hpge-validation --example refine_replay -- FITDIR T [EVALS]`
+//! the rounds TRAIN (a comma list; round T + 1 of the fit used 0,..,T), and scores it on the
+//! check draws of round TEST: the log-ratios ln L_exact - ln L_corrected that the check
+//! re-weights with, their PSIS k-hat and ESS, the shift of each mean, and the error model's
+//! calibration there. No exact solve. With EXTRA, also the error models of TRAIN plus 5, 10,
+//! 20 and 40 curves of round EXTRA's check.
+//! `cargo run --release -p hpge-validation --example refine_replay -- FITDIR TRAIN TEST [EVALS [EXTRA]]`
 
 use hpge_inference::CvModel;
 use hpge_inference::fit::{
@@ -18,9 +20,18 @@ type Curves = Vec<(Vec<f64>, Vec<f64>)>;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let dir = std::path::PathBuf::from(args.first().ok_or("usage: FITDIR T [EVALS]")?);
-    let t: usize = args.get(1).ok_or("T")?.parse()?;
-    let evals: usize = args.get(2).map_or(Ok(600), |a| a.parse())?;
+    let dir = std::path::PathBuf::from(
+        args.first()
+            .ok_or("usage: FITDIR TRAIN TEST [EVALS [EXTRA]]")?,
+    );
+    let train_rounds: Vec<usize> = args
+        .get(1)
+        .ok_or("TRAIN")?
+        .split(',')
+        .map(str::parse)
+        .collect::<Result<_, _>>()?;
+    let test: usize = args.get(2).ok_or("TEST")?.parse()?;
+    let evals: usize = args.get(3).map_or(Ok(600), |a| a.parse())?;
     let files = FitFiles {
         data: repo_path(DEFAULT_DATA),
         model: repo_path(DEFAULT_MODEL),
@@ -33,10 +44,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         Ok(serde_json::from_str(&std::fs::read_to_string(p)?)?)
     };
     let mut train: Curves = Vec::new();
-    for k in 0..=t {
+    for &k in &train_rounds {
         train.extend(read(k)?.solved);
     }
-    let next = read(t + 1)?;
+    let next = read(test)?;
     let draws: Curves = next.solved[..next.check.draws - next.check.failed].to_vec();
     let nv = job.data.voltage_v.len();
     let sm = &job.surrogate;
@@ -62,16 +73,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .ok_or("no training curve")?;
     let gp = GpCorrection::fit(&xs, &rs, None, evals)?;
     println!(
-        "train {} curves (rounds 0..={t}), test {} draws of round {}; hyper {:?}",
+        "train {} curves (rounds {train_rounds:?}), test {} draws of round {test}; hyper {:?}",
         xs.len(),
         draws.len(),
-        t + 1,
         gp.hyper
     );
     report("as fitted", &job, &draws, &gp, &best);
     // Round 0 plus K curves from a later round's check (near the exact posterior), every
     // STRIDE-th: how much a few curves where the next round samples would help.
-    if let Some(extra_round) = args.get(3) {
+    if let Some(extra_round) = args.get(4) {
         let extra = read(extra_round.parse()?)?;
         for k in [5usize, 10, 20, 40] {
             let stride = (extra.check.draws / k).max(1);
