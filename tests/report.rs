@@ -21,8 +21,9 @@ fn scratch(name: &str) -> PathBuf {
 }
 
 /// The figures a quick run draws.
-const QUICK: [&str; 12] = [
+const QUICK: [&str; 13] = [
     "cv-data-vs-manufacturer",
+    "depletion-volumes",
     "sensitivity-25V",
     "transform",
     "example-density-z",
@@ -58,7 +59,7 @@ fn quick_report_makes_every_figure() {
     let o = run(&["report", "paper", "--quick", "--out", out.to_str().unwrap()]);
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success(), "{err}");
-    assert!(err.contains("step 8/8"), "no progress on stderr: {err}");
+    assert!(err.contains("step 9/9"), "no progress on stderr: {err}");
     for stem in QUICK {
         for ext in ["svg", "png"] {
             let p = out.join("figures").join(format!("{stem}.{ext}"));
@@ -87,7 +88,7 @@ fn quick_report_makes_every_figure() {
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
     assert_eq!(json["version"], env!("CARGO_PKG_VERSION"));
-    assert_eq!(json["steps"].as_array().unwrap().len(), 8);
+    assert_eq!(json["steps"].as_array().unwrap().len(), 9);
     assert_eq!(json["figures"].as_array().unwrap().len(), 2 * QUICK.len());
     // Every verdict follows from the criteria printed beside it.
     let faults = hpge_reports::paper::inconsistent_rows(&json);

@@ -233,6 +233,11 @@ struct SimulateArgs {
     /// Where to draw the potential at --field (.svg or .png).
     #[arg(long = "field-plot", value_name = "FILE")]
     field_plot: Option<PathBuf>,
+    /// Draw the undepleted volume at the curve's biases as shaded bands (the paper's Fig. 11;
+    /// at most 13 of the listed voltages, evenly chosen, the first and last included; .svg or
+    /// .png).
+    #[arg(long = "depletion-plot", value_name = "FILE")]
+    depletion_plot: Option<PathBuf>,
 }
 
 #[derive(Debug, clap::Args)]
@@ -349,6 +354,7 @@ pub fn run(cli: Cli) -> Result<()> {
                 plot: a.plot.as_ref(),
                 field: a.field,
                 field_plot: a.field_plot.as_ref(),
+                depletion_plot: a.depletion_plot.as_ref(),
             })
         }
         Command::Sensitivity(a) => sensitivity::run(&sensitivity::SensitivityOptions {

@@ -28,12 +28,16 @@ pub struct SimulateOptions<'a> {
     pub plot: Option<&'a PathBuf>,
     pub field: Option<f64>,
     pub field_plot: Option<&'a PathBuf>,
+    pub depletion_plot: Option<&'a PathBuf>,
 }
 
 /// Runs a C-V curve and writes what was asked for.
 pub fn run(o: &SimulateOptions<'_>) -> Result<()> {
     if let Some(p) = o.plot {
         plot::check_output(p, "--plot")?;
+    }
+    if let Some(p) = o.depletion_plot {
+        plot::check_output(p, "--depletion-plot")?;
     }
     if let Some(p) = o.field_plot {
         plot::check_output(p, "--field-plot")?;
@@ -156,6 +160,14 @@ pub fn run(o: &SimulateOptions<'_>) -> Result<()> {
     if let (Some(u), Some(path)) = (o.field, o.field_plot) {
         let p = solve_potential(&det, u, &settings, None)?;
         plot::field_map(&det, &p, None, path)?;
+    }
+    if let Some(path) = o.depletion_plot {
+        let states =
+            depletion_biases(&curve.points.iter().map(|p| p.voltage_v).collect::<Vec<_>>())
+                .into_iter()
+                .map(|u| solve_potential(&det, u, &settings, None))
+                .collect::<std::result::Result<Vec<_>, _>>()?;
+        plot::depletion_map(&det, &states, path)?;
     }
     let pinch_off_v = curve_pinch_off_voltage(&det, &curve, &settings)?;
     let last = curve.points.last().map_or((0, 0), |p| p.grid);
@@ -351,4 +363,37 @@ pub fn capacitance(
         );
     }
     Ok(())
+}
+
+/// At most 13 of `voltages` (sorted, duplicates removed), evenly chosen, the first and the last
+/// included: the biases of `--depletion-plot`.
+fn depletion_biases(voltages: &[f64]) -> Vec<f64> {
+    const MAX: usize = 13;
+    let mut v = voltages.to_vec();
+    v.sort_by(f64::total_cmp);
+    v.dedup();
+    if v.len() <= MAX {
+        return v;
+    }
+    let n = v.len() - 1;
+    let mut out: Vec<f64> = (0..MAX)
+        .map(|k| v[(k * n + (MAX - 1) / 2) / (MAX - 1)])
+        .collect();
+    out.dedup();
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::depletion_biases;
+
+    #[test]
+    fn depletion_biases_keep_the_ends_and_at_most_13() {
+        let v: Vec<f64> = (0..60).map(|k| 25.0 + 50.0 * k as f64).collect();
+        let b = depletion_biases(&v);
+        assert_eq!(b.len(), 13);
+        assert_eq!((b[0], b[12]), (25.0, 2975.0));
+        assert!(b.windows(2).all(|w| w[1] > w[0]));
+        assert_eq!(depletion_biases(&[300.0, 100.0, 100.0]), vec![100.0, 300.0]);
+    }
 }

@@ -30,7 +30,7 @@ pub struct Inputs {
     /// The prior of the B_RZ fit.
     pub prior_brz: PathBuf,
     /// The exact solver's B_Z fit of the same data (a model discovery's `discovery.json`),
-    /// read where the surrogate's B_Z fit differs from the paper; optional.
+    /// read where the surrogate's B_Z fit differs from the paper.
     pub exact_bz: PathBuf,
 }
 

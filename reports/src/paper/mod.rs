@@ -3,6 +3,7 @@
 //! the paper's statements.
 //!
 //! - [`cv`]: Fig. 12, the C-V curve of the manufacturer's model against the data.
+//! - [`depletion`]: Fig. 11, the undepleted volume at biases in steps of 250 V.
 //! - [`density`]: Figs. 14 and 15 and the cross-sections (Fig. 9): the parameter transform, the
 //!   example density along z and r, the detector with both impurity models.
 //! - [`samples`]: Fig. 16, the distributions of the training and test samples.
@@ -24,6 +25,7 @@ pub mod criterion;
 pub mod ctx;
 pub mod cv;
 pub mod density;
+pub mod depletion;
 pub mod fits;
 pub mod models;
 mod options;

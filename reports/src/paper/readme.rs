@@ -14,8 +14,8 @@ use crate::error::{Error, Result};
 /// The paper's figures this report does not make, and why.
 const NOT_MADE: &str = "Figs. 1-4 and 6 (schemes and photographs), 5 and 7 (pulser pulses and \
 Q_t spectra of the measurement: `hpge-cv measure --plot` draws them for the stand-in data), 8b \
-(the data's -dc12/dU_B; its 1e-3 pF/V crossing is quoted in the C-V row), 10 (the lithium \
-contact's modelling) and 11 (undepleted volumes per bias: `simulate --field-plot` draws one bias)";
+(the data's -dc12/dU_B; its 1e-3 pF/V crossing is quoted in the C-V row) and 10 (the lithium \
+contact's modelling)";
 
 fn hash(path: &std::path::Path) -> String {
     std::fs::read(path).map_or_else(|_| "?".into(), |b| format!("{:016x}", fnv1a(&b)))

@@ -4,7 +4,9 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use super::{Ctx, Inputs, cv, density, fits, readme, samples, section9, sensitivity, surrogate};
+use super::{
+    Ctx, Inputs, cv, density, depletion, fits, readme, samples, section9, sensitivity, surrogate,
+};
 use crate::fit::FitObserver;
 use crate::{Error, Result};
 
@@ -25,8 +27,9 @@ pub struct PaperRun {
 type StepFn = fn(&mut Ctx) -> Result<()>;
 
 /// The steps in order, with their names.
-const STEPS: [(&str, StepFn); 8] = [
+const STEPS: [(&str, StepFn); 9] = [
     ("C-V curve: manufacturer model vs data", cv::run),
+    ("undepleted volumes by bias", depletion::run),
     ("sensitivity scan at 25 V", sensitivity::run),
     ("transform, example density, cross-sections", density::run),
     ("training-sample histograms", samples::run),

@@ -58,6 +58,27 @@ pub fn density_color(zeta_cm3: f64, levels: usize) -> RGBColor {
     t_color(density_to_t(zeta_cm3), levels)
 }
 
+/// A perceptually ordered map (viridis anchors) for t in [0, 1].
+pub(super) fn viridis(t: f64) -> RGBColor {
+    const A: [(f64, [u8; 3]); 5] = [
+        (0.0, [68, 1, 84]),
+        (0.25, [59, 82, 139]),
+        (0.5, [33, 145, 140]),
+        (0.75, [94, 201, 98]),
+        (1.0, [253, 231, 37]),
+    ];
+    let t = t.clamp(0.0, 1.0);
+    let i = A
+        .windows(2)
+        .position(|w| t <= w[1].0)
+        .unwrap_or(A.len() - 2);
+    let (t0, c0) = A[i];
+    let (t1, c1) = A[i + 1];
+    let f = (t - t0) / (t1 - t0);
+    let m = |k: usize| (c0[k] as f64 + f * (c1[k] as f64 - c0[k] as f64)).round() as u8;
+    RGBColor(m(0), m(1), m(2))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

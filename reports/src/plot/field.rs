@@ -7,29 +7,9 @@ use hpge_solver::field::PotentialPoint;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+use super::colormap::viridis;
 use super::style::err;
 use crate::error::Result;
-
-/// A perceptually ordered map (viridis anchors) for t in [0, 1].
-fn viridis(t: f64) -> RGBColor {
-    const A: [(f64, [u8; 3]); 5] = [
-        (0.0, [68, 1, 84]),
-        (0.25, [59, 82, 139]),
-        (0.5, [33, 145, 140]),
-        (0.75, [94, 201, 98]),
-        (1.0, [253, 231, 37]),
-    ];
-    let t = t.clamp(0.0, 1.0);
-    let i = A
-        .windows(2)
-        .position(|w| t <= w[1].0)
-        .unwrap_or(A.len() - 2);
-    let (t0, c0) = A[i];
-    let (t1, c1) = A[i + 1];
-    let f = (t - t0) / (t1 - t0);
-    let m = |k: usize| (c0[k] as f64 + f * (c1[k] as f64 - c0[k] as f64)).round() as u8;
-    RGBColor(m(0), m(1), m(2))
-}
 
 /// Colour of trapped-carrier pockets.
 const POCKET: RGBColor = RGBColor(240, 120, 20);
