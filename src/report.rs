@@ -20,6 +20,15 @@ enum ReportKind {
     /// The status table of the README, derived from the shipped results files (fits, coverage
     /// studies, the default surrogate's held-out figures, the solver's accuracy).
     Status(StatusArgs),
+    /// Draws a coverage study's figures again from its coverage.json (the study is not run).
+    Coverage(CoverageArgs),
+}
+
+/// `report coverage`.
+#[derive(Debug, clap::Args)]
+struct CoverageArgs {
+    /// The study's folder (holding coverage.json), e.g. reports/coverage/b-rz.
+    dir: std::path::PathBuf,
 }
 
 /// `report status`.
@@ -38,6 +47,13 @@ pub fn run(a: &ReportArgs) -> Result<()> {
     match &a.what {
         ReportKind::Paper(p) => paper(p),
         ReportKind::Status(s) => status(s),
+        ReportKind::Coverage(c) => {
+            let files = hpge_reports::plot::redraw_coverage(&c.dir)?;
+            for f in files {
+                println!("{}", f.display());
+            }
+            Ok(())
+        }
     }
 }
 

@@ -66,7 +66,13 @@ pub fn run(o: &SensitivityOptions<'_>) -> Result<()> {
         }
     }
     if let Some(path) = o.plot {
-        plot::sensitivity(&points, o.voltage_v, &det.name, path)?;
+        plot::sensitivity(
+            &points,
+            o.voltage_v,
+            &det.name,
+            &plot::ScanMarks::sensitive_range(),
+            path,
+        )?;
     }
     if o.json {
         let v = json!({

@@ -151,7 +151,7 @@ pub fn coverage(o: &CoverageOptions, as_json: bool) -> Result<()> {
     hpge_reports::plot::coverage_figures(
         &out.join("figures"),
         &report,
-        &format!("{} coverage", o.prior.display()),
+        &hpge_reports::plot::coverage_title(&o.prior.display().to_string(), o.data_from()),
     )?;
     if as_json {
         // The fields first: n_truths, parameters (name, ks_p, coverage_683,

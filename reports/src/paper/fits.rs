@@ -36,7 +36,7 @@ const BRZ_FIGS: [(&str, &str, &str); 5] = [
 ];
 
 /// The paper's manufacturer levels (cm^-3) at the bottom and the top.
-const ZETA_M: (f64, f64) = (1.3e10, 0.44e10);
+pub(super) const ZETA_M: (f64, f64) = (1.3e10, 0.44e10);
 
 pub(super) fn fit_dir(ctx: &Ctx, key: &str) -> PathBuf {
     ctx.out.join("fits").join(key)

@@ -25,8 +25,31 @@ pub fn run(ctx: &mut Ctx) -> Result<()> {
     p.set("d_li_mm".to_string(), 1.0);
     let det = Detector::from_file(&ctx.inputs.detector, &p)?;
     let points = sensitivity_scan(&det, VOLTAGE_V, &zetas, &FieldSettings::default(), &|_| {})?;
+    let data = ctx.inputs.data_curve()?;
+    let c_m = data
+        .voltage_v
+        .iter()
+        .position(|&u| (u - VOLTAGE_V).abs() < 1e-9)
+        .map_or(f64::NAN, |i| data.c12_pf[i]);
+    // As the paper's figure: the sensitive range, the manufacturer's levels and the data.
+    let mut marks = plot::ScanMarks::sensitive_range();
+    for (label, z) in [
+        ("bottom", super::fits::ZETA_M.0),
+        ("top", super::fits::ZETA_M.1),
+    ] {
+        marks.densities.push(plot::Mark {
+            label: format!("manufacturer's level, {label} ({z:.2e} cm^-3)"),
+            value: z,
+        });
+    }
+    if c_m.is_finite() {
+        marks.capacitances.push(plot::Mark {
+            label: format!("data c12^m({VOLTAGE_V:.0} V) = {c_m:.0} pF"),
+            value: c_m,
+        });
+    }
     ctx.both(STEM, |path| {
-        plot::sensitivity(&points, VOLTAGE_V, &det.name, path)
+        plot::sensitivity(&points, VOLTAGE_V, &det.name, &marks, path)
     })?;
     let at = |z: f64| {
         points
@@ -35,12 +58,6 @@ pub fn run(ctx: &mut Ctx) -> Result<()> {
             .ok_or_else(|| Error::invalid("a density of the scan is missing"))
     };
     let (p7, p8, p11) = (at(1e7)?, at(1e8)?, at(1e11)?);
-    let data = ctx.inputs.data_curve()?;
-    let c_m = data
-        .voltage_v
-        .iter()
-        .position(|&u| (u - VOLTAGE_V).abs() < 1e-9)
-        .map_or(f64::NAN, |i| data.c12_pf[i]);
     let near_limit = (p8.c12_pf / p7.c12_pf - 1.0).abs();
     let ours = format!(
         "c12(1e7) = {:.2} pF, c12(1e8) = {:.2} pF ({:+.2}%, fully depleted: {}); c12(1e11) = {:.0} pF vs data c12^m(25 V) = {:.0} pF",

@@ -289,6 +289,46 @@ fn rank_panel<DB: DrawingBackend>(
     Ok(())
 }
 
+/// The title of a study's figures: its prior and where its data came from.
+pub fn coverage_title(prior: &str, data_from: &str) -> String {
+    match data_from {
+        "exact" => format!("{prior} coverage, exact-solver data"),
+        "" => format!("{prior} coverage"),
+        other => format!("{prior} coverage, {other} data"),
+    }
+}
+
+/// Draws the figures of the study in `dir` again from its `coverage.json` (into
+/// `dir/figures`), e.g. after a change of the figures; the study itself is not run.
+///
+/// # Errors
+/// A missing or unreadable `coverage.json` (named), and every error of [`coverage_figures`].
+pub fn redraw_coverage(dir: &Path) -> Result<Vec<PathBuf>> {
+    let file = dir.join("coverage.json");
+    let text = std::fs::read_to_string(&file).map_err(|source| crate::Error::Read {
+        file: file.clone(),
+        what: "a coverage study's results",
+        source,
+    })?;
+    let v: serde_json::Value =
+        serde_json::from_str(&text).map_err(|source| crate::Error::Json {
+            file: file.clone(),
+            what: "not JSON",
+            source,
+        })?;
+    let report: CoverageReport =
+        serde_json::from_value(v.clone()).map_err(|source| crate::Error::Json {
+            file: file.clone(),
+            what: "not a coverage study's coverage.json",
+            source,
+        })?;
+    let title = coverage_title(
+        v["inputs"]["prior"].as_str().unwrap_or("?"),
+        v["data_from"].as_str().unwrap_or(""),
+    );
+    coverage_figures(&dir.join("figures"), &report, &title)
+}
+
 /// Coverage against nominal level, per parameter, over the diagonal and its band.
 fn coverage<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
@@ -296,8 +336,25 @@ fn coverage<DB: DrawingBackend>(
     title: &str,
 ) -> Result<()> {
     root.fill(&WHITE).map_err(err)?;
-    let verdict = if report.pass { "PASS" } else { "FAIL" };
-    let mut sub = format!("n = {} truths, L = {}", report.n_truths, report.ranks);
+    // The verdict per parameter, in the title and the legend.
+    let d = report.parameters.len();
+    let failures: Vec<Vec<String>> = report.parameters.iter().map(|p| p.failures(d)).collect();
+    let failing: Vec<&str> = report
+        .parameters
+        .iter()
+        .zip(&failures)
+        .filter(|(_, f)| !f.is_empty())
+        .map(|(p, _)| p.name.as_str())
+        .collect();
+    let verdict = if failing.is_empty() {
+        format!("all {d} parameters pass")
+    } else {
+        format!("{} of {d} parameters pass (legend: why)", d - failing.len())
+    };
+    let mut sub = format!(
+        "{verdict}; n = {} truths, L = {}",
+        report.n_truths, report.ranks
+    );
     if report.unconverged > 0 {
         sub += &format!(", {} unconverged", report.unconverged);
     }
@@ -306,7 +363,7 @@ fn coverage<DB: DrawingBackend>(
     }
     let root = root
         .titled(
-            &format!("{title}: coverage of the smallest intervals, {verdict}"),
+            &format!("{title}: coverage of the smallest intervals"),
             ("sans-serif", 24),
         )
         .map_err(err)?;
@@ -377,7 +434,11 @@ fn coverage<DB: DrawingBackend>(
         chart
             .draw_series(LineSeries::new(pts.clone(), c.stroke_width(2)))
             .map_err(err)?
-            .label(p.name.clone())
+            .label(if failures[k].is_empty() {
+                format!("{}: pass", p.name)
+            } else {
+                format!("{}: {}", p.name, failures[k].join("; "))
+            })
             .legend(move |(x, y)| {
                 EmptyElement::at((x, y))
                     + PathElement::new(vec![(0, 0), (20, 0)], c.stroke_width(2))

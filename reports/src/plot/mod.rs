@@ -25,7 +25,7 @@ pub(crate) mod style;
 mod surrogate;
 
 pub use convergence::convergence;
-pub use coverage::coverage_figures;
+pub use coverage::{coverage_figures, coverage_title, redraw_coverage};
 pub use cross_section::cross_section;
 pub use cv::cv_curve;
 pub use depletion::{DepletionBands, depleted_from, depletion_bands, depletion_map};
@@ -35,5 +35,5 @@ pub use fit::{ZetaAtMode, ZetaProfile, fit_figures};
 pub use format::{Format, check_output};
 pub use lines::{Corner, Curve, LineFigure, line_figure};
 pub use measure::measurement;
-pub use sensitivity::sensitivity;
+pub use sensitivity::{Mark, ScanMarks, sensitivity};
 pub use surrogate::{learning_curves, surrogate_errors};

@@ -13,7 +13,7 @@ use std::time::Instant;
 use hpge_inference::{Likelihood, Prior};
 use hpge_surrogate::Shard;
 use rayon::prelude::*;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 mod settings;
 pub mod store;
@@ -27,7 +27,7 @@ use truth::fit_truth;
 use crate::error::Result;
 
 /// One parameter's calibration.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ParameterCoverage {
     /// Name.
     pub name: String,
@@ -47,8 +47,34 @@ pub struct ParameterCoverage {
     pub ranks: Vec<usize>,
 }
 
+impl ParameterCoverage {
+    /// The tests this parameter fails in a study of `d` parameters (empty: it passes): the
+    /// rank KS test at p > 0.01 / d, and the 68.3% and 95.5% coverages inside their 99%
+    /// binomial bands. The study passes when no parameter fails one.
+    pub fn failures(&self, d: usize) -> Vec<String> {
+        let mut f = Vec::new();
+        let limit = 0.01 / d.max(1) as f64;
+        // NaN fails.
+        if self.ks_p.is_nan() || self.ks_p <= limit {
+            f.push(format!("rank KS p {:.2e} < {limit:.1e}", self.ks_p));
+        }
+        for (level, c, band) in [
+            ("68.3%", self.coverage_683, self.expected_683),
+            ("95.5%", self.coverage_955, self.expected_955),
+        ] {
+            if !(band[0]..=band[1]).contains(&c) {
+                f.push(format!(
+                    "{level} coverage {c:.2} outside [{:.2}, {:.2}]",
+                    band[0], band[1]
+                ));
+            }
+        }
+        f
+    }
+}
+
 /// A study's result.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct CoverageReport {
     /// Truths fitted.
     pub n_truths: usize,
@@ -67,16 +93,18 @@ pub struct CoverageReport {
     /// Wall time of this run, s.
     pub seconds: f64,
     /// Truths of this run's shard taken back from an earlier run (`OUT/truths/`).
+    #[serde(default)]
     pub resumed: usize,
     /// Wall time of every truth's own work added up, s (the study's cost, however it was run).
+    #[serde(default)]
     pub truth_seconds: f64,
     /// With the full pipeline: how the fits' exact checks ended.
-    #[serde(skip_serializing_if = "Option::is_none")]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub exact_check: Option<CheckTally>,
 }
 
 /// How the exact checks of a study's fits ended (studies with the full pipeline).
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct CheckTally {
     /// Fits whose last exact check passed.
     pub passed: usize,
@@ -306,12 +334,7 @@ fn summarise(truths: &[&TruthFit], prior: &Prior, l: usize) -> CoverageReport {
             .map(|k| kept.iter().filter(|t| t.inside[j][k]).count() as f64 / m.max(1) as f64)
             .collect();
         let (c683, c955) = (curve[k683], curve[k955]);
-        pass &= ks_p > 0.01 / d as f64
-            && c683 >= e683[0]
-            && c683 <= e683[1]
-            && c955 >= e955[0]
-            && c955 <= e955[1];
-        parameters.push(ParameterCoverage {
+        let pc = ParameterCoverage {
             name: p.name.clone(),
             ks_p,
             coverage_683: c683,
@@ -320,7 +343,9 @@ fn summarise(truths: &[&TruthFit], prior: &Prior, l: usize) -> CoverageReport {
             expected_955: e955,
             coverage_curve: curve,
             ranks: kept.iter().map(|t| t.ranks[j]).collect(),
-        });
+        };
+        pass &= pc.failures(d).is_empty();
+        parameters.push(pc);
     }
     let checks: Vec<&TruthCheck> = kept.iter().filter_map(|t| t.check.as_ref()).collect();
     let exact_check = (!checks.is_empty()).then(|| CheckTally {
@@ -346,6 +371,36 @@ fn summarise(truths: &[&TruthFit], prior: &Prior, l: usize) -> CoverageReport {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn a_parameter_fails_by_name_for_each_test_it_misses() {
+        let p = ParameterCoverage {
+            name: "y1_bot".into(),
+            ks_p: 0.5,
+            coverage_683: 0.70,
+            coverage_955: 0.84,
+            expected_683: [0.6, 0.76],
+            expected_955: [0.86, 1.0],
+            coverage_curve: vec![],
+            ranks: vec![],
+        };
+        let f = p.failures(9);
+        assert_eq!(f.len(), 1, "{f:?}");
+        assert!(f[0].starts_with("95.5% coverage 0.84 outside"), "{f:?}");
+        let q = ParameterCoverage {
+            ks_p: 1e-3,
+            ..p.clone()
+        };
+        // 1e-3 < 0.01 / 9: the KS test fails too.
+        assert_eq!(q.failures(9).len(), 2);
+        assert_eq!(q.failures(1).len(), 2);
+        let r = ParameterCoverage {
+            ks_p: f64::NAN,
+            coverage_955: 0.9,
+            ..p
+        };
+        assert_eq!(r.failures(9).len(), 1, "a NaN p-value fails");
+    }
+
     use super::*;
 
     #[test]
