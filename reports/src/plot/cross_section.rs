@@ -272,6 +272,64 @@ pub(super) fn draw_regions<DB: DrawingBackend>(
     Ok(())
 }
 
+/// Draws the outlines of `det`'s regions over a figure of something else (a field, a
+/// potential): on an (nx, nz) raster of `r` x `z` (mm), each cell whose region differs from
+/// its right or upper neighbour's, in black where the semiconductor meets another region, in
+/// the contact's colour along a contact and in dark grey around a passive part; then the zero-thickness contact surfaces.
+pub(super) fn draw_outlines<DB: DrawingBackend>(
+    chart: &mut ChartContext<'_, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+    det: &Detector,
+    r: [f64; 2],
+    z: [f64; 2],
+    (nx, nz): (usize, usize),
+) -> Result<()> {
+    let dr = (r[1] - r[0]) / nx as f64;
+    let dz = (z[1] - z[0]) / nz as f64;
+    let at = |i: usize, j: usize| {
+        det.classify(r[0] + (i as f64 + 0.5) * dr, z[0] + (j as f64 + 0.5) * dz)
+    };
+    let mut rects = Vec::new();
+    let mut prev: Vec<Region> = (0..nx).map(|i| at(i, 0)).collect();
+    for j in 0..nz {
+        let row: Vec<Region> = if j == 0 {
+            prev.clone()
+        } else {
+            (0..nx).map(|i| at(i, j)).collect()
+        };
+        for i in 0..nx {
+            let here = row[i];
+            let others = [(i + 1 < nx).then(|| row[i + 1]), (j > 0).then(|| prev[i])];
+            let Some(other) = others.into_iter().flatten().find(|o| *o != here) else {
+                continue;
+            };
+            let color = match (here, other) {
+                (Region::Contact(k), _) | (_, Region::Contact(k)) => contact_color(k),
+                (Region::Semiconductor, _) | (_, Region::Semiconductor) => BLACK,
+                (Region::Passive(_), _) | (_, Region::Passive(_)) => RGBColor(90, 90, 90),
+                _ => continue,
+            };
+            let (x0, y0) = (r[0] + i as f64 * dr, z[0] + j as f64 * dz);
+            rects.push(Rectangle::new(
+                [(x0, y0), (x0 + 1.5 * dr, y0 + 1.5 * dz)],
+                color.filled(),
+            ));
+        }
+        prev = row;
+    }
+    chart.draw_series(rects).map_err(err)?;
+    for (k, c) in det.contacts.iter().enumerate() {
+        for (a, b) in c.geometry.surface_segments() {
+            chart
+                .draw_series(LineSeries::new(
+                    [(a[0], a[1]), (b[0], b[1])],
+                    contact_color(k).stroke_width(4),
+                ))
+                .map_err(err)?;
+        }
+    }
+    Ok(())
+}
+
 fn draw_title<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, det: &Detector) -> Result<()> {
     let params: Vec<String> = det
         .parameters

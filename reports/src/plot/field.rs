@@ -8,6 +8,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::colormap::viridis;
+use super::cross_section::draw_outlines;
 use super::style::err;
 use crate::error::Result;
 
@@ -103,6 +104,15 @@ fn draw<DB: DrawingBackend>(
         }
     }
     chart.draw_series(rects).map_err(err)?;
+    // The crystal's and the contacts' outlines over the potential.
+    let (ox, oz) = ((pw / 2).max(1) as usize, (ph / 2).max(1) as usize);
+    draw_outlines(
+        &mut chart,
+        det,
+        [0.0, w.r_max_mm],
+        [w.z_min_mm, w.z_max_mm],
+        (ox, oz),
+    )?;
     if let Some(at) = bridge_mm {
         chart
             .draw_series([Cross::new(at, 9, RED.stroke_width(3))])
