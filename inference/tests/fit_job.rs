@@ -216,12 +216,28 @@ fn zeta_bands_come_from_the_draws_and_the_truth_is_drawn_where_given() {
     let o = shipped("priors/b-rz.toml");
     let job = FitJob::from_files(&o.files(), o.noise().unwrap(), &o.grid).unwrap();
     let a: Vec<f64> = vec![3.0, 0.66, 0.65, 0.58, -0.4, 0.55, 0.54, 0.47, -0.3];
-    let b: Vec<f64> = vec![2.5, 0.60, 0.70, 0.50, 0.2, 0.60, 0.50, 0.40, -0.8];
+    // The same d_Li: the lines (which leave out the lithium layer) are the same for both.
+    let b: Vec<f64> = vec![3.0, 0.60, 0.70, 0.50, 0.2, 0.60, 0.50, 0.40, -0.8];
     // Draws all equal to the mode: the bands collapse onto it, and the truth at the mode is it.
     let z = zeta_profiles(&job.exact, &job.prior, &a, &[&a, &a, &a], Some(&a)).unwrap();
     assert_eq!(z.band_draws, 3);
     assert_eq!(z.along_z.len(), 5);
     assert_eq!(z.along_r.len(), 3);
+    // The rz model's knots are marked along r (r_4 on the mantle at the line's end), none
+    // along z; at mid-height the line leaves out the 3 mm lithium layer of the borehole
+    // (r = 5 to 8 mm).
+    for p in &z.along_r {
+        let end = *p.x_mm.last().unwrap();
+        assert_eq!(p.knots_mm, vec![20.0, 28.0, 33.0, end], "{}", p.label);
+    }
+    let mid = &z.along_r[1];
+    assert!(
+        mid.x_mm[0] >= 8.0,
+        "{} starts at {} mm",
+        mid.label,
+        mid.x_mm[0]
+    );
+    assert!(z.along_z.iter().all(|p| p.knots_mm.is_empty()));
     for p in z.along_z.iter().chain(&z.along_r) {
         assert_eq!(p.truth_cm3, p.zeta_cm3);
         let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * b.abs().max(1.0);

@@ -25,6 +25,9 @@ pub struct ZetaProfile {
     pub band_955_cm3: Vec<[f64; 2]>,
     /// zeta of the known truth; empty when none was given.
     pub truth_cm3: Vec<f64>,
+    /// Where along the line the impurity model has a knot (mm; the rz model's radii on a line
+    /// along r), for a figure to mark the fitted values there; empty for none.
+    pub knots_mm: Vec<f64>,
 }
 
 /// zeta(z) at several radii and zeta(r) at several heights.
@@ -38,6 +41,9 @@ pub struct ZetaAtMode {
     pub band_draws: usize,
 }
 
+/// How far beyond a line's end (mm) a knot is still marked, at the end.
+const KNOT_REACH_MM: f64 = 1.0;
+
 /// Points per profile.
 const POINTS: usize = 141;
 
@@ -48,12 +54,17 @@ pub const ZETA_BAND_DRAWS: usize = 400;
 type Line = (String, Vec<(f64, f64, f64)>);
 
 /// The lines of [`zeta_profiles`] through `det`'s semiconductor: along z at 2, 25, 50, 75 and 98%
-/// of the radial span at mid-height, along r at 2, 50 and 98% of the height, inside the
-/// semiconductor only (a borehole or groove is left out).
+/// of the radial span at mid-height, along r at 2, 50 and 98% of the height, inside the active
+/// semiconductor only (a borehole, a groove and a contact's volume such as the lithium layer
+/// are left out).
 fn lines(det: &Detector) -> (Vec<Line>, Vec<Line>) {
     let b = det.semiconductor.geometry.bbox();
-    // Strictly inside (a negative tolerance), so the axis of a borehole does not count.
-    let inside = |r: f64, z: f64| det.semiconductor.geometry.contains(r, z, -1e-6);
+    // Strictly inside (a negative tolerance), so the axis of a borehole does not count, and
+    // not in a contact.
+    let inside = |r: f64, z: f64| {
+        det.semiconductor.geometry.contains(r, z, -1e-6)
+            && det.classify(r, z) == hpge_solver::detector::Region::Semiconductor
+    };
     let lin = |a: f64, c: f64| -> Vec<f64> {
         (0..POINTS)
             .map(|i| a + (c - a) * i as f64 / (POINTS - 1) as f64)
@@ -138,7 +149,8 @@ pub fn zeta_profiles(
         }
     }
     let truth_det = truth.map(build).transpose()?;
-    let profile = |(label, pts): Line| {
+    let knots_r = det.impurity().knots_r_mm();
+    let profile = |(label, pts): Line, radial: bool| {
         let mut band_683 = Vec::new();
         let mut band_955 = Vec::new();
         if !dets.is_empty() {
@@ -155,19 +167,34 @@ pub fn zeta_profiles(
             truth_cm3: truth_det.as_ref().map_or_else(Vec::new, |t| along(t, &pts)),
             x_mm: pts.iter().map(|p| p.0).collect(),
             label,
+            knots_mm: if radial {
+                let (lo, hi) = (
+                    pts.first().map_or(f64::NAN, |p| p.0),
+                    pts.last().map_or(f64::NAN, |p| p.0),
+                );
+                // A knot on the crystal's surface (the rz model's r_4 at the mantle) is just
+                // beyond the line, which stops short of the contact: it is marked at the end.
+                knots_r
+                    .iter()
+                    .filter(|k| **k >= lo && **k <= hi + KNOT_REACH_MM)
+                    .map(|k| k.min(hi))
+                    .collect()
+            } else {
+                Vec::new()
+            },
             band_683_cm3: band_683,
             band_955_cm3: band_955,
         }
     };
-    let keep = |v: Vec<Line>| -> Vec<ZetaProfile> {
+    let keep = |v: Vec<Line>, radial: bool| -> Vec<ZetaProfile> {
         v.into_iter()
             .filter(|l| !l.1.is_empty())
-            .map(profile)
+            .map(|l| profile(l, radial))
             .collect()
     };
     Ok(ZetaAtMode {
-        along_z: keep(along_z),
-        along_r: keep(along_r),
+        along_z: keep(along_z, false),
+        along_r: keep(along_r, true),
         band_draws: dets.len(),
     })
 }

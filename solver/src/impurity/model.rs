@@ -19,6 +19,11 @@ pub trait ImpurityModel: std::fmt::Debug + Send + Sync {
     fn name(&self) -> &'static str;
     /// Signed density in cm^-3 at (r, z) in mm.
     fn density_cm3(&self, r_mm: f64, z_mm: f64) -> f64;
+    /// The radii of the model's knots, mm (the rz model's r_1..r_4; none for a model without
+    /// radial knots): where a figure marks the fitted values.
+    fn knots_r_mm(&self) -> Vec<f64> {
+        Vec::new()
+    }
     /// y, x (where the model has them) and zeta at (r, z).
     fn evaluate(&self, r_mm: f64, z_mm: f64) -> PointDensity {
         PointDensity {

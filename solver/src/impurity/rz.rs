@@ -215,6 +215,11 @@ impl ImpurityModel for RzModel {
         self.transform.zeta_cm3_of_y(self.y_at(r_mm, z_mm))
     }
 
+    /// The knots r_i (mm).
+    fn knots_r_mm(&self) -> Vec<f64> {
+        self.knots_mm().to_vec()
+    }
+
     /// y (Eq. (21)), x = T(y) (Eq. (20)) and zeta (Eq. (18)) at (r, z).
     fn evaluate(&self, r_mm: f64, z_mm: f64) -> PointDensity {
         let y = self.y_at(r_mm, z_mm);

@@ -153,6 +153,13 @@ pub(super) fn zeta<DB: DrawingBackend>(
     if truth {
         keys.push((Key::Dashed(RGBColor(90, 90, 90)), "truth".into()));
     }
+    let knots = profiles.iter().any(|p| !p.knots_mm.is_empty());
+    if knots {
+        keys.push((
+            Key::Dot(RGBColor(60, 60, 60)),
+            "knot of the model, with its value at the mode (1e10 cm^-3)".into(),
+        ));
+    }
     let body = key_strip(&root, &keys)?;
     let (x0, x1) = padded(profiles.iter().flat_map(|p| p.x_mm.iter().copied()), 0.02);
     let ys = profiles.iter().flat_map(|p| {
@@ -209,6 +216,23 @@ pub(super) fn zeta<DB: DrawingBackend>(
         chart
             .draw_series(LineSeries::new(pts, colour.stroke_width(3)))
             .map_err(err)?;
+        // The knots: a dot on the mode's curve and its value.
+        for &xk in &p.knots_mm {
+            let Some(v) = interpolate(&p.x_mm, &p.zeta_cm3, xk) else {
+                continue;
+            };
+            let v = v / 1e10;
+            chart
+                .draw_series([Circle::new((xk, v), 5, colour.filled())])
+                .map_err(err)?;
+            chart
+                .draw_series([Text::new(
+                    format!("{v:.2}"),
+                    (xk, v),
+                    ("sans-serif", 14).into_font().color(&colour),
+                )])
+                .map_err(err)?;
+        }
         if p.truth_cm3.len() == p.x_mm.len() {
             let pts: Vec<(f64, f64)> = p
                 .x_mm
@@ -222,6 +246,17 @@ pub(super) fn zeta<DB: DrawingBackend>(
         }
     }
     Ok(())
+}
+
+/// y at `x` by linear interpolation of the points (xs increasing), None outside them.
+fn interpolate(xs: &[f64], ys: &[f64], x: f64) -> Option<f64> {
+    let i = xs.partition_point(|t| *t < x);
+    if i == 0 {
+        return (xs.first() == Some(&x)).then(|| ys[0]);
+    }
+    let (x0, x1) = (xs[i - 1], *xs.get(i)?);
+    let f = if x1 > x0 { (x - x0) / (x1 - x0) } else { 0.0 };
+    Some(ys[i - 1] + f * (ys[i] - ys[i - 1]))
 }
 
 /// A whole-figure chart of the fit's curves on [x0, x1] x [y0, y1], with its axes drawn.

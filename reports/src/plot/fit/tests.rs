@@ -210,6 +210,11 @@ fn profile(label: String, f: impl Fn(f64) -> f64) -> ZetaProfile {
         band_683_cm3: band(1.0),
         band_955_cm3: band(2.0),
         truth_cm3: zeta_cm3_of(&x_mm, &f).iter().map(|z| z + 5e8).collect(),
+        knots_mm: if x_mm.len() > 20 {
+            vec![20.0, 28.0, 33.0]
+        } else {
+            Vec::new()
+        },
         x_mm,
         zeta_cm3,
     }
