@@ -86,6 +86,7 @@ fn b_z_fit_writes_every_output() {
     }
     for f in [
         "marginals",
+        "marginals-zeta",
         "predictive",
         "zeta-z",
         "zeta-r",

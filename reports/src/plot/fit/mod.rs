@@ -33,7 +33,8 @@ macro_rules! both {
 
 /// Writes every figure of a fit into `dir` (created if missing), each as .svg and .png; returns the paths written.
 ///
-/// The figures: `marginals`, `posterior-2d-<nameA>-<nameB>` per pair of parameter indices in
+/// The figures: `marginals`, `marginals-zeta` (the impurity parameters y as densities zeta,
+/// where the fit has any), `posterior-2d-<nameA>-<nameB>` per pair of parameter indices in
 /// `pairs`, `predictive`, `zeta-z` and `zeta-r` (each skipped when it has no profiles) and
 /// `traces`. `truth` (one value per parameter; NaN where unknown) is marked where given; every
 /// title starts with `title`.
@@ -73,8 +74,14 @@ pub fn fit_figures(
     let (rows, cols) = grid(d, 3);
     let size = (1500, 100 + 380 * rows as u32);
     both!(out, dir, "marginals", size, |root| posterior::marginals(
-        &root, fit, truth, title, cols
+        &root, fit, truth, title, cols, false
     ));
+    // The transform coordinates y as densities (the paper's Figs. 21 and 26).
+    if params.iter().any(posterior::is_density_coordinate) {
+        both!(out, dir, "marginals-zeta", size, |root| {
+            posterior::marginals(&root, fit, truth, title, cols, true)
+        });
+    }
     for &(a, b) in pairs {
         let stem = format!(
             "posterior-2d-{}-{}",

@@ -30,12 +30,14 @@ fn draws_of(fit: &Fit, j: usize) -> Vec<f64> {
         .collect()
 }
 
-/// The index of the narrowest level whose smallest intervals hold x.
-fn level_of(p: &ParameterSummary, x: f64) -> Option<usize> {
+/// The index of the narrowest level whose smallest intervals (mapped onto the panel's axis by
+/// `view`, an increasing map) hold the axis value x.
+fn level_of(p: &ParameterSummary, x: f64, view: &dyn PanelView) -> Option<usize> {
     LEVELS.iter().position(|l| {
-        p.smallest_intervals
-            .get(&format!("{l}"))
-            .is_some_and(|iv| iv.iter().any(|[a, b]| (*a..=*b).contains(&x)))
+        p.smallest_intervals.get(&format!("{l}")).is_some_and(|iv| {
+            iv.iter()
+                .any(|[a, b]| (view.map(*a)..=view.map(*b)).contains(&x))
+        })
     })
 }
 
@@ -49,12 +51,18 @@ fn marker_keys(truth: Option<&[f64]>, mode: Key) -> Vec<(Key, String)> {
 }
 
 /// The grid of 1D marginals: histogram coloured by the smallest intervals, prior, mode, truth.
+///
+/// With `zeta`, the transform coordinates y (parameters named y... of unit 1) are shown as the
+/// density zeta = zeta(T(y)) in 1e10 cm^-3 (the paper's Figs. 21 and 26): the transform is
+/// increasing, so draws, smallest intervals, mode and truth map point by point and the prior's
+/// density becomes p(y(zeta)) dy/dzeta.
 pub(super) fn marginals<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     fit: &Fit,
     truth: Option<&[f64]>,
     title: &str,
     cols: usize,
+    zeta: bool,
 ) -> Result<()> {
     root.fill(&WHITE).map_err(err)?;
     let params = &fit.summary.parameters;
@@ -62,7 +70,8 @@ pub(super) fn marginals<DB: DrawingBackend>(
     let root = root
         .titled(
             &format!(
-                "{title}: marginal posteriors ({n} draws, {} chains)",
+                "{title}: marginal posteriors{} ({n} draws, {} chains)",
+                if zeta { " of the densities" } else { "" },
                 fit.samples.chains.len()
             ),
             ("sans-serif", 24),
@@ -80,22 +89,131 @@ pub(super) fn marginals<DB: DrawingBackend>(
     let panels = body.split_evenly((rows, cols));
     for (j, (p, area)) in params.iter().zip(&panels).enumerate() {
         let t = truth.map(|t| t[j]).filter(|t| t.is_finite());
-        marginal(area, p, &draws_of(fit, j), t)?;
+        if zeta && is_density_coordinate(p) {
+            marginal(area, &ZetaView::of(p), &draws_of(fit, j), t)?;
+        } else {
+            marginal(area, &Identity(p), &draws_of(fit, j), t)?;
+        }
     }
     Ok(())
 }
 
+/// Whether a parameter is a transform coordinate y of the impurity density (the priors name
+/// them y..., dimensionless): shown as zeta in the density marginals.
+pub(super) fn is_density_coordinate(p: &ParameterSummary) -> bool {
+    p.name.starts_with('y') && matches!(p.unit.trim(), "" | "1")
+}
+
+/// How a marginal panel shows its parameter: the axis, the map of values onto it and the
+/// prior's density there.
+trait PanelView {
+    fn summary(&self) -> &ParameterSummary;
+    fn label(&self) -> String;
+    /// The parameter's value on the axis.
+    fn map(&self, x: f64) -> f64;
+    /// The prior's density at axis value v (with the Jacobian of the map).
+    fn prior_pdf(&self, v: f64) -> f64;
+    /// Whether the view spans the central 99% of the draws rather than all of them (a map
+    /// with long tails, such as zeta's exponential one, would squeeze the draws to a spike).
+    fn central_view(&self) -> bool {
+        false
+    }
+}
+
+struct Identity<'a>(&'a ParameterSummary);
+
+impl PanelView for Identity<'_> {
+    fn summary(&self) -> &ParameterSummary {
+        self.0
+    }
+    fn label(&self) -> String {
+        axis_label(self.0)
+    }
+    fn map(&self, x: f64) -> f64 {
+        x
+    }
+    fn prior_pdf(&self, v: f64) -> f64 {
+        self.0.prior.ln_pdf(v, self.0.support).exp()
+    }
+}
+
+/// y shown as zeta(T(y)) in 1e10 cm^-3.
+struct ZetaView<'a> {
+    p: &'a ParameterSummary,
+    t: hpge_solver::impurity::LogTransform,
+}
+
+impl<'a> ZetaView<'a> {
+    fn of(p: &'a ParameterSummary) -> Self {
+        Self {
+            p,
+            t: hpge_solver::impurity::LogTransform::default(),
+        }
+    }
+}
+
+impl PanelView for ZetaView<'_> {
+    fn summary(&self) -> &ParameterSummary {
+        self.p
+    }
+    fn label(&self) -> String {
+        format!("zeta of {} [1e10 cm^-3]", self.p.name)
+    }
+    fn map(&self, y: f64) -> f64 {
+        self.t.zeta_cm3_of_y(y) / 1e10
+    }
+    fn central_view(&self) -> bool {
+        true
+    }
+    fn prior_pdf(&self, v: f64) -> f64 {
+        // p(zeta) = p(y(zeta)) dy/dzeta, dy/dzeta by a central difference of the inverse.
+        let y_of = |v: f64| self.t.y_of_zeta_cm3(v * 1e10).ok();
+        let h = 1e-6 * v.abs().max(1e-3);
+        match (y_of(v), y_of(v - h), y_of(v + h)) {
+            (Some(y), Some(a), Some(b)) if b > a => {
+                self.p.prior.ln_pdf(y, self.p.support).exp() * (b - a) / (2.0 * h)
+            }
+            _ => f64::NAN,
+        }
+    }
+}
+
 fn marginal<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
-    p: &ParameterSummary,
+    view: &dyn PanelView,
     draws: &[f64],
     truth: Option<f64>,
 ) -> Result<()> {
-    let extra: Vec<f64> = [Some(p.global_mode), truth].into_iter().flatten().collect();
-    let (lo, hi) = view_range(draws, &extra, p.support);
+    let p = view.summary();
+    let draws: Vec<f64> = draws.iter().map(|&x| view.map(x)).collect();
+    let truth = truth.map(|t| view.map(t));
+    let support = [view.map(p.support[0]), view.map(p.support[1])];
+    let m = view.map(p.global_mode);
+    let extra: Vec<f64> = [Some(m), truth].into_iter().flatten().collect();
+    let (lo, hi) = if view.central_view() {
+        let mut sorted = draws.clone();
+        sorted.sort_by(f64::total_cmp);
+        let q = |f: f64| sorted[((sorted.len() - 1) as f64 * f).round() as usize];
+        view_range(&[q(0.005), q(0.995)], &extra, support)
+    } else {
+        view_range(&draws, &extra, support)
+    };
+    // A global mode at the view's edge (a domain edge: d_Li at its prior's bound) would hide
+    // behind the axis: the view reaches 3% beyond it there.
+    let edge = 0.015 * (hi - lo);
+    let lo = if (m - lo).abs() <= edge {
+        lo - 0.03 * (hi - lo)
+    } else {
+        lo
+    };
+    let hi = if (hi - m).abs() <= edge {
+        hi + 0.03 * (hi - lo)
+    } else {
+        hi
+    };
     let w = (hi - lo) / BINS_1D as f64;
     let mut h = vec![0.0; BINS_1D];
-    for &v in draws {
+    for &v in &draws {
         let k = ((v - lo) / w).floor();
         if k >= 0.0 && (k as usize) < BINS_1D {
             h[k as usize] += 1.0;
@@ -105,7 +223,7 @@ fn marginal<DB: DrawingBackend>(
     h.iter_mut().for_each(|c| *c *= norm);
     let prior: Vec<(f64, f64)> = (0..=300)
         .map(|i| lo + (hi - lo) * i as f64 / 300.0)
-        .map(|x| (x, p.prior.ln_pdf(x, p.support).exp()))
+        .map(|x| (x, view.prior_pdf(x)))
         .filter(|(_, y)| y.is_finite())
         .collect();
     let top = h
@@ -125,7 +243,7 @@ fn marginal<DB: DrawingBackend>(
     draw_axes(
         &mut chart,
         Axes {
-            desc: (&axis_label(p), "posterior density"),
+            desc: (&view.label(), "posterior density"),
             span: (hi - lo, top),
             labels: Some((6, 6)),
             font: (15, 17),
@@ -138,7 +256,8 @@ fn marginal<DB: DrawingBackend>(
                 .filter(|(_, c)| **c > 0.0)
                 .map(|(i, &c)| {
                     let x0 = lo + i as f64 * w;
-                    let color = level_of(p, x0 + 0.5 * w).map_or(OUTSIDE, |l| LEVEL_COLORS[l]);
+                    let color =
+                        level_of(p, x0 + 0.5 * w, view).map_or(OUTSIDE, |l| LEVEL_COLORS[l]);
                     Rectangle::new([(x0, 0.0), (x0 + w, c)], color.filled())
                 }),
         )
@@ -160,9 +279,8 @@ fn marginal<DB: DrawingBackend>(
     chart
         .draw_series(LineSeries::new(prior, PRIOR.stroke_width(2)))
         .map_err(err)?;
-    let m = p.global_mode;
     chart
-        .draw_series(LineSeries::new([(m, 0.0), (m, top)], BLACK.stroke_width(2)))
+        .draw_series(LineSeries::new([(m, 0.0), (m, top)], BLACK.stroke_width(3)))
         .map_err(err)?;
     if let Some(t) = truth {
         chart

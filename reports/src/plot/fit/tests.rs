@@ -264,6 +264,7 @@ fn b_z_figures() {
     let truth = [1.0, 0.7, 0.55];
     let stems = [
         "marginals",
+        "marginals-zeta",
         "posterior-2d-y_bot-y_top",
         "posterior-2d-d_li_mm-y_bot",
         "predictive",
@@ -285,6 +286,7 @@ fn b_rz_figures() {
     let fit = synthetic_fit(9, 4);
     let stems = [
         "marginals",
+        "marginals-zeta",
         "posterior-2d-y1_bot-y1_top",
         "predictive",
         "zeta-z",
