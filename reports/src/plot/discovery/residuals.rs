@@ -17,7 +17,7 @@ pub(super) fn residual_panel<DB: DrawingBackend>(
     let s = &d.summary;
     let body = caption(
         area,
-        "standardised posterior-predictive residuals (data - model) / sd",
+        "standardised posterior-predictive residuals (c_p - c_m) / sd: model - data, as every figure",
     )?;
     let order = sorted_voltages(&d.voltage_v);
     let volts: Vec<f64> = order.iter().map(|p| p.0).collect();
@@ -50,7 +50,7 @@ pub(super) fn residual_panel<DB: DrawingBackend>(
     let plot_h = f64::from(body_h) - f64::from(2 * MARGIN + X_LABEL_H);
     let residuals = std::iter::once(&d.before)
         .chain(&d.after)
-        .flat_map(|f| f.check.residuals.iter().copied());
+        .flat_map(|f| f.check.residuals.iter().map(|r| -r));
     let (y0, y1) = residual_range(residuals, plot_h, top_px, bottom_px);
 
     let mut chart = ChartBuilder::on(&body)
@@ -62,7 +62,7 @@ pub(super) fn residual_panel<DB: DrawingBackend>(
     chart
         .configure_mesh()
         .x_desc("U_B (V)")
-        .y_desc("standardised residual")
+        .y_desc("(c_p - c_m) / sd")
         .x_label_formatter(&tick)
         .y_label_formatter(&tick)
         .label_style(("sans-serif", 16))
@@ -103,7 +103,9 @@ pub(super) fn residual_panel<DB: DrawingBackend>(
     for (k, (fit, gap, color, what)) in models.into_iter().enumerate() {
         let pts: Vec<(f64, f64)> = order
             .iter()
-            .map(|&(v, i)| (v, fit.check.residuals[i]))
+            // discovery.json keeps data - model; the figure shows model - data (c_p - c_m),
+            // the sign convention of every figure.
+            .map(|&(v, i)| (v, -fit.check.residuals[i]))
             .collect();
         // Lines between finite neighbours only.
         for run in pts.split(|p| !p.1.is_finite()).filter(|r| !r.is_empty()) {
