@@ -21,7 +21,7 @@ pub fn measurement(m: &Measurement, sets: &[PulseSet], dir: &Path) -> Result<()>
         one(render!(&p("pulses"), (1500, 500), |root, _svg| pulses(
             &root, m, sets
         )))?;
-        one(render!(&p("spectra"), (1000, 650), |root, _svg| spectra(
+        one(render!(&p("spectra"), (1150, 650), |root, _svg| spectra(
             &root, m
         )))?;
         one(render!(&p("peak-fits"), (1200, 900), |root, _svg| {
@@ -122,8 +122,16 @@ fn pulses<DB: DrawingBackend>(
     Ok(())
 }
 
+/// Gamma lines marked on the spectra: (label, energy in keV).
+const GAMMA_LINES: [(&str, f64); 3] = [
+    ("208Tl 2614.5 keV", 2614.5),
+    ("40K 1460.8 keV", 1460.8),
+    ("208Tl 583.2 keV", 583.2),
+];
+
 fn spectra<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, m: &Measurement) -> Result<()> {
     root.fill(&WHITE).map_err(err)?;
+    let (root, bar) = root.split_horizontally(1000);
     let all: Vec<f64> = m
         .points
         .iter()
@@ -161,9 +169,9 @@ fn spectra<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, m: &Measurement) -
         (u[k] - below, u[k] + above)
     };
     let (ylo, yhi) = (half(0).0, half(u.len() - 1).1);
-    let mut chart = ChartBuilder::on(root)
+    let mut chart = ChartBuilder::on(&root)
         .caption(
-            "Q_t of all pulses per bias (colour: log counts; the pulser peak moves left with U_B, gammas end at 0.14 pC)",
+            "Q_t of all pulses per bias: the pulser peak moves left with U_B; gamma lines dashed",
             ("sans-serif", 17),
         )
         .margin(15)
@@ -193,13 +201,71 @@ fn spectra<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, m: &Measurement) -
             }))
             .map_err(err)?;
     }
-    let tl = 2614.5 * PC_PER_KEV;
-    chart
-        .draw_series(LineSeries::new([(tl, ylo), (tl, yhi)], RED.mix(0.6)))
-        .map_err(err)?
-        .label("208Tl 2614.5 keV")
-        .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], RED));
-    legend(&mut chart, SeriesLabelPosition::MiddleRight)?;
+    // The gamma lines (dashed, labelled at the top) and the pulser track (labelled at its
+    // first bias).
+    let label_font = ("sans-serif", 14).into_font();
+    for (k, (name, kev)) in GAMMA_LINES.iter().enumerate() {
+        let q = kev * PC_PER_KEV;
+        if !(qmin..qmax).contains(&q) {
+            continue;
+        }
+        chart
+            .draw_series(DashedLineSeries::new(
+                [(q, ylo), (q, yhi)],
+                6,
+                4,
+                RED.mix(0.7).stroke_width(1),
+            ))
+            .map_err(err)?;
+        let y = yhi - (0.03 + 0.04 * k as f64) * (yhi - ylo);
+        chart
+            .draw_series([Text::new(
+                name.to_string(),
+                (q * 1.03, y),
+                label_font.clone().color(&RED),
+            )])
+            .map_err(err)?;
+    }
+    if let Some(p) = m.points.first() {
+        let q = p.peak.mean_pc;
+        if q.is_finite() && (qmin..qmax).contains(&q) {
+            chart
+                .draw_series([Text::new(
+                    format!("pulser peak ({:.0} V)", p.bias_v),
+                    (q * 0.75, p.bias_v + 0.04 * (yhi - ylo)),
+                    label_font.clone(),
+                )])
+                .map_err(err)?;
+        }
+    }
+    // Colour bar: counts per bin on the same log scale as the map.
+    let (x0, y0, bw, bh) = (20, 60, 24, 420);
+    for k in 0..bh {
+        let t = 1.0 - (k as f64 + 0.5) / bh as f64;
+        bar.draw(&Rectangle::new(
+            [(x0, y0 + k), (x0 + bw, y0 + k + 1)],
+            ViridisRGB::get_color(1.0 - t).filled(),
+        ))
+        .map_err(err)?;
+    }
+    let font = ("sans-serif", 14).into_font();
+    bar.draw(&Text::new(
+        "pulses per bin",
+        (x0 - 10, y0 - 30),
+        font.clone(),
+    ))
+    .map_err(err)?;
+    for k in 0..=4 {
+        let t = k as f64 / 4.0;
+        let counts = ((1.0 + hmax).ln() * t).exp() - 1.0;
+        let y = y0 + ((1.0 - t) * bh as f64) as i32;
+        bar.draw(&Text::new(
+            format!("{counts:.0}"),
+            (x0 + bw + 6, y - 7),
+            font.clone(),
+        ))
+        .map_err(err)?;
+    }
     Ok(())
 }
 

@@ -9,7 +9,7 @@ use hpge_surrogate::{Figures, ModelInfo};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::style::{err, legend};
+use super::style::{err, legend, log_key_points};
 use crate::error::Result;
 
 /// `learning-curves.svg/png` in `dir`.
@@ -47,13 +47,23 @@ fn draw_curves<DB: DrawingBackend>(
         .margin(15)
         .x_label_area_size(45)
         .y_label_area_size(80)
-        .build_cartesian_2d(0.0..epochs + 1.0, ((lo * 0.8)..(hi * 1.25)).log_scale())
+        .build_cartesian_2d(
+            0.0..epochs + 1.0,
+            ((lo * 0.8)..(hi * 1.25))
+                .log_scale()
+                .with_key_points(log_key_points(lo * 0.8, hi * 1.25)),
+        )
         .map_err(err)?;
+    let loss = info
+        .recipe
+        .as_ref()
+        .map_or("loss".to_string(), |r| r.loss.describe());
     chart
         .configure_mesh()
         .x_desc("epoch")
-        .y_desc("mean loss")
-        .y_label_formatter(&|v| format!("{v:.1e}"))
+        .y_desc(format!("mean loss per sample: {loss}"))
+        .y_label_formatter(&|v| format!("{v}"))
+        .label_style(("sans-serif", 15))
         .draw()
         .map_err(err)?;
     // Cycle boundaries (dashed).
@@ -137,16 +147,26 @@ fn scatter<DB: DrawingBackend>(
     label: &str,
 ) -> Result<()> {
     root.fill(&WHITE).map_err(err)?;
-    let all = pred.iter().chain(truth).copied().filter(|v| v.is_finite());
+    // Log axes: c12 spans two decades (a few pF at full depletion to about 1000 pF at 25 V),
+    // and the relative error is what the likelihood sees.
+    let all = pred
+        .iter()
+        .chain(truth)
+        .copied()
+        .filter(|v| v.is_finite() && *v > 0.0);
     let (lo, hi) = all.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
         (a.min(v), b.max(v))
     });
-    let pad = 0.03 * (hi - lo);
-    let (lo, hi) = (lo - pad, hi + pad);
+    let (lo, hi) = if lo < hi {
+        (lo / 1.1, hi * 1.1)
+    } else {
+        (1.0, 10.0)
+    };
+    let n = truth.len();
     let mut chart = ChartBuilder::on(root)
         .caption(
             format!(
-                "{label} set: c12 surrogate vs solver ({})",
+                "{label} set ({n} rows): c12 surrogate vs solver, recipe {}",
                 info.recipe_name
             ),
             ("sans-serif", 20),
@@ -154,12 +174,17 @@ fn scatter<DB: DrawingBackend>(
         .margin(15)
         .x_label_area_size(45)
         .y_label_area_size(60)
-        .build_cartesian_2d(lo..hi, lo..hi)
+        .build_cartesian_2d(
+            (lo..hi).log_scale().with_key_points(log_key_points(lo, hi)),
+            (lo..hi).log_scale().with_key_points(log_key_points(lo, hi)),
+        )
         .map_err(err)?;
     chart
         .configure_mesh()
         .x_desc("c12 solver (pF)")
         .y_desc("c12 surrogate (pF)")
+        .x_label_formatter(&|v| format!("{v}"))
+        .y_label_formatter(&|v| format!("{v}"))
         .draw()
         .map_err(err)?;
     chart
@@ -167,6 +192,7 @@ fn scatter<DB: DrawingBackend>(
             truth
                 .iter()
                 .zip(pred)
+                .filter(|(t, p)| **t > 0.0 && **p > 0.0)
                 .map(|(&t, &p)| Circle::new((t, p), 1, BLUE.mix(0.35).filled())),
         )
         .map_err(err)?;

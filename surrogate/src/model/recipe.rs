@@ -51,6 +51,21 @@ pub enum Loss {
     },
 }
 
+impl Loss {
+    /// The loss per sample with its unit, for a learning-curve axis.
+    pub fn describe(&self) -> String {
+        match self {
+            Self::PaperRobust { h } => {
+                format!("h ln(((c_p - c_s) / pF)^2 / h + 1), h = {h} (pF^2)")
+            }
+            Self::RelativeSquared => "(100 ln(c_p / c_s))^2 (%^2)".into(),
+            Self::RelativeRobust { h } => {
+                format!("h ln(r^2 / h + 1), r = 100 ln(c_p / c_s) %, h = {h} (%^2)")
+            }
+        }
+    }
+}
+
 /// One Adam cycle: learning rate (decayed by a half cosine to `lr_end` when given), epochs and
 /// batch size.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
