@@ -249,16 +249,7 @@ pub(super) fn draw_regions<DB: DrawingBackend>(
     chart.draw_series(rects).map_err(err)?;
 
     // Zero-thickness surfaces (e.g. the p+ mantle) as thick lines.
-    for (k, c) in det.contacts.iter().enumerate() {
-        for (a, b) in c.geometry.surface_segments() {
-            chart
-                .draw_series(LineSeries::new(
-                    [(a[0], a[1]), (b[0], b[1])],
-                    contact_color(k).stroke_width(5),
-                ))
-                .map_err(err)?;
-        }
-    }
+    draw_contact_surfaces(chart, det, 5)?;
     for p in &det.passives {
         for (a, b) in p.geometry.surface_segments() {
             chart
@@ -317,17 +308,53 @@ pub(super) fn draw_outlines<DB: DrawingBackend>(
         prev = row;
     }
     chart.draw_series(rects).map_err(err)?;
+    draw_contact_surfaces(chart, det, 4)
+}
+
+/// The zero-thickness contact surfaces of `det` (e.g. the p+ mantle) as lines `width` px wide
+/// in the contacts' colours.
+fn draw_contact_surfaces<DB: DrawingBackend>(
+    chart: &mut ChartContext<'_, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+    det: &Detector,
+    width: u32,
+) -> Result<()> {
     for (k, c) in det.contacts.iter().enumerate() {
         for (a, b) in c.geometry.surface_segments() {
             chart
                 .draw_series(LineSeries::new(
                     [(a[0], a[1]), (b[0], b[1])],
-                    contact_color(k).stroke_width(4),
+                    contact_color(k).stroke_width(width),
                 ))
                 .map_err(err)?;
         }
     }
     Ok(())
+}
+
+/// A chart of r x z (mm) with `caption` on `area`, its axes labelled: the frame of the figures
+/// drawn over the cross-section (potential, depletion bands).
+pub(super) fn rz_chart<'a, DB: DrawingBackend>(
+    area: &'a DrawingArea<DB, Shift>,
+    caption: String,
+    caption_size: u32,
+    r: [f64; 2],
+    z: [f64; 2],
+) -> Result<ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>> {
+    let mut chart = ChartBuilder::on(area)
+        .caption(caption, ("sans-serif", caption_size))
+        .margin(15)
+        .x_label_area_size(45)
+        .y_label_area_size(60)
+        .build_cartesian_2d(r[0]..r[1], z[0]..z[1])
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .x_desc("r (mm)")
+        .y_desc("z (mm)")
+        .draw()
+        .map_err(err)?;
+    Ok(chart)
 }
 
 fn draw_title<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, det: &Detector) -> Result<()> {

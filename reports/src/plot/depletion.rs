@@ -11,7 +11,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::colormap::viridis;
-use super::cross_section::draw_regions;
+use super::cross_section::{draw_regions, rz_chart};
 use super::style::err;
 use crate::error::Result;
 
@@ -166,23 +166,13 @@ fn draw<DB: DrawingBackend>(
     let n = states.len();
     let last = states[n - 1].bias_v;
     let (main, side) = root.split_horizontally(pw + 100);
-    let mut chart = ChartBuilder::on(&main)
-        .caption(
-            format!("{}: undepleted volume by bias", det.name),
-            ("sans-serif", 17),
-        )
-        .margin(15)
-        .x_label_area_size(45)
-        .y_label_area_size(60)
-        .build_cartesian_2d(r[0]..r[1], z[0]..z[1])
-        .map_err(err)?;
-    chart
-        .configure_mesh()
-        .disable_mesh()
-        .x_desc("r (mm)")
-        .y_desc("z (mm)")
-        .draw()
-        .map_err(err)?;
+    let mut chart = rz_chart(
+        &main,
+        format!("{}: undepleted volume by bias", det.name),
+        17,
+        r,
+        z,
+    )?;
     let nx = (pw / cell).max(1) as usize;
     let nz = (ph / cell).max(1) as usize;
     // Each band coloured, its boundary (a cell whose right or upper neighbour depletes at

@@ -8,7 +8,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::colormap::viridis;
-use super::cross_section::draw_outlines;
+use super::cross_section::{draw_outlines, rz_chart};
 use super::style::err;
 use crate::error::Result;
 
@@ -51,26 +51,16 @@ fn draw<DB: DrawingBackend>(
     let w = &det.world;
     let (main, side) = root.split_horizontally(pw + 110);
     let (main, _) = main.split_vertically(ph + 140);
-    let mut chart = ChartBuilder::on(&main)
-        .caption(
-            format!(
-                "{}: U_B = {} V (grey: undepleted, orange: pocket)",
-                det.name, p.bias_v
-            ),
-            ("sans-serif", 18),
-        )
-        .margin(15)
-        .x_label_area_size(45)
-        .y_label_area_size(60)
-        .build_cartesian_2d(0.0..w.r_max_mm, w.z_min_mm..w.z_max_mm)
-        .map_err(err)?;
-    chart
-        .configure_mesh()
-        .disable_mesh()
-        .x_desc("r (mm)")
-        .y_desc("z (mm)")
-        .draw()
-        .map_err(err)?;
+    let mut chart = rz_chart(
+        &main,
+        format!(
+            "{}: U_B = {} V (grey: undepleted, orange: pocket)",
+            det.name, p.bias_v
+        ),
+        18,
+        [0.0, w.r_max_mm],
+        [w.z_min_mm, w.z_max_mm],
+    )?;
     let g = &p.mesh.grid;
     let nx = (pw / cell).max(1) as usize;
     let nz = (ph / cell).max(1) as usize;
