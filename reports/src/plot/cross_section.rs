@@ -266,7 +266,8 @@ pub(super) fn draw_regions<DB: DrawingBackend>(
 /// Draws the outlines of `det`'s regions over a figure of something else (a field, a
 /// potential): on an (nx, nz) raster of `r` x `z` (mm), each cell whose region differs from
 /// its right or upper neighbour's, in black where the semiconductor meets another region, in
-/// the contact's colour along a contact and in dark grey around a passive part; then the zero-thickness contact surfaces.
+/// the contact's colour along a contact and in dark grey around a passive part; then the
+/// zero-thickness contact surfaces.
 pub(super) fn draw_outlines<DB: DrawingBackend>(
     chart: &mut ChartContext<'_, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
     det: &Detector,
