@@ -89,6 +89,8 @@ fn tiny_network_on_a_tiny_generated_set() {
         "learning-curves.png",
         "test-scatter.png",
         "test-errors.svg",
+        "scatter-train-test.png",
+        "scatter-train-test.svg",
     ] {
         assert!(d.join("plots").join(f).is_file(), "{f}");
     }

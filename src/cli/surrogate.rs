@@ -136,6 +136,21 @@ pub fn train(job: &TrainJob, plot: Option<&Path>, quiet: bool) -> Result<()> {
             "test",
             dir,
         )?;
+        // Both sets in one scatter (the paper's Fig. 18).
+        for ext in ["svg", "png"] {
+            hpge_reports::plot::scatter_sets(
+                &[
+                    (
+                        "training",
+                        &outcome.train_predictions,
+                        &outcome.train_c12_pf,
+                    ),
+                    ("test", &outcome.test_predictions, &outcome.test_c12_pf),
+                ],
+                &model.info,
+                &dir.join(format!("scatter-train-test.{ext}")),
+            )?;
+        }
     }
     let f = &model.info.test_figures;
     if !quiet {

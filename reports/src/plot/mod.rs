@@ -36,4 +36,4 @@ pub use format::{Format, check_output};
 pub use lines::{Corner, Curve, LineFigure, line_figure};
 pub use measure::measurement;
 pub use sensitivity::{Mark, ScanMarks, sensitivity};
-pub use surrogate::{learning_curves, surrogate_errors};
+pub use surrogate::{learning_curves, scatter_sets, surrogate_errors};

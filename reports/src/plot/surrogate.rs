@@ -9,7 +9,7 @@ use hpge_surrogate::{Figures, ModelInfo};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::style::{err, legend, log_key_points};
+use super::style::{PALETTE, err, legend, log_key_points};
 use crate::error::Result;
 
 /// `learning-curves.svg/png` in `dir`.
@@ -129,7 +129,9 @@ pub fn surrogate_errors(
         let p = dir.join(format!("{label}-scatter.{ext}"));
         let one = |f: Result<()>| f;
         one(render!(&p, (800, 800), |root, _svg| scatter(
-            &root, pred, truth, info, label
+            &root,
+            &[(label, pred, truth)],
+            info
         )))?;
         let p = dir.join(format!("{label}-errors.{ext}"));
         one(render!(&p, (1400, 600), |root, _svg| errors(
@@ -139,19 +141,26 @@ pub fn surrogate_errors(
     Ok(())
 }
 
+/// `path` (.svg or .png): c_p over c_s of several sets on log axes, one colour each (e.g. the
+/// training and test sets of a `train` run, as the paper's Fig. 18), each named with its size.
+pub fn scatter_sets(sets: &[(&str, &[f64], &[f64])], info: &ModelInfo, path: &Path) -> Result<()> {
+    if sets.is_empty() || sets.iter().any(|(_, p, t)| p.len() != t.len()) {
+        invalid!("a scatter needs sets with one prediction per solver value");
+    }
+    render!(path, (800, 800), |root, _svg| scatter(&root, sets, info))
+}
+
 fn scatter<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
-    pred: &[f64],
-    truth: &[f64],
+    sets: &[(&str, &[f64], &[f64])],
     info: &ModelInfo,
-    label: &str,
 ) -> Result<()> {
     root.fill(&WHITE).map_err(err)?;
     // Log axes: c12 spans two decades (a few pF at full depletion to about 1000 pF at 25 V),
     // and the relative error is what the likelihood sees.
-    let all = pred
+    let all = sets
         .iter()
-        .chain(truth)
+        .flat_map(|(_, p, t)| p.iter().chain(t.iter()))
         .copied()
         .filter(|v| v.is_finite() && *v > 0.0);
     let (lo, hi) = all.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
@@ -162,14 +171,18 @@ fn scatter<DB: DrawingBackend>(
     } else {
         (1.0, 10.0)
     };
-    let n = truth.len();
+    let names: Vec<String> = sets
+        .iter()
+        .map(|(label, _, t)| format!("{label} set ({} rows)", t.len()))
+        .collect();
     let mut chart = ChartBuilder::on(root)
         .caption(
             format!(
-                "{label} set ({n} rows): c12 surrogate vs solver, recipe {}",
+                "{}: c12 surrogate vs solver, recipe {}",
+                names.join(", "),
                 info.recipe_name
             ),
-            ("sans-serif", 20),
+            ("sans-serif", 18),
         )
         .margin(15)
         .x_label_area_size(45)
@@ -187,18 +200,26 @@ fn scatter<DB: DrawingBackend>(
         .y_label_formatter(&|v| format!("{v}"))
         .draw()
         .map_err(err)?;
-    chart
-        .draw_series(
-            truth
-                .iter()
-                .zip(pred)
-                .filter(|(t, p)| **t > 0.0 && **p > 0.0)
-                .map(|(&t, &p)| Circle::new((t, p), 1, BLUE.mix(0.35).filled())),
-        )
-        .map_err(err)?;
+    for (k, ((_, pred, truth), name)) in sets.iter().zip(&names).enumerate() {
+        let c = PALETTE[k % PALETTE.len()];
+        chart
+            .draw_series(
+                truth
+                    .iter()
+                    .zip(pred.iter())
+                    .filter(|(t, p)| **t > 0.0 && **p > 0.0)
+                    .map(|(&t, &p)| Circle::new((t, p), 1, c.mix(0.35).filled())),
+            )
+            .map_err(err)?
+            .label(name.clone())
+            .legend(move |(x, y)| Circle::new((x + 10, y), 4, c.filled()));
+    }
     chart
         .draw_series(LineSeries::new([(lo, lo), (hi, hi)], BLACK))
         .map_err(err)?;
+    if sets.len() > 1 {
+        legend(&mut chart, SeriesLabelPosition::UpperLeft)?;
+    }
     Ok(())
 }
 
