@@ -77,7 +77,7 @@ pub fn write(ctx: &Ctx, total_s: f64) -> Result<PathBuf> {
         |f: &dyn Fn(&Judgement) -> bool| ctx.rows.iter().filter(|r| f(&r.judgement)).count();
     writeln!(
         t,
-        "\n{} rows agree, {} differ, {} are shown without a numeric statement, {} not run. A verdict \
+        "\n{} rows agree, {} differ, {} shown without a numeric statement, {} not run. A verdict \
          agrees when every criterion beside it holds; a row that differs names the criteria that \
          fail.\n",
         count(&|j| j.agrees() == Some(true)),
