@@ -22,26 +22,17 @@ const UNDEPLETED: RGBColor = RGBColor(150, 150, 150);
 /// around it is (trapped-carrier pockets count as undepleted). Its nearest node alone would put
 /// the cells along a contact's surface, whose nearest node is the contact's, among the depleted.
 pub fn undepleted_at(p: &PotentialPoint, r_mm: f64, z_mm: f64) -> bool {
-    let g = &p.mesh.grid;
-    let cell = |x: &[f64], v: f64| {
-        let i = x.partition_point(|t| *t <= v).clamp(1, x.len() - 1);
-        [i - 1, i]
+    let nodes = p.mesh.grid.cell_nodes(r_mm, z_mm);
+    let semiconductor = || {
+        nodes
+            .iter()
+            .filter(|&&k| p.mesh.kind[k] == NodeKind::Semiconductor)
     };
-    let (ir, iz) = (cell(g.r_mm(), r_mm), cell(g.z_mm(), z_mm));
-    let mut any_semiconductor = false;
-    for i in ir {
-        for j in iz {
-            let k = g.index(i, j);
-            if p.mesh.kind[k] == NodeKind::Semiconductor {
-                any_semiconductor = true;
-                if p.potential.undepleted[k] {
-                    return true;
-                }
-            }
-        }
+    if semiconductor().next().is_none() {
+        // A cell with no semiconductor node: the nearest node decides.
+        return p.potential.undepleted[p.mesh.grid.nearest(r_mm, z_mm)];
     }
-    // A cell with no semiconductor node: the nearest node decides.
-    !any_semiconductor && p.potential.undepleted[g.nearest(r_mm, z_mm)]
+    semiconductor().any(|&k| p.potential.undepleted[k])
 }
 
 /// The index of the first state (in the given order) in which (r, z) is depleted, or
@@ -176,12 +167,24 @@ fn draw<DB: DrawingBackend>(
     let nx = (pw / cell).max(1) as usize;
     let nz = (ph / cell).max(1) as usize;
     // Each band coloured, its boundary (a cell whose right or upper neighbour depletes at
-    // another bias) darkened, so that neighbouring bands stay apart.
+    // another bias) darkened, so that neighbouring bands stay apart. The bands of the raster's
+    // cell centres, one column and row beyond for the neighbours, are found once.
     let (dr, dz) = ((r[1] - r[0]) / nx as f64, (z[1] - z[0]) / nz as f64);
+    let band: Vec<usize> = (0..=nz)
+        .flat_map(|j| (0..=nx).map(move |i| (i, j)))
+        .map(|(i, j)| {
+            let rc = r[0] + (i as f64 + 0.5) * dr;
+            let zc = z[0] + (j as f64 + 0.5) * dz;
+            depleted_from(states, rc, zc)
+        })
+        .collect();
+    let at = |i: usize, j: usize| band[j * (nx + 1) + i];
     draw_regions(&mut chart, det, r, z, (nx, nz), |rr, zz| {
-        let k = depleted_from(states, rr, zz);
+        let i = ((rr - r[0]) / dr - 0.5).round().clamp(0.0, nx as f64 - 1.0) as usize;
+        let j = ((zz - z[0]) / dz - 0.5).round().clamp(0.0, nz as f64 - 1.0) as usize;
+        let k = at(i, j);
         let c = band_color(k, n);
-        if depleted_from(states, rr + dr, zz) != k || depleted_from(states, rr, zz + dz) != k {
+        if at(i + 1, j) != k || at(i, j + 1) != k {
             RGBColor(
                 (f64::from(c.0) * 0.55) as u8,
                 (f64::from(c.1) * 0.55) as u8,

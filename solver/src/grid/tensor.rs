@@ -240,6 +240,19 @@ impl Grid {
         self.bilinear(field, locate(&self.r_mm, r_mm), locate(&self.z_mm, z_mm))
     }
 
+    /// The indices of the four corner nodes of the cell holding (r, z) in mm (clamped to the
+    /// grid), in the order (i, j), (i + 1, j), (i, j + 1), (i + 1, j + 1).
+    pub fn cell_nodes(&self, r_mm: f64, z_mm: f64) -> [usize; 4] {
+        let (i, _) = locate(&self.r_mm, r_mm);
+        let (j, _) = locate(&self.z_mm, z_mm);
+        [
+            self.index(i, j),
+            self.index(i + 1, j),
+            self.index(i, j + 1),
+            self.index(i + 1, j + 1),
+        ]
+    }
+
     /// Index of the node nearest to (r, z) in mm within its cell.
     pub fn nearest(&self, r_mm: f64, z_mm: f64) -> usize {
         let (i, fr) = locate(&self.r_mm, r_mm);
@@ -268,6 +281,20 @@ fn locate(t: &[f64], x: f64) -> (usize, f64) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn cell_nodes_are_the_corners_of_the_cell_holding_the_point() {
+        let g = Grid::new(vec![0.0, 1.0, 2.0], vec![0.0, 1.0, 3.0]).unwrap();
+        assert_eq!(
+            g.cell_nodes(1.5, 2.0),
+            [g.index(1, 1), g.index(2, 1), g.index(1, 2), g.index(2, 2)]
+        );
+        // Outside: the nearest cell.
+        assert_eq!(
+            g.cell_nodes(-1.0, 9.0),
+            [g.index(0, 1), g.index(1, 1), g.index(0, 2), g.index(1, 2)]
+        );
+    }
 
     #[test]
     fn refine_and_interpolate() {
