@@ -8,6 +8,7 @@
 
 use std::path::{Path, PathBuf};
 
+use hpge_validation::studies::coverage::ParameterCoverage;
 use serde_json::Value;
 
 use crate::{Error, Result};
@@ -216,26 +217,10 @@ fn coverage_row(root: &Path, name: &str, what: &str, needed: u64) -> Result<Stat
 }
 
 /// Whether one parameter of a coverage study passes: KS p > 0.01 and both coverages inside their
-/// expected bands.
+/// expected bands ([`ParameterCoverage::failures_at`]; a record that is not one fails).
 fn parameter_passes(p: &Value) -> bool {
-    let inside = |c: &str, band: &str| -> bool {
-        match (
-            p.get(c).and_then(Value::as_f64),
-            p.get(band).and_then(Value::as_array),
-        ) {
-            (Some(x), Some(b)) if b.len() == 2 => {
-                let lo = b[0].as_f64().unwrap_or(f64::NAN);
-                let hi = b[1].as_f64().unwrap_or(f64::NAN);
-                x >= lo && x <= hi
-            }
-            _ => false,
-        }
-    };
-    p.get("ks_p")
-        .and_then(Value::as_f64)
-        .is_some_and(|k| k > 0.01)
-        && inside("coverage_683", "expected_683")
-        && inside("coverage_955", "expected_955")
+    serde_json::from_value::<ParameterCoverage>(p.clone())
+        .is_ok_and(|pc| pc.failures_at(0.01).is_empty())
 }
 
 /// The default surrogate's held-out figures (`models/NAME.heldout.json`).

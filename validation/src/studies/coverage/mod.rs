@@ -30,6 +30,7 @@ use crate::error::Result;
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ParameterCoverage {
     /// Name.
+    #[serde(default)]
     pub name: String,
     /// KS p-value of the (jittered) normalised ranks against uniform.
     pub ks_p: f64,
@@ -42,8 +43,10 @@ pub struct ParameterCoverage {
     /// The same for 95.5%.
     pub expected_955: [f64; 2],
     /// Coverage at each of COVERAGE_LEVELS.
+    #[serde(default)]
     pub coverage_curve: Vec<f64>,
     /// Rank of each truth among L draws (0..=L).
+    #[serde(default)]
     pub ranks: Vec<usize>,
 }
 
@@ -52,8 +55,14 @@ impl ParameterCoverage {
     /// rank KS test at p > 0.01 / d, and the 68.3% and 95.5% coverages inside their 99%
     /// binomial bands. The study passes when no parameter fails one.
     pub fn failures(&self, d: usize) -> Vec<String> {
+        self.failures_at(0.01 / d.max(1) as f64)
+    }
+
+    /// [`ParameterCoverage::failures`] with the KS test at p > `ks_limit` (e.g. 0.01 for one
+    /// parameter judged alone, as an acceptance line states it).
+    pub fn failures_at(&self, ks_limit: f64) -> Vec<String> {
         let mut f = Vec::new();
-        let limit = 0.01 / d.max(1) as f64;
+        let limit = ks_limit;
         // NaN fails.
         if self.ks_p.is_nan() || self.ks_p <= limit {
             f.push(format!("rank KS p {:.2e} < {limit:.1e}", self.ks_p));
