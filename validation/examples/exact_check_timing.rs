@@ -5,13 +5,10 @@
 //! (draws FIRST.. FIRST+COUNT-1 of the N thinned ones; `CURVES=DIR` writes each curve to DIR)
 //! (the shipped data, model, prior and detector).
 
-use hpge_inference::fit::{
-    DEFAULT_DATA, DEFAULT_DETECTOR, DEFAULT_MODEL, DEFAULT_PRIOR, FitFiles, FitJob, outputs,
-    thin_indices,
-};
+use hpge_inference::fit::{FitJob, outputs, thin_indices};
 use hpge_solver::GridOverrides;
 use hpge_solver::field::{Continuation, cv_curve_with};
-use hpge_validation::repo_path;
+use hpge_validation::shipped_fit_files;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -19,12 +16,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .first()
         .ok_or("usage: exact_check_timing SAMPLES.csv [N]")?;
     let n: usize = args.get(1).map_or(Ok(100), |a| a.parse())?;
-    let files = FitFiles {
-        data: repo_path(DEFAULT_DATA),
-        model: repo_path(DEFAULT_MODEL),
-        prior: repo_path(DEFAULT_PRIOR),
-        detector: repo_path(DEFAULT_DETECTOR),
-    };
+    let files = shipped_fit_files();
     let grid = GridOverrides {
         tolerance: args.get(2).map(|a| a.parse()).transpose()?,
         grid: Vec::new(),

@@ -5,13 +5,10 @@
 //! `cargo run --release -p hpge-validation --example refine_probe -- FITDIR N OUT.csv [SKIP]`
 
 use hpge_inference::CvModel;
-use hpge_inference::fit::{
-    DEFAULT_DATA, DEFAULT_DETECTOR, DEFAULT_MODEL, DEFAULT_PRIOR, FitFiles, FitJob, outputs,
-    thin_indices,
-};
+use hpge_inference::fit::{FitJob, outputs, thin_indices};
 use hpge_inference::model::ExactModel;
 use hpge_solver::GridOverrides;
-use hpge_validation::repo_path;
+use hpge_validation::shipped_fit_files;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -19,12 +16,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let n: usize = args.get(1).ok_or("N")?.parse()?;
     let out = args.get(2).ok_or("OUT")?;
     let skip: usize = args.get(3).map_or(Ok(0), |a| a.parse())?;
-    let files = FitFiles {
-        data: repo_path(DEFAULT_DATA),
-        model: repo_path(DEFAULT_MODEL),
-        prior: repo_path(DEFAULT_PRIOR),
-        detector: repo_path(DEFAULT_DETECTOR),
-    };
+    let files = shipped_fit_files();
     let job = FitJob::from_files(&files, Default::default(), &GridOverrides::default())?;
     let draws = outputs::read_samples(&dir.join("samples.csv"))?;
     let summary: serde_json::Value =

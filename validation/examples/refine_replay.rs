@@ -8,13 +8,11 @@
 //! `cargo run --release -p hpge-validation --example refine_replay -- FITDIR TRAIN TEST [EVALS [EXTRA]]`
 
 use hpge_inference::CvModel;
-use hpge_inference::fit::{
-    DEFAULT_DATA, DEFAULT_DETECTOR, DEFAULT_MODEL, DEFAULT_PRIOR, FitFiles, FitJob, SavedRound,
-};
+use hpge_inference::fit::{FitJob, SavedRound};
 use hpge_inference::refine::{CorrectedModel, GpCorrection};
 use hpge_inference::summary::psis;
 use hpge_solver::GridOverrides;
-use hpge_validation::repo_path;
+use hpge_validation::shipped_fit_files;
 
 type Curves = Vec<(Vec<f64>, Vec<f64>)>;
 
@@ -32,12 +30,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .collect::<Result<_, _>>()?;
     let test: usize = args.get(2).ok_or("TEST")?.parse()?;
     let evals: usize = args.get(3).map_or(Ok(600), |a| a.parse())?;
-    let files = FitFiles {
-        data: repo_path(DEFAULT_DATA),
-        model: repo_path(DEFAULT_MODEL),
-        prior: repo_path(DEFAULT_PRIOR),
-        detector: repo_path(DEFAULT_DETECTOR),
-    };
+    let files = shipped_fit_files();
     let job = FitJob::from_files(&files, Default::default(), &GridOverrides::default())?;
     let read = |k: usize| -> Result<SavedRound, Box<dyn std::error::Error>> {
         let p = dir.join(format!("rounds/round-{k}.json"));

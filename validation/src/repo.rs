@@ -6,3 +6,16 @@ pub fn repo_path(relative: &str) -> std::path::PathBuf {
         .join("..")
         .join(relative)
 }
+
+/// The main job's shipped inputs (data, surrogate, prior, detector) as absolute paths: what the
+/// probes of a fit (`examples/refine_probe.rs`, `refine_replay.rs`, `exact_check_timing.rs`)
+/// build their job from.
+pub fn shipped_fit_files() -> hpge_inference::fit::FitFiles {
+    use hpge_inference::fit::{DEFAULT_DATA, DEFAULT_DETECTOR, DEFAULT_MODEL, DEFAULT_PRIOR};
+    hpge_inference::fit::FitFiles {
+        data: repo_path(DEFAULT_DATA),
+        model: repo_path(DEFAULT_MODEL),
+        prior: repo_path(DEFAULT_PRIOR),
+        detector: repo_path(DEFAULT_DETECTOR),
+    }
+}
