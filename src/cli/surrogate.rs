@@ -137,14 +137,11 @@ pub fn train(job: &TrainJob, plot: Option<&Path>, quiet: bool) -> Result<()> {
             dir,
         )?;
         // Both sets in one scatter (the paper's Fig. 18).
+        let train_pred = model.predict_set(&outcome.train_set);
         for ext in ["svg", "png"] {
             hpge_reports::plot::scatter_sets(
                 &[
-                    (
-                        "training",
-                        &outcome.train_predictions,
-                        &outcome.train_c12_pf,
-                    ),
+                    ("training", &train_pred, &outcome.train_set.c12_pf),
                     ("test", &outcome.test_predictions, &outcome.test_c12_pf),
                 ],
                 &model.info,

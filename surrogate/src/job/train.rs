@@ -109,10 +109,8 @@ pub struct TrainOutcome {
     pub test_predictions: Vec<f64>,
     /// The solver's c12 (pF) of each test sample.
     pub test_c12_pf: Vec<f64>,
-    /// The model's c12 (pF) of each training sample (for the scatter of both sets).
-    pub train_predictions: Vec<f64>,
-    /// The solver's c12 (pF) of each training sample.
-    pub train_c12_pf: Vec<f64>,
+    /// The training set as read (a caller that draws both sets predicts it only then).
+    pub train_set: DataSet,
 }
 
 /// The detector record of a model: the file and the hash a generation run's fingerprint gives
@@ -260,7 +258,6 @@ impl TrainJob {
         info.train_seconds = seconds;
         let mut model = Surrogate::new(info.clone(), predictor)?;
         let pred = model.predict_set(&test);
-        let train_pred = model.predict_set(&train);
         info.test_figures = Figures::of(&pred, &test.c12_pf);
         info.sigma_p = info.test_figures.rel_sigma;
         model.info = info;
@@ -287,8 +284,7 @@ impl TrainJob {
             seconds,
             test_predictions: pred,
             test_c12_pf: test.c12_pf,
-            train_predictions: train_pred,
-            train_c12_pf: train.c12_pf,
+            train_set: train,
         })
     }
 
