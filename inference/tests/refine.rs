@@ -62,19 +62,26 @@ macro_rules! common {
     };
 }
 
+/// The exact model's curve, Jacobian and sigma_rel (0): the closed form itself.
+macro_rules! closed_form {
+    () => {
+        fn sigma_rel(&self) -> f64 {
+            0.0
+        }
+        fn curve(&self, x: &[f64], c: &mut [f64]) -> Result<()> {
+            exact_curve(x, c, None);
+            Ok(())
+        }
+        fn curve_jacobian(&self, x: &[f64], c: &mut [f64], jac: &mut [f64]) -> Result<()> {
+            exact_curve(x, c, Some(jac));
+            Ok(())
+        }
+    };
+}
+
 impl CvModel for Exact {
     common!();
-    fn sigma_rel(&self) -> f64 {
-        0.0
-    }
-    fn curve(&self, x: &[f64], c: &mut [f64]) -> Result<()> {
-        exact_curve(x, c, None);
-        Ok(())
-    }
-    fn curve_jacobian(&self, x: &[f64], c: &mut [f64], jac: &mut [f64]) -> Result<()> {
-        exact_curve(x, c, Some(jac));
-        Ok(())
-    }
+    closed_form!();
 }
 
 impl CvModel for Surrogate {
@@ -404,17 +411,7 @@ struct GridFlaky;
 
 impl CvModel for GridFlaky {
     common!();
-    fn sigma_rel(&self) -> f64 {
-        0.0
-    }
-    fn curve(&self, x: &[f64], c: &mut [f64]) -> Result<()> {
-        exact_curve(x, c, None);
-        Ok(())
-    }
-    fn curve_jacobian(&self, x: &[f64], c: &mut [f64], jac: &mut [f64]) -> Result<()> {
-        exact_curve(x, c, Some(jac));
-        Ok(())
-    }
+    closed_form!();
     fn curves_near(
         &self,
         x: &[f64],
