@@ -45,6 +45,7 @@
 mod error;
 pub mod discover;
 pub mod fit;
+mod json_file;
 pub mod paper;
 pub mod plot;
 mod provenance;

@@ -72,17 +72,7 @@ pub struct StatusRow {
 }
 
 fn read_json(root: &Path, rel: &str) -> Result<Value> {
-    let file = root.join(rel);
-    let text = std::fs::read_to_string(&file).map_err(|source| Error::Read {
-        file: file.clone(),
-        what: "a results file of the status table",
-        source,
-    })?;
-    serde_json::from_str(&text).map_err(|source| Error::Json {
-        file,
-        what: "not JSON",
-        source,
-    })
+    crate::json_file::read_json(&root.join(rel), "a results file of the status table")
 }
 
 /// A number at `key` (a JSON pointer) of `v`, or an error naming the file and the key.

@@ -305,17 +305,7 @@ pub fn coverage_title(prior: &str, data_from: &str) -> String {
 /// A missing or unreadable `coverage.json` (named), and every error of [`coverage_figures`].
 pub fn redraw_coverage(dir: &Path) -> Result<Vec<PathBuf>> {
     let file = dir.join("coverage.json");
-    let text = std::fs::read_to_string(&file).map_err(|source| crate::Error::Read {
-        file: file.clone(),
-        what: "a coverage study's results",
-        source,
-    })?;
-    let v: serde_json::Value =
-        serde_json::from_str(&text).map_err(|source| crate::Error::Json {
-            file: file.clone(),
-            what: "not JSON",
-            source,
-        })?;
+    let v = crate::json_file::read_json(&file, "a coverage study's results")?;
     let report: CoverageReport =
         serde_json::from_value(v.clone()).map_err(|source| crate::Error::Json {
             file: file.clone(),
