@@ -77,6 +77,7 @@ pub mod measure;
 mod options;
 pub mod peak;
 pub mod slope;
+pub mod stand_in;
 pub mod synth;
 pub mod tail;
 mod types;

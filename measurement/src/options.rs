@@ -86,6 +86,24 @@ pub struct SynthOptions {
         arg(long, value_name = "K", default_value_t = DEFAULT_DECIMATE)
     )]
     pub decimate: usize,
+    /// Draw the run's calibration error once: the true charge scale and circuit constants
+    /// differ from the nominal ones (which `measure` assumes) by 3% normal draws each, so every
+    /// point carries one common factor (sd 5.96%; recorded in truth.json).
+    #[cfg_attr(feature = "clap", arg(long))]
+    pub draw_calibration: bool,
+    /// Relative part f_s of the detector's independent per-bias mismatch to the model's curve,
+    /// c12_det = c12 + (f_s c12 + a_s) z (paper, eq. 7: 0.01) [default: 0, none].
+    #[cfg_attr(
+        feature = "clap",
+        arg(long = "mismatch-rel", value_name = "F", default_value_t = 0.0)
+    )]
+    pub mismatch_rel: f64,
+    /// Absolute part a_s of that mismatch, pF (paper, eq. 7: 1) [default: 0, none].
+    #[cfg_attr(
+        feature = "clap",
+        arg(long = "mismatch-abs-pf", value_name = "PF", default_value_t = 0.0)
+    )]
+    pub mismatch_abs_pf: f64,
 }
 
 impl SynthOptions {
@@ -98,6 +116,9 @@ impl SynthOptions {
             depletion_voltage: None,
             pulses: DEFAULT_PULSER_PULSES,
             decimate: DEFAULT_DECIMATE,
+            draw_calibration: false,
+            mismatch_rel: 0.0,
+            mismatch_abs_pf: 0.0,
         }
     }
 
@@ -130,6 +151,14 @@ impl SynthOptions {
                     "must lie in 1..={most}: a trace has {native} samples and must keep at least {MIN_DECIMATED_SAMPLES}"
                 ),
             );
+        }
+        for (flag, v) in [
+            ("--mismatch-rel", self.mismatch_rel),
+            ("--mismatch-abs-pf", self.mismatch_abs_pf),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                return bad(format!("{flag} {v}"), "must be a number >= 0".into());
+            }
         }
         if let Some(v) = self.depletion_voltage
             && !(v.is_finite() && v > 0.0)

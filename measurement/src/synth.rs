@@ -74,8 +74,11 @@ pub struct SynthSettings {
     pub slow_fraction: f64,
     /// tau_0 of the slow part extrapolated to 0 V, ns (default 1500).
     pub slow_tau_ns: f64,
-    /// The circuit that turns c12 into charge.
+    /// The circuit that turns c12 into charge (the true one: `measure` assumes the nominal).
     pub circuit: Circuit,
+    /// Recorded charge per true charge (default 1: an exact calibration; a drawn calibration
+    /// error, [`crate::stand_in::CalibrationDraw`], scales every recorded sample).
+    pub charge_scale: f64,
 }
 
 impl Default for SynthSettings {
@@ -95,6 +98,7 @@ impl Default for SynthSettings {
             slow_fraction: 0.5,
             slow_tau_ns: 1500.0,
             circuit: Circuit::default(),
+            charge_scale: 1.0,
         }
     }
 }
@@ -109,6 +113,7 @@ impl SynthSettings {
             ("rise_ns", self.rise_ns),
             ("gamma_rise_ns", self.gamma_rise_ns),
             ("slow_tau_ns", self.slow_tau_ns),
+            ("charge_scale", self.charge_scale),
         ] {
             if !(v.is_finite() && v > 0.0) {
                 return Err(Error::setting(k, format!("must be positive, got {v}")));
@@ -283,7 +288,7 @@ pub fn synthesize_voltage(
             } else {
                 q * (1.0 - (-t / s.gamma_rise_ns).exp())
             };
-            *v = b + signal + noise.sample(&mut rng);
+            *v = s.charge_scale * (b + signal + noise.sample(&mut rng));
         }
         for blk in trace.chunks_exact(s.decimate).take(out_n) {
             charge.push(blk.iter().sum::<f64>() / s.decimate as f64);

@@ -189,3 +189,56 @@ fn shipped_curve_loads_with_its_covariance() {
     assert_eq!(run.sets.len(), 60);
     assert!(run.problems.is_empty(), "{:?}", run.problems);
 }
+
+/// A stand-in with a drawn calibration and model mismatch (`synthesize --draw-calibration
+/// --mismatch-rel 0.01 --mismatch-abs-pf 1`), measured with the nominal circuit: every point
+/// recovers the detector's curve times the run's one calibration factor, to its statistics;
+/// the measured covariance's calibration term covers that factor.
+#[test]
+fn a_drawn_calibration_is_one_common_factor() {
+    use hpge_measurement::SynthOptions;
+    use hpge_measurement::stand_in::StandInDraws;
+
+    let volts = [75.0, 1025.0, 2025.0, 2975.0];
+    let model: Vec<f64> = volts.iter().map(|&u| truth_pf(u)).collect();
+    let mut o = SynthOptions::new(Path::new("truth.csv"), Path::new("raw"));
+    o.seed = 20231001;
+    o.draw_calibration = true;
+    o.mismatch_rel = 0.01;
+    o.mismatch_abs_pf = 1.0;
+    let draws = StandInDraws::draw(&o, &model).unwrap();
+    let cal = draws.calibration.as_ref().unwrap();
+    assert!((cal.c12_factor - 1.0).abs() > 1e-3, "{}", cal.c12_factor);
+    let s = draws.settings(&SynthSettings {
+        pulser_pulses: 60,
+        decimate: 20,
+        ..SynthSettings::default()
+    });
+    let sets: Vec<_> = volts
+        .iter()
+        .zip(&draws.detector_pf)
+        .enumerate()
+        .map(|(k, (&u, &c))| {
+            synthesize_voltage(u, c, 2600.0, &s, voltage_seed(o.seed, k))
+                .unwrap()
+                .set
+        })
+        .collect();
+    let m = measure(&sets, &MeasureSettings::default(), Path::new("stand-in")).unwrap();
+    let want = draws.expected_measured_pf();
+    let cov = m.curve.covariance_pf2.as_ref().unwrap();
+    for (k, (&c, w)) in m.curve.c12_pf.iter().zip(&want).enumerate() {
+        assert!(
+            (c / w - 1.0).abs() < 2e-3,
+            "{} V: measured {c} pF, expected {w} pF (factor {})",
+            volts[k],
+            cal.c12_factor
+        );
+        let z = (c / model[k] - 1.0) / (cov[k][k].sqrt() / c);
+        assert!(
+            z.abs() < 4.0,
+            "{} V: the calibration error is {z} sd of the covariance",
+            volts[k]
+        );
+    }
+}

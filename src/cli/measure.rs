@@ -4,6 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
+use hpge_measurement::stand_in::StandInDraws;
 use hpge_measurement::synth::voltage_seed;
 use hpge_measurement::{
     MeasureOptions, Measurement, PulseSet, RawProblem, SynthOptions, depletion_voltage, measure,
@@ -231,6 +232,8 @@ pub fn synthesize(o: &SynthOptions) -> Result<()> {
         _ => anyhow::anyhow!("synthesis settings: {e}"),
     })?;
     let (volts, c12) = read_truth(&o.curve)?;
+    let draws = StandInDraws::draw(o, &c12)
+        .with_context(|| format!("--curve {}: the stand-in's draws", o.curve.display()))?;
     let ufd = match o.depletion_voltage {
         Some(v) if v.is_finite() && v > 0.0 => v,
         Some(v) => bail!("--depletion-voltage {v}: must be a positive number of volts"),
@@ -244,7 +247,7 @@ pub fn synthesize(o: &SynthOptions) -> Result<()> {
     let made = !o.out.exists();
     std::fs::create_dir_all(&o.out)
         .with_context(|| format!("--out {}: cannot create the folder", o.out.display()))?;
-    let written = write_synthetic(o, &settings, &volts, &c12, ufd);
+    let written = write_synthetic(o, &settings, &volts, &c12, ufd, &draws);
     if written.is_err() && made {
         let _ = std::fs::remove_dir_all(&o.out);
     }
@@ -258,13 +261,15 @@ fn write_synthetic(
     volts: &[f64],
     c12: &[f64],
     ufd: f64,
+    draws: &StandInDraws,
 ) -> Result<()> {
+    let settings = &draws.settings(settings);
     let bar = ProgressBar::new(volts.len() as u64);
     bar.set_style(
         ProgressStyle::with_template("{bar:40} {pos}/{len} voltages, eta {eta}")
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
-    for (k, (&u, &c)) in volts.iter().zip(c12).enumerate() {
+    for (k, (&u, &c)) in volts.iter().zip(&draws.detector_pf).enumerate() {
         let v = synthesize_voltage(u, c, ufd, settings, voltage_seed(o.seed, k))?;
         let name = o.out.join(format!("U{:04}V.npy", u.round() as i64));
         let set = PulseSet {
@@ -297,6 +302,14 @@ fn write_synthetic(
         "depletion_voltage_V": ufd,
         "seed": o.seed,
         "settings": settings,
+        "mismatch": json!({
+            "rel": o.mismatch_rel,
+            "abs_pF": o.mismatch_abs_pf,
+            "formula": "c12_detector = c12 + (rel c12 + abs) z, z ~ N(0, 1) per bias (paper eq. 7)",
+        }),
+        "c12_detector_pF": draws.detector_pf,
+        "calibration": draws.calibration,
+        "c12_expected_measured_pF": draws.expected_measured_pf(),
         "version": env!("CARGO_PKG_VERSION"),
     });
     let truth_path = o.out.join("truth.json");
