@@ -33,6 +33,11 @@ pub const DEFAULT_EXACT_DRAWS: usize = 100;
 /// while a user waits; the shipped fit converges in about 30 s. Half the library's budget
 /// ([`crate::sampler::DEFAULT_MAX_SECONDS`]), which is meant for unattended runs.
 pub const FIT_MAX_SECONDS: f64 = 300.0;
+/// The likelihood of `fit` unless `--likelihood` names one: the measured covariance where the
+/// curve has one. A measured curve's calibration error is one scale shared by every point
+/// (5.96% for the paper's circuit uncertainties); the paper's 3% independent term weighs a
+/// common scale delta as 60 (delta / 3%)^2 in chi^2, the covariance as (delta / 5.96%)^2.
+pub const FIT_LIKELIHOOD: &str = "auto";
 
 /// Everything a user chooses about a fit.
 #[derive(Debug, Clone, PartialEq)]
@@ -107,9 +112,10 @@ pub struct FitOptions {
     /// code 4).
     #[cfg_attr(feature = "clap", arg(long))]
     pub allow_exact_mismatch: bool,
-    /// Likelihood: paper (independent, 3% measurement term) or covariance (the measured
-    /// covariance instead of the 3% term).
-    #[cfg_attr(feature = "clap", arg(long, default_value = NoiseKind::default().as_str()))]
+    /// Likelihood: paper (independent, 3% measurement term), covariance (the measured
+    /// covariance instead of the 3% term: one calibration scale shared by every point), or auto
+    /// (covariance where the curve comes with its <stem>.covariance.csv, else paper).
+    #[cfg_attr(feature = "clap", arg(long, default_value = FIT_LIKELIHOOD))]
     pub likelihood: String,
     /// The surrogate's constant sigma_p in the likelihood (the paper's eq. 13) even where its
     /// model file has a calibrated per-point uncertainty sigma_s(p, U_B) (`hpge-cv calibrate`).
@@ -162,7 +168,7 @@ impl Default for FitOptions {
             refine_rounds: DEFAULT_REFINE_ROUNDS,
             refine_variance: RefineVariance::default().as_str().into(),
             allow_exact_mismatch: false,
-            likelihood: NoiseKind::default().as_str().into(),
+            likelihood: FIT_LIKELIHOOD.into(),
             constant_sigma: false,
             chains: DEFAULT_CHAINS,
             ess: DEFAULT_ESS_MIN,
@@ -341,7 +347,7 @@ pub fn sampler_kind(name: &str) -> Result<SamplerKind> {
 pub fn noise_settings(likelihood: &str) -> Result<NoiseSettings> {
     let kind = NoiseKind::parse(likelihood).ok_or_else(|| Error::BadOption {
         option: format!("--likelihood {likelihood}"),
-        message: "use paper or covariance".into(),
+        message: "use paper, covariance or auto".into(),
     })?;
     Ok(NoiseSettings {
         kind,

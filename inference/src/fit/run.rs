@@ -193,7 +193,7 @@ pub fn fit(
         posterior_outside_support: None,
         program_version: env!("CARGO_PKG_VERSION").into(),
         inputs,
-        likelihood: settings.noise,
+        likelihood: posterior.likelihood.noise,
         settings: settings.sample,
         stop: samples.stop,
         tuned: samples.tuned,

@@ -12,6 +12,16 @@
 //! replaces the diagonal 3% term,
 //!   Sigma(c_p) = V_m + diag((f_s c_p + a_s)^2 + (sigma_p c_p)^2),
 //!   ln L = -r^T Sigma^-1 r / 2 - ln det Sigma / 2 - N ln sqrt(2 pi),  r = c_m - c_p.
+//! A measured covariance is one calibration scale shared by every point plus each point's
+//! statistics, V_m = u u^T + diag(d) (`measure`'s, exactly); then Sigma = D + u u^T with D
+//! diagonal, and Sherman-Morrison gives, with w = D^-1 u and s = 1 + u^T w,
+//!   Sigma^-1 r = D^-1 r - w (w^T r) / s,  ln det Sigma = sum_k ln D_k + ln s,
+//!   (Sigma^-1)_kk = 1 / D_k - w_k^2 / s,
+//! in O(N) instead of a Cholesky factorisation's O(N^3) per evaluation ([`RankOne`]; any other
+//! covariance takes the Cholesky path). Both give the same numbers (unit tests).
+//!
+//! `auto` ([`NoiseKind::Auto`]): the covariance variant where the curve comes with its covariance,
+//! else the paper's; [`Likelihood::new`] resolves it, so a likelihood's kind is never `auto`.
 
 use rand::Rng;
 use rand_distr::{Distribution, StandardNormal};
@@ -31,14 +41,18 @@ pub enum NoiseKind {
     Paper,
     /// The measured covariance instead of the 3% term.
     Covariance,
+    /// `covariance` where the curve has a covariance file, else `paper` (resolved when the data
+    /// are bound: [`Likelihood::new`]).
+    Auto,
 }
 
 impl NoiseKind {
-    /// Parses `paper` or `covariance`.
+    /// Parses `paper`, `covariance` or `auto`.
     pub fn parse(s: &str) -> Option<Self> {
         match s {
             "paper" => Some(NoiseKind::Paper),
             "covariance" => Some(NoiseKind::Covariance),
+            "auto" => Some(NoiseKind::Auto),
             _ => None,
         }
     }
@@ -48,6 +62,7 @@ impl NoiseKind {
         match self {
             NoiseKind::Paper => "paper",
             NoiseKind::Covariance => "covariance",
+            NoiseKind::Auto => "auto",
         }
     }
 }
@@ -109,14 +124,83 @@ pub struct Likelihood {
     pub sigma_rel_model: f64,
     /// V_m (row-major), for the covariance variant.
     covariance: Option<Vec<f64>>,
+    /// V_m as u u^T + diag(d) where it has that form (the fast path).
+    rank_one: Option<RankOne>,
+}
+
+/// A covariance u u^T + diag(d): one fully correlated scale plus independent parts.
+#[derive(Debug, Clone, PartialEq)]
+struct RankOne {
+    u: Vec<f64>,
+    d: Vec<f64>,
+}
+
+impl RankOne {
+    /// u and d of `v` (N x N, row-major) when every off-diagonal element is u_j u_k to 1e-12
+    /// of sqrt(V_jj V_kk) and d = diag(V) - u^2 >= 0; None otherwise (or for N < 3, where
+    /// u is not determined by the off-diagonal elements).
+    fn detect(v: &[f64], n: usize) -> Option<Self> {
+        if n < 3 {
+            return None;
+        }
+        let at = |j: usize, k: usize| v[j * n + k];
+        let u = (0..n)
+            .map(|k| {
+                let (j, l) = ((k + 1) % n, (k + 2) % n);
+                let u2 = at(k, j) * at(k, l) / at(j, l);
+                // Signs relative to u_0 > 0.
+                let sign = if k == 0 { 1.0 } else { at(k, 0).signum() };
+                (u2.is_finite() && u2 > 0.0).then(|| sign * u2.sqrt())
+            })
+            .collect::<Option<Vec<f64>>>()?;
+        let tol = 1e-12;
+        for j in 0..n {
+            for k in 0..n {
+                if j != k && (at(j, k) - u[j] * u[k]).abs() > tol * (at(j, j) * at(k, k)).sqrt() {
+                    return None;
+                }
+            }
+        }
+        let d: Vec<f64> = (0..n).map(|k| (at(k, k) - u[k] * u[k]).max(0.0)).collect();
+        if (0..n).any(|k| at(k, k) - u[k] * u[k] < -tol * at(k, k)) {
+            return None;
+        }
+        Some(Self { u, d })
+    }
+
+    /// (Sigma^-1 r, ln det Sigma, diag Sigma^-1) for Sigma = diag(d + extra) + u u^T, or None
+    /// where a diagonal element is not positive.
+    fn solve(&self, extra: impl Fn(usize) -> f64, r: &[f64]) -> Option<(Vec<f64>, f64, Vec<f64>)> {
+        let n = self.u.len();
+        let dd: Vec<f64> = (0..n).map(|k| self.d[k] + extra(k)).collect();
+        if dd.iter().any(|&x| !(x > 0.0 && x.is_finite())) {
+            return None;
+        }
+        let w: Vec<f64> = (0..n).map(|k| self.u[k] / dd[k]).collect();
+        let s = 1.0 + self.u.iter().zip(&w).map(|(a, b)| a * b).sum::<f64>();
+        let wr: f64 = w.iter().zip(r).map(|(a, b)| a * b).sum();
+        let alpha = (0..n).map(|k| r[k] / dd[k] - w[k] * wr / s).collect();
+        let ln_det = dd.iter().map(|x| x.ln()).sum::<f64>() + s.ln();
+        let inv_diag = (0..n).map(|k| 1.0 / dd[k] - w[k] * w[k] / s).collect();
+        Some((alpha, ln_det, inv_diag))
+    }
 }
 
 impl Likelihood {
     /// The likelihood of `data` under `noise`, with the model's sigma_p. The covariance variant
-    /// needs the data's covariance.
+    /// needs the data's covariance; `auto` becomes `covariance` where the data have one, else
+    /// `paper`.
     pub fn new(data: &CvData, noise: NoiseSettings, sigma_rel_model: f64) -> Result<Self> {
+        let mut noise = noise;
+        if noise.kind == NoiseKind::Auto {
+            noise.kind = if data.covariance_pf2.is_some() {
+                NoiseKind::Covariance
+            } else {
+                NoiseKind::Paper
+            };
+        }
         let covariance = match noise.kind {
-            NoiseKind::Paper => None,
+            NoiseKind::Paper | NoiseKind::Auto => None,
             NoiseKind::Covariance => {
                 let cov = data.covariance_pf2.as_ref().ok_or_else(|| {
                     Error::invalid(
@@ -125,15 +209,59 @@ impl Likelihood {
                         "the covariance likelihood needs the curve's covariance file (<stem>.covariance.csv)",
                     )
                 })?;
-                Some(cov.iter().flatten().copied().collect())
+                Some(cov.iter().flatten().copied().collect::<Vec<f64>>())
             }
         };
+        let n = data.c12_pf.len();
+        let rank_one = covariance
+            .as_deref()
+            .and_then(|v: &[f64]| RankOne::detect(v, n));
         Ok(Self {
             c_m: data.c12_pf.clone(),
             noise,
             sigma_rel_model,
             covariance,
+            rank_one,
         })
+    }
+
+    /// Whether Sigma takes the rank-one fast path; [`Likelihood::dense`] is a copy that
+    /// factorises Sigma by Cholesky even where the fast path applies (tests compare the two).
+    #[cfg(test)]
+    pub(crate) fn has_rank_one(&self) -> bool {
+        self.rank_one.is_some()
+    }
+
+    /// See [`Likelihood::has_rank_one`].
+    #[cfg(test)]
+    pub(crate) fn dense(&self) -> Self {
+        Self {
+            rank_one: None,
+            ..self.clone()
+        }
+    }
+
+    /// (Sigma^-1 r, ln det Sigma, diag Sigma^-1 when `want_diag`) of the covariance variant,
+    /// by the rank-one fast path where V_m has that form, else by Cholesky; None where Sigma is
+    /// not positive definite.
+    fn solve_sigma(
+        &self,
+        vm: &[f64],
+        c_p: &[f64],
+        v: ModelVar,
+        r: &[f64],
+        want_diag: bool,
+    ) -> Option<(Vec<f64>, f64, Vec<f64>)> {
+        if let Some(ro) = &self.rank_one {
+            return ro.solve(|k| self.variance(c_p[k], v.at(k)), r);
+        }
+        let chol = Cholesky::new(&self.covariance_at(vm, c_p, v), self.len())?;
+        let inv_diag = if want_diag {
+            chol.inverse_diagonal()
+        } else {
+            Vec::new()
+        };
+        Some((chol.solve(r), chol.ln_det(), inv_diag))
     }
 
     /// The number of points N.
@@ -151,9 +279,11 @@ impl Likelihood {
     fn variance(&self, c: f64, s2: f64) -> f64 {
         let n = &self.noise;
         let s = n.solver_rel * c + n.solver_abs_pf;
-        let m = match n.kind {
-            NoiseKind::Paper => n.measurement_rel * c,
-            NoiseKind::Covariance => 0.0,
+        // The 3% term unless the measured covariance replaces it.
+        let m = if self.covariance.is_none() {
+            n.measurement_rel * c
+        } else {
+            0.0
         };
         s * s + s2 * c * c + m * m
     }
@@ -163,7 +293,7 @@ impl Likelihood {
         let n = &self.noise;
         let s = n.solver_rel * c + n.solver_abs_pf;
         let mut d = 2.0 * s * n.solver_rel + 2.0 * s2 * c;
-        if n.kind == NoiseKind::Paper {
+        if self.covariance.is_none() {
             d += 2.0 * n.measurement_rel.powi(2) * c;
         }
         d
@@ -253,14 +383,14 @@ impl Likelihood {
                 ll
             }
             Some(vm) => {
-                let Some(chol) = Cholesky::new(&self.covariance_at(vm, c_p, v), n) else {
+                let r: Vec<f64> = (0..n).map(|k| self.c_m[k] - c_p[k]).collect();
+                let grads = gc.is_some() || gv.is_some();
+                let Some((alpha, ln_det, inv_diag)) = self.solve_sigma(vm, c_p, v, &r, grads)
+                else {
                     return f64::NEG_INFINITY;
                 };
-                let r: Vec<f64> = (0..n).map(|k| self.c_m[k] - c_p[k]).collect();
-                let alpha = chol.solve(&r);
                 let quad: f64 = r.iter().zip(&alpha).map(|(x, y)| x * y).sum();
-                if gc.is_some() || gv.is_some() {
-                    let inv_diag = chol.inverse_diagonal();
+                if grads {
                     for k in 0..n {
                         let dl_dv = 0.5 * (alpha[k] * alpha[k] - inv_diag[k]);
                         if let Some(g) = gc.as_deref_mut() {
@@ -271,7 +401,7 @@ impl Likelihood {
                         }
                     }
                 }
-                -0.5 * quad - 0.5 * chol.ln_det() - n as f64 * LN_SQRT_2PI
+                -0.5 * quad - 0.5 * ln_det - n as f64 * LN_SQRT_2PI
             }
         }
     }
@@ -294,11 +424,10 @@ impl Likelihood {
                 .map(|k| (self.c_m[k] - c_p[k]).powi(2) / self.variance(c_p[k], v.at(k)))
                 .sum(),
             Some(vm) => {
-                let Some(chol) = Cholesky::new(&self.covariance_at(vm, c_p, v), n) else {
+                let r: Vec<f64> = (0..n).map(|k| self.c_m[k] - c_p[k]).collect();
+                let Some((alpha, _, _)) = self.solve_sigma(vm, c_p, v, &r, false) else {
                     return f64::INFINITY;
                 };
-                let r: Vec<f64> = (0..n).map(|k| self.c_m[k] - c_p[k]).collect();
-                let alpha = chol.solve(&r);
                 r.iter().zip(&alpha).map(|(x, y)| x * y).sum()
             }
         }

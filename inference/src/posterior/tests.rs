@@ -182,3 +182,56 @@ fn per_point_variance_gradients_match_finite_differences() {
         }
     }
 }
+
+/// The rank-one fast path (Sherman-Morrison) gives the Cholesky path's ln L, gradients and
+/// chi^2; a covariance of another form takes the Cholesky path; `auto` resolves by the data.
+#[test]
+fn rank_one_fast_path_equals_cholesky() {
+    let noise = NoiseSettings {
+        kind: NoiseKind::Covariance,
+        ..NoiseSettings::default()
+    };
+    let fast = Likelihood::new(&data(Some(covariance())), noise, 0.015).unwrap();
+    assert!(
+        fast.has_rank_one(),
+        "measure's form must take the fast path"
+    );
+    let dense = fast.dense();
+    let c_p = vec![310.0, 148.0, 91.0, 59.0, 44.0, 41.0];
+    let var = vec![1e-4, 4e-4, 2.5e-5, 9e-4, 1e-4, 1.6e-3];
+    let (mut g1, mut g2) = (vec![0.0; 6], vec![0.0; 6]);
+    let (mut v1, mut v2) = (vec![0.0; 6], vec![0.0; 6]);
+    let a = fast.ln_likelihood_var(&c_p, &var, Some(&mut g1), Some(&mut v1));
+    let b = dense.ln_likelihood_var(&c_p, &var, Some(&mut g2), Some(&mut v2));
+    assert!((a - b).abs() < 1e-10 * b.abs().max(1.0), "{a} vs {b}");
+    for k in 0..6 {
+        assert!((g1[k] - g2[k]).abs() < 1e-10 * g2[k].abs().max(1e-3), "{k}");
+        assert!((v1[k] - v2[k]).abs() < 1e-8 * v2[k].abs().max(1e-3), "{k}");
+    }
+    let (x, y) = (fast.chi2(&c_p), dense.chi2(&c_p));
+    assert!((x - y).abs() < 1e-10 * y, "{x} vs {y}");
+    // An exponential correlation is not one scale plus independent parts.
+    let c = data(None).c12_pf;
+    let smooth: Vec<Vec<f64>> = (0..6)
+        .map(|i| {
+            (0..6)
+                .map(|j| 0.03 * c[i] * 0.03 * c[j] * (-(i as f64 - j as f64).abs() / 2.0).exp())
+                .collect()
+        })
+        .collect();
+    let l = Likelihood::new(&data(Some(smooth)), noise, 0.015).unwrap();
+    assert!(!l.has_rank_one());
+    // auto: covariance with a covariance file, paper without.
+    let auto = NoiseSettings {
+        kind: NoiseKind::Auto,
+        ..NoiseSettings::default()
+    };
+    let with = Likelihood::new(&data(Some(covariance())), auto, 0.015).unwrap();
+    assert_eq!(with.noise.kind, NoiseKind::Covariance);
+    assert_eq!(
+        with.ln_likelihood(&c_p, None),
+        fast.ln_likelihood(&c_p, None)
+    );
+    let without = Likelihood::new(&data(None), auto, 0.015).unwrap();
+    assert_eq!(without.noise.kind, NoiseKind::Paper);
+}

@@ -58,7 +58,7 @@ pub struct CoverageOptions {
     /// error does to coverage; about 2 CPU-seconds per truth more).
     #[cfg_attr(feature = "clap", arg(long))]
     pub exact: bool,
-    /// Likelihood: paper or covariance.
+    /// Likelihood: paper, covariance, or auto (covariance where the data have one, else paper).
     #[cfg_attr(feature = "clap", arg(long, default_value = NoiseKind::default().as_str()))]
     pub likelihood: String,
     /// Sampler: metropolis or nuts.
