@@ -195,16 +195,27 @@ fn synthesize_reads_old_curves_and_measure_writes_plain_tables() {
     let _ = std::fs::remove_dir_all(&d);
 }
 
-/// The shipped curve still carries its old `#` provenance lines (its hash is recorded in the
-/// shipped models and reports) and still reads: the library reader skips them.
+/// A curve in the format written before issue 22 (leading `#` provenance lines, as the shipped
+/// curve had until it was regenerated with a drawn calibration) still reads: the library reader
+/// skips them. The shipped curve is now a plain table.
 #[test]
-fn the_shipped_old_format_curve_still_reads() {
+fn an_old_format_curve_still_reads() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/super-siegfried-k1/cv.csv");
     let text = std::fs::read_to_string(&path).unwrap();
     assert!(
-        text.starts_with('#'),
-        "the shipped file is no longer old-format"
+        text.starts_with("voltage_V,"),
+        "the shipped curve is a plain table"
     );
-    let c = hpge_measurement::read_curve(&path, None).unwrap();
+    let d = temp("old-format");
+    let old = d.join("cv.csv");
+    std::fs::write(
+        &old,
+        format!("# hpge-cv 0.1.0 measure --raw raw\n# settings: raw/measurement.toml\n{text}"),
+    )
+    .unwrap();
+    let c = hpge_measurement::read_curve(&old, None).unwrap();
     assert_eq!(c.voltage_v.len(), 60);
+    let shipped = hpge_measurement::read_curve(&path, None).unwrap();
+    assert_eq!(c.c12_pf, shipped.c12_pf);
+    let _ = std::fs::remove_dir_all(&d);
 }

@@ -1,5 +1,6 @@
 //! The status table of the README, derived from the results files the repository ships: the
-//! main job's exact-solver check and wall time, the B_Z check, the truth of the stand-in data,
+//! main job's exact-solver check, wall time and chi^2 at its mode, the B_Z check, the truth of
+//! the stand-in data and whether its noise is what its covariance states,
 //! the coverage studies, the default surrogate's held-out accuracy and the solver's accuracy,
 //! each beside its target and a verdict computed from the two.
 //!
@@ -9,6 +10,7 @@
 use std::path::{Path, PathBuf};
 
 use hpge_validation::studies::coverage::ParameterCoverage;
+use hpge_validation::studies::stand_in::{chi2_band, stand_in_noise};
 use serde_json::Value;
 
 use crate::{Error, Result};
@@ -150,6 +152,21 @@ fn fit_rows(root: &Path, name: &str, what: &str, main: bool) -> Result<Vec<Statu
             source: rel.clone(),
         });
     }
+    if main {
+        let chi2 = num(&s, &rel, "/chi2")?;
+        let ndf = num(&s, &rel, "/ndf")? as usize;
+        let [lo, hi] = chi2_band(ndf, 0.99);
+        rows.push(StatusRow {
+            what: format!("{what}: chi^2 at the global mode"),
+            result: format!(
+                "{chi2:.2} for {ndf} degrees of freedom (the likelihood's solver and surrogate \
+                 terms are not in a stand-in made by the same solver)"
+            ),
+            target: format!("inside the central 99% of chi^2({ndf}), [{lo:.1}, {hi:.1}]"),
+            verdict: Verdict::of((lo..=hi).contains(&chi2)),
+            source: rel.clone(),
+        });
+    }
     if let Some(truth) = s.get("truth").and_then(Value::as_array) {
         let inside = truth
             .iter()
@@ -167,6 +184,32 @@ fn fit_rows(root: &Path, name: &str, what: &str, main: bool) -> Result<Vec<Statu
         });
     }
     Ok(rows)
+}
+
+/// The shipped stand-in's noise against its covariance ([`stand_in_noise`]).
+fn stand_in_row(root: &Path) -> Result<StatusRow> {
+    let dir = "data/super-siegfried-k1";
+    let s = stand_in_noise(&root.join(dir)).map_err(|e| Error::Content {
+        file: PathBuf::from(dir),
+        message: e.to_string(),
+    })?;
+    let [lo, hi] = s.band_99;
+    let factor = s.calibration_factor.map_or(String::new(), |f| {
+        format!("; drawn calibration factor {f:.5}")
+    });
+    Ok(StatusRow {
+        what: "stand-in data: noise as its covariance states".into(),
+        result: format!(
+            "chi^2 of the truth curve {:.1} for {} points with the measured covariance{factor}",
+            s.chi2_measured, s.points
+        ),
+        target: format!(
+            "inside the central 99% of chi^2({}), [{lo:.1}, {hi:.1}]",
+            s.points
+        ),
+        verdict: Verdict::of((lo..=hi).contains(&s.chi2_measured)),
+        source: format!("{dir}/README.md"),
+    })
 }
 
 /// A coverage study (`reports/coverage/NAME/coverage.json`) against the truths it needs.
@@ -288,6 +331,7 @@ pub fn status_rows(root: &Path, model: &str) -> Result<Vec<StatusRow>> {
     let (exact_n, surrogate_n) = COVERAGE_TRUTHS;
     let mut rows = fit_rows(root, "b-rz", "main job (B_RZ fit)", true)?;
     rows.extend(fit_rows(root, "b-z", "B_Z fit", false)?);
+    rows.push(stand_in_row(root)?);
     rows.push(coverage_row(
         root,
         "b-rz-exact",

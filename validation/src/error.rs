@@ -20,6 +20,14 @@ pub enum Error {
     /// An inference-side failure (a fit in a coverage study).
     #[error(transparent)]
     Inference(#[from] hpge_inference::Error),
+    /// A shipped file whose content a study cannot use.
+    #[error("{}: {message}", path.display())]
+    File {
+        /// The file.
+        path: std::path::PathBuf,
+        /// What is wrong with it.
+        message: String,
+    },
 }
 
 /// Result alias of the validation crate.
@@ -33,6 +41,7 @@ impl Error {
             Error::Domain { .. } => true,
             Error::Solver(e) => e.is_recoverable(),
             Error::Inference(e) => e.is_recoverable(),
+            Error::File { .. } => false,
         }
     }
 }

@@ -5,8 +5,10 @@
 //!   [`coverage::store`]: its truths written as they finish (resume, shards).
 //! - [`hidden`]: hidden-effect tests of model discovery.
 //! - [`options`]: the options of the coverage and hidden-effect studies as a user states them.
+//! - [`stand_in`]: whether a stand-in data set carries the noise its covariance states.
 
 pub mod accuracy;
 pub mod coverage;
 pub mod hidden;
 pub mod options;
+pub mod stand_in;
