@@ -95,7 +95,8 @@ pub fn write(ctx: &Ctx, total_s: f64) -> Result<PathBuf> {
          - Example density: `{}` with d_Li = 3 mm.\n\
          - Surrogate figures: `{}` (the paper's recipe) on `{}`; the fits use `{}`.\n\
          - Fits: `fit` with the shipped defaults (metropolis, 4 chains, seed 0, ESS 1000, R-hat \
-         1.01, at most 300 s, 24 mode starts, the paper's likelihood){}; B_Z with `{}`, B_RZ with \
+         1.01, at most 300 s, 24 mode starts, the paper's likelihood, not `fit`'s default \
+         measured covariance){}; B_Z with `{}`, B_RZ with \
          `{}` and the stand-in's truth marked; outputs in `fits/`.\n\
          - Section 9: `paper::section9` with the global modes of these two fits; outputs in \
          `section9/`.\n",

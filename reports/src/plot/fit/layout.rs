@@ -121,13 +121,15 @@ pub(super) fn draw_axes<DB: DrawingBackend>(
 }
 
 /// A tick-label formatter for an axis spanning `span`: as many decimals as a step of about
-/// span/6 needs (none for steps of 1 and more), exponent notation for very small or large steps.
+/// span/6 needs (none for steps of 1 and more, at most 12), so that neighbouring labels differ
+/// even on a narrow axis far from 0 (a posterior squeezed against d_Li = 0.2 mm: 0.200002,
+/// 0.200004); exponent notation only for values of 1e6 and more, or below 1e-4 on such a step.
 pub(super) fn ticks(span: f64) -> impl Fn(&f64) -> String {
     let step = (span / 6.0).abs();
-    let exp = !(1e-4..1e6).contains(&step);
-    let decimals = (-step.log10().floor()).max(0.0) as usize;
+    let decimals = (-step.log10().floor()).clamp(0.0, 12.0) as usize;
     move |v: &f64| {
-        if exp {
+        let a = v.abs();
+        if a >= 1e6 || (a > 0.0 && a < 1e-4 && step < 1e-4) {
             format!("{v:.1e}")
         } else {
             format!("{v:.decimals$}")
@@ -212,4 +214,20 @@ pub(super) fn key_strip<DB: DrawingBackend>(
             .map_err(err)?;
     }
     Ok(rest)
+}
+
+#[cfg(test)]
+mod tick_tests {
+    use super::ticks;
+
+    #[test]
+    fn narrow_axes_far_from_zero_keep_their_ticks_apart() {
+        let t = ticks(1.2e-5);
+        assert_eq!(t(&0.200002), "0.200002");
+        assert_ne!(t(&0.200002), t(&0.200004));
+        assert_eq!(ticks(3.0)(&1.5), "1.5");
+        assert_eq!(ticks(600.0)(&200.0), "200");
+        assert_eq!(ticks(3e6)(&2e6), "2.0e6");
+        assert_eq!(ticks(6e-6)(&3e-5), "3.0e-5");
+    }
 }
