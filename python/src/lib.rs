@@ -599,7 +599,8 @@ fn measure<'py>(
 ///
 /// Arguments (defaults: the command line's, relative to the working directory): `data` (C-V
 /// CSV), `model` (surrogate), `prior` (TOML), `detector` (TOML), `seed`, `sampler`
-/// ("metropolis" or "nuts"), `likelihood` ("paper" or "covariance"), `chains`, `ess`, `rhat`,
+/// ("metropolis" or "nuts"), `likelihood` ("auto", the default: the measured covariance
+/// where the curve has one, else "paper"; or "paper", "covariance"), `chains`, `ess`, `rhat`,
 /// `max_seconds` (s), `exact_check` (re-weight `exact_draws` draws with the field solver; off by
 /// default here, on in the command line; `exact_grids` "mode" or "own" and `exact_grid_check`,
 /// as `--exact-grids` and `--exact-grid-check`; while the check fails, up to `refine_rounds`
