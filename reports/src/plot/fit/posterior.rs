@@ -233,11 +233,13 @@ fn marginal<DB: DrawingBackend>(
         .fold(0.0, f64::max)
         .max(1e-300)
         * 1.08;
+    // Room for the longest density label (a posterior squeezed against an edge reaches 1e5).
+    let label_chars = ticks(top)(&top).len() as f64;
     let mut chart = ChartBuilder::on(area)
         .margin(12)
         .margin_right(22)
         .x_label_area_size(48)
-        .y_label_area_size(62)
+        .y_label_area_size((26.0 + 8.5 * label_chars).max(62.0) as u32)
         .build_cartesian_2d(lo..hi, 0.0..top)
         .map_err(err)?;
     draw_axes(
