@@ -50,6 +50,8 @@ stop() {
     kill -TERM "$pid" 2> /dev/null || true
     while kill -0 "$pid" 2> /dev/null; do sleep 0.2; done
   done
+  # A folder this script made goes with it (one given in SLURM_CI_DIR stays for inspection).
+  [ -n "${SLURM_CI_DIR:-}" ] || rm -rf "$D"
 }
 trap stop EXIT
 /usr/sbin/slurmctld
