@@ -84,8 +84,9 @@ mod types;
 
 pub use error::{Error, Result};
 pub use formats::{
-    Data, PulseFormat, RawProblem, RawRun, load_data, read_curve, read_lh5_pulses, read_pulse_file,
-    read_pulses, read_raw_dir, write_curve, write_curve_with_comments, write_pulses,
+    Data, PulseFormat, RawProblem, RawRun, load_data, read_curve, read_lh5_pulses,
+    read_model_curve, read_pulse_file, read_pulses, read_raw_dir, write_curve,
+    write_curve_with_comments, write_pulses,
 };
 pub use measure::{MeasureSettings, Measurement, Problem, VoltagePoint, measure};
 pub use options::{MIN_DECIMATED_SAMPLES, MeasureOptions, SynthOptions};

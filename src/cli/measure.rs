@@ -8,7 +8,7 @@ use hpge_measurement::stand_in::StandInDraws;
 use hpge_measurement::synth::voltage_seed;
 use hpge_measurement::{
     MeasureOptions, Measurement, PulseSet, RawProblem, SynthOptions, depletion_voltage, measure,
-    read_raw_dir, synthesize_voltage, write_curve, write_pulses,
+    read_model_curve, read_raw_dir, synthesize_voltage, write_curve, write_pulses,
 };
 use hpge_reports::plot;
 use indicatif::{ProgressBar, ProgressStyle};
@@ -162,60 +162,6 @@ fn report_json(
     })
 }
 
-/// Reads a curve CSV with columns `voltage_V` and `c12_pF` (the output of `simulate --out` or a
-/// measured curve).
-fn read_truth(path: &Path) -> Result<(Vec<f64>, Vec<f64>)> {
-    let mut rdr = csv::ReaderBuilder::new()
-        .comment(Some(b'#'))
-        .trim(csv::Trim::All)
-        .from_path(path)
-        .with_context(|| format!("--curve {}: cannot read the file", path.display()))?;
-    let headers = rdr.headers()?.clone();
-    let col = |name: &str| {
-        headers
-            .iter()
-            .position(|h| h == name)
-            .with_context(|| format!("--curve {}: no column `{name}`", path.display()))
-    };
-    let (cu, cc) = (col("voltage_V")?, col("c12_pF")?);
-    let (mut u, mut c) = (Vec::new(), Vec::new());
-    for (i, rec) in rdr.records().enumerate() {
-        let rec = rec.with_context(|| format!("--curve {}: line {}", path.display(), i + 2))?;
-        let num = |k: usize, name: &str| -> Result<f64> {
-            let t = rec.get(k).unwrap_or("");
-            t.parse::<f64>()
-                .ok()
-                .filter(|x| x.is_finite())
-                .with_context(|| {
-                    format!(
-                        "--curve {}: line {}, {name}: `{t}` is not a finite number",
-                        path.display(),
-                        i + 2
-                    )
-                })
-        };
-        let volts = num(cu, "voltage_V")?;
-        if volts <= 0.0 {
-            // A pulse file is named by its bias (U0025V.npy): -25 V would make U-025V.npy, and a
-            // bias of 0 or below is no reverse bias at all.
-            bail!(
-                "--curve {}: line {}, voltage_V: {volts} V: the bias U_B must be above 0 V",
-                path.display(),
-                i + 2
-            );
-        }
-        u.push(volts);
-        c.push(num(cc, "c12_pF")?);
-    }
-    if u.len() < 2 || u.windows(2).any(|w| w[1] <= w[0]) || c.iter().any(|x| *x <= 0.0) {
-        bail!(
-            "--curve {}: need at least 2 rows, strictly increasing voltages and c12 > 0",
-            path.display()
-        );
-    }
-    Ok((u, c))
-}
-
 /// Writes one pulse file per bias (`U<bias>V.npy` + sidecar), `measurement.toml` listing the
 /// biases, and `truth.json` with the curve, seed and settings.
 ///
@@ -231,7 +177,8 @@ pub fn synthesize(o: &SynthOptions) -> Result<()> {
         }
         _ => anyhow::anyhow!("synthesis settings: {e}"),
     })?;
-    let (volts, c12) = read_truth(&o.curve)?;
+    let (volts, c12) =
+        read_model_curve(&o.curve).with_context(|| format!("--curve {}", o.curve.display()))?;
     let draws = StandInDraws::draw(o, &c12)
         .with_context(|| format!("--curve {}: the stand-in's draws", o.curve.display()))?;
     let ufd = match o.depletion_voltage {

@@ -251,6 +251,57 @@ fn records(file: &Path, text: &str) -> Result<Vec<Row>> {
     Ok(rows)
 }
 
+/// Reads a model curve without uncertainties: the columns `voltage_V` and `c12_pF` of a CSV,
+/// found by name (others, as `simulate --out`'s `fully_depleted` and `c12_err_pF`, are ignored;
+/// `#` lines are comments). At least 2 rows; every voltage (V) above 0 (a reverse bias) and
+/// strictly increasing, every c12 (pF) above 0.
+///
+/// # Errors
+/// An unreadable file, a missing column, or a cell that breaks these rules, naming the file,
+/// the line and the column.
+pub fn read_model_curve(csv: &Path) -> Result<(Vec<f64>, Vec<f64>)> {
+    let text = read_text(csv)?;
+    let rows = records(csv, &text)?;
+    let Some((header, body)) = rows.split_first() else {
+        return Err(Error::format(
+            csv,
+            "empty: no header with voltage_V and c12_pF",
+        ));
+    };
+    let col = |name: &str| {
+        header
+            .cells
+            .iter()
+            .position(|h| h == name)
+            .ok_or_else(|| Error::format(csv, format!("no column `{name}`")))
+    };
+    let (cu, cc) = (col("voltage_V")?, col("c12_pF")?);
+    let (mut u, mut c) = (Vec::new(), Vec::new());
+    for row in body {
+        let cell = |k: usize| row.cells.get(k).map_or("", String::as_str);
+        let volts = number(csv, row.line, cu, "voltage_V", cell(cu))?;
+        if volts <= 0.0 {
+            return Err(Error::invalid(
+                csv,
+                "voltage_V",
+                format!(
+                    "line {}: {volts} V: the bias U_B must be above 0 V",
+                    row.line
+                ),
+            ));
+        }
+        u.push(volts);
+        c.push(number(csv, row.line, cc, "c12_pF", cell(cc))?);
+    }
+    if u.len() < 2 || u.windows(2).any(|w| w[1] <= w[0]) || c.iter().any(|x| *x <= 0.0) {
+        return Err(Error::format(
+            csv,
+            "need at least 2 rows, strictly increasing voltages and c12 > 0",
+        ));
+    }
+    Ok((u, c))
+}
+
 /// Parses one cell as a finite number; `col` is 0-based, messages give it 1-based with its name.
 fn number(file: &Path, line: u64, col: usize, name: &str, cell: &str) -> Result<f64> {
     let value: f64 = cell.parse().map_err(|_| {

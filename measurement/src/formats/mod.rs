@@ -25,7 +25,7 @@ mod sidecar;
 
 use std::path::Path;
 
-pub use curve::{read_curve, write_curve, write_curve_with_comments};
+pub use curve::{read_curve, read_model_curve, write_curve, write_curve_with_comments};
 pub use lh5::read_lh5_pulses;
 pub use npy::{read_pulses, write_pulses};
 pub use raw_dir::{PulseFormat, RawProblem, RawRun, read_pulse_file, read_raw_dir};

@@ -14,7 +14,7 @@ use std::path::{Path, PathBuf};
 
 use hpge_inference::posterior::NoiseKind;
 use hpge_inference::{Likelihood, NoiseSettings};
-use hpge_measurement::read_curve;
+use hpge_measurement::{read_curve, read_model_curve};
 use serde::Serialize;
 use statrs::distribution::{ChiSquared, ContinuousCDF};
 
@@ -62,28 +62,6 @@ fn content(path: &Path, message: impl Into<String>) -> Error {
     }
 }
 
-/// (U_B, c12) of a truth curve (`voltage_V,c12_pF,...`, `simulate --out`).
-fn truth_curve(path: &Path) -> Result<(Vec<f64>, Vec<f64>)> {
-    let text = std::fs::read_to_string(path).map_err(|e| content(path, e.to_string()))?;
-    let mut lines = text.lines().filter(|l| !l.starts_with('#'));
-    let header = lines.next().unwrap_or_default();
-    if !header.starts_with("voltage_V,c12_pF") {
-        return Err(content(path, "the header must start with voltage_V,c12_pF"));
-    }
-    let mut out = (Vec::new(), Vec::new());
-    for (k, l) in lines.enumerate() {
-        let f: Vec<Option<f64>> = l.split(',').take(2).map(|x| x.parse().ok()).collect();
-        match f[..] {
-            [Some(u), Some(c)] => {
-                out.0.push(u);
-                out.1.push(c);
-            }
-            _ => return Err(content(path, format!("row {}: not two numbers", k + 2))),
-        }
-    }
-    Ok(out)
-}
-
 /// The stand-in of folder `dir` (`cv.csv` with its covariance, `truth-cv.csv`, optionally
 /// `raw/truth.json`) weighed against its truth.
 ///
@@ -94,7 +72,7 @@ pub fn stand_in_noise(dir: &Path) -> Result<StandInNoise> {
     let data_path = dir.join("cv.csv");
     let data = read_curve(&data_path, None).map_err(hpge_inference::Error::from)?;
     let truth_path = dir.join("truth-cv.csv");
-    let (volts, truth) = truth_curve(&truth_path)?;
+    let (volts, truth) = read_model_curve(&truth_path).map_err(hpge_inference::Error::from)?;
     if volts != data.voltage_v {
         return Err(content(
             &truth_path,
