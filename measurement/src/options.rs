@@ -104,6 +104,15 @@ pub struct SynthOptions {
         arg(long = "mismatch-abs-pf", value_name = "PF", default_value_t = 0.0)
     )]
     pub mismatch_abs_pf: f64,
+    /// Correlation length L of that mismatch in ln c12: 0 draws it independently per bias (as
+    /// eq. 7 states it); L > 0 makes it a smooth function of the depletion state,
+    /// z = h(ln c12) with correlation exp(-(ln c_i - ln c_j)^2 / (2 L^2)), as a real detector's
+    /// geometry mismatch is [default: 0].
+    #[cfg_attr(
+        feature = "clap",
+        arg(long = "mismatch-corr-lnc", value_name = "L", default_value_t = 0.0)
+    )]
+    pub mismatch_corr_lnc: f64,
 }
 
 impl SynthOptions {
@@ -119,6 +128,7 @@ impl SynthOptions {
             draw_calibration: false,
             mismatch_rel: 0.0,
             mismatch_abs_pf: 0.0,
+            mismatch_corr_lnc: 0.0,
         }
     }
 
@@ -155,6 +165,7 @@ impl SynthOptions {
         for (flag, v) in [
             ("--mismatch-rel", self.mismatch_rel),
             ("--mismatch-abs-pf", self.mismatch_abs_pf),
+            ("--mismatch-corr-lnc", self.mismatch_corr_lnc),
         ] {
             if !(v.is_finite() && v >= 0.0) {
                 return bad(format!("{flag} {v}"), "must be a number >= 0".into());

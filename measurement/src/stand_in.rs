@@ -17,10 +17,16 @@
 //! **Model mismatch** ([`draw_mismatch`]): the paper (eq. 7) gives each simulated point an
 //! independent uncertainty sigma_s = f_s c12 + a_s (f_s = 1% from the grid, a_s = 1 pF from an
 //! imperfect implementation of the geometry). A real detector's curve differs from its model's
-//! by such amounts; the stand-in draws c12_det,k = c12_k + sigma_s,k z_k, independent per bias.
+//! by such amounts; the stand-in draws c12_det,k = c12_k + sigma_s,k z_k. With a correlation
+//! length L = 0 the z_k are independent per bias, as eq. 7 states them. A real mismatch (a
+//! groove, a contact or a Li layer not quite as modelled) is a smooth function of how far the
+//! detector is depleted, not noise from bias to bias: with L > 0, z_k = h(ln c12_k) where h is
+//! a stationary Gaussian process of unit variance with correlation
+//! exp(-(ln c_i - ln c_j)^2 / (2 L^2)) ([`smooth_unit_process`]). The curve stays smooth, and
+//! constant beyond full depletion where c12 is.
 
-use rand::SeedableRng;
 use rand::rngs::StdRng;
+use rand::{RngExt, SeedableRng};
 use rand_distr::{Distribution, StandardNormal};
 use serde::{Deserialize, Serialize};
 
@@ -90,23 +96,77 @@ impl CalibrationDraw {
     }
 }
 
-/// The detector's curve around the model's: c12_det,k = c12_k + (f_s c12_k + a_s) z_k with
-/// independent z_k ~ N(0, 1) (paper, eq. 7: f_s = `rel`, a_s = `abs_pf`). Same seed, same draw.
+/// Random Fourier features in [`smooth_unit_process`].
+const FOURIER_FEATURES: usize = 1024;
+
+/// One draw of a stationary, unit-variance process with squared-exponential correlation
+/// E[h(x) h(y)] = exp(-(x - y)^2 / (2 `length`^2)), evaluated at `x`, by random Fourier
+/// features (Rahimi and Recht 2007):
+///
+///   h(x) = sqrt(2 / M) sum_m cos(w_m x + phi_m),  w_m ~ N(0, 1 / L^2), phi_m ~ U(0, 2 pi),
+///
+/// whose covariance is the kernel's in expectation over the features (Bochner's theorem) and
+/// whose values tend to a Gaussian process as M = 1024 grows. Unlike a Cholesky factor of the
+/// kernel matrix it stays exact for points that coincide (a curve beyond full depletion).
+pub fn smooth_unit_process(x: &[f64], length: f64, rng: &mut StdRng) -> Vec<f64> {
+    let features: Vec<(f64, f64)> = (0..FOURIER_FEATURES)
+        .map(|_| {
+            let w: f64 = StandardNormal.sample(rng);
+            let phi = std::f64::consts::TAU * rng.random::<f64>();
+            (w / length, phi)
+        })
+        .collect();
+    let scale = (2.0 / FOURIER_FEATURES as f64).sqrt();
+    x.iter()
+        .map(|&x| scale * features.iter().map(|(w, p)| (w * x + p).cos()).sum::<f64>())
+        .collect()
+}
+
+/// The detector's curve around the model's: c12_det,k = c12_k + (f_s c12_k + a_s) z_k
+/// (paper, eq. 7: f_s = `rel`, a_s = `abs_pf`) with z_k ~ N(0, 1): independent per bias when
+/// `corr_lnc` = 0, else z_k = h(ln c12_k) with h the smooth process of
+/// [`smooth_unit_process`] and correlation length `corr_lnc` in ln c12. Same seed, same draw.
 ///
 /// # Errors
-/// [`Error::Setting`] for a negative or non-finite `rel` or `abs_pf`, or a draw that makes a
-/// point non-positive.
-pub fn draw_mismatch(c12_pf: &[f64], rel: f64, abs_pf: f64, seed: u64) -> Result<Vec<f64>> {
-    for (k, v) in [("mismatch_rel", rel), ("mismatch_abs_pf", abs_pf)] {
+/// [`Error::Setting`] for a negative or non-finite `rel`, `abs_pf` or `corr_lnc`, a
+/// non-positive model point when the draw is correlated, or a draw that makes a point
+/// non-positive.
+pub fn draw_mismatch(
+    c12_pf: &[f64],
+    rel: f64,
+    abs_pf: f64,
+    corr_lnc: f64,
+    seed: u64,
+) -> Result<Vec<f64>> {
+    for (k, v) in [
+        ("mismatch_rel", rel),
+        ("mismatch_abs_pf", abs_pf),
+        ("mismatch_corr_lnc", corr_lnc),
+    ] {
         if !(v.is_finite() && v >= 0.0) {
             return Err(Error::setting(k, format!("must be >= 0, got {v}")));
         }
     }
     let mut rng = StdRng::seed_from_u64(draw_seed(seed, MISMATCH_TAG));
+    let z: Vec<f64> = if corr_lnc > 0.0 {
+        if let Some(c) = c12_pf.iter().find(|c| c.is_nan() || **c <= 0.0) {
+            return Err(Error::setting(
+                "mismatch_corr_lnc",
+                format!("a correlated mismatch needs c12 > 0 at every bias, got {c} pF"),
+            ));
+        }
+        let lnc: Vec<f64> = c12_pf.iter().map(|c| c.ln()).collect();
+        smooth_unit_process(&lnc, corr_lnc, &mut rng)
+    } else {
+        c12_pf
+            .iter()
+            .map(|_| StandardNormal.sample(&mut rng))
+            .collect()
+    };
     c12_pf
         .iter()
-        .map(|&c| {
-            let z: f64 = StandardNormal.sample(&mut rng);
+        .zip(z)
+        .map(|(&c, z)| {
             let d = c + (rel * c + abs_pf) * z;
             if d > 0.0 {
                 Ok(d)
@@ -137,7 +197,13 @@ impl StandInDraws {
     /// # Errors
     /// See [`draw_mismatch`] and [`CalibrationDraw::draw`].
     pub fn draw(o: &SynthOptions, c12_pf: &[f64]) -> Result<Self> {
-        let detector_pf = draw_mismatch(c12_pf, o.mismatch_rel, o.mismatch_abs_pf, o.seed)?;
+        let detector_pf = draw_mismatch(
+            c12_pf,
+            o.mismatch_rel,
+            o.mismatch_abs_pf,
+            o.mismatch_corr_lnc,
+            o.seed,
+        )?;
         let calibration = if o.draw_calibration {
             Some(CalibrationDraw::draw(
                 &Circuit::default(),
@@ -210,11 +276,11 @@ mod tests {
         assert_ne!(a, CalibrationDraw::draw(&nominal, &u, 8).unwrap());
         let c = [400.0, 100.0, 40.0];
         assert_eq!(
-            draw_mismatch(&c, 0.01, 1.0, 7).unwrap(),
-            draw_mismatch(&c, 0.01, 1.0, 7).unwrap()
+            draw_mismatch(&c, 0.01, 1.0, 0.0, 7).unwrap(),
+            draw_mismatch(&c, 0.01, 1.0, 0.0, 7).unwrap()
         );
-        assert_eq!(draw_mismatch(&c, 0.0, 0.0, 7).unwrap(), c.to_vec());
-        assert!(draw_mismatch(&c, -0.1, 1.0, 7).is_err());
+        assert_eq!(draw_mismatch(&c, 0.0, 0.0, 0.0, 7).unwrap(), c.to_vec());
+        assert!(draw_mismatch(&c, -0.1, 1.0, 0.0, 7).is_err());
         // Zero uncertainties: the nominal circuit and a factor of exactly 1.
         let zero = Uncertainties {
             q_rel: 0.0,
@@ -233,7 +299,7 @@ mod tests {
     #[test]
     fn mismatch_pulls_are_standard_normal() {
         let c: Vec<f64> = (0..4000).map(|k| 30.0 + (k % 400) as f64).collect();
-        let d = draw_mismatch(&c, 0.01, 1.0, 11).unwrap();
+        let d = draw_mismatch(&c, 0.01, 1.0, 0.0, 11).unwrap();
         let z: Vec<f64> = c
             .iter()
             .zip(&d)
@@ -244,5 +310,44 @@ mod tests {
         let var = z.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0);
         assert!(mean.abs() < 4.0 / n.sqrt(), "{mean}");
         assert!((var - 1.0).abs() < 4.0 * (2.0 / n).sqrt(), "{var}");
+    }
+
+    /// The smooth process has unit variance and the squared-exponential correlation, over
+    /// many draws, and is one value for coinciding points.
+    #[test]
+    fn smooth_process_has_the_stated_covariance() {
+        let (l, n) = (0.3, 4000);
+        let x = [0.0, 0.15, 0.3, 0.6, 0.6];
+        let mut rng = StdRng::seed_from_u64(5);
+        let draws: Vec<Vec<f64>> = (0..n)
+            .map(|_| smooth_unit_process(&x, l, &mut rng))
+            .collect();
+        let cov = |i: usize, j: usize| draws.iter().map(|h| h[i] * h[j]).sum::<f64>() / n as f64;
+        for (i, j) in [(0, 0), (0, 1), (0, 2), (0, 3), (1, 3)] {
+            let d: f64 = x[i] - x[j];
+            let want = (-d * d / (2.0 * l * l)).exp();
+            // Standard error of a product moment of unit normals is at most sqrt(2 / n).
+            assert!(
+                (cov(i, j) - want).abs() < 4.0 * (2.0 / n as f64).sqrt(),
+                "({i}, {j}): {} against {want}",
+                cov(i, j)
+            );
+        }
+        assert!(draws.iter().all(|h| h[3] == h[4]));
+        // Smooth: neighbours 0.01 L apart differ by about 0.01 of the spread.
+        let h = smooth_unit_process(&[0.0, 0.003], l, &mut rng);
+        assert!((h[0] - h[1]).abs() < 0.1, "{h:?}");
+    }
+
+    #[test]
+    fn correlated_mismatch_is_seeded_and_checked() {
+        let c = [400.0, 100.0, 40.0, 40.0];
+        let a = draw_mismatch(&c, 0.01, 1.0, 0.3, 9).unwrap();
+        assert_eq!(a, draw_mismatch(&c, 0.01, 1.0, 0.3, 9).unwrap());
+        assert_ne!(a, draw_mismatch(&c, 0.01, 1.0, 0.0, 9).unwrap());
+        // Equal c12, equal deviation: the curve stays flat beyond full depletion.
+        assert_eq!(a[2], a[3]);
+        assert!(draw_mismatch(&c, 0.01, 1.0, -1.0, 9).is_err());
+        assert!(draw_mismatch(&[10.0, 0.0], 0.01, 1.0, 0.3, 9).is_err());
     }
 }

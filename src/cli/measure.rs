@@ -252,7 +252,8 @@ fn write_synthetic(
         "mismatch": json!({
             "rel": o.mismatch_rel,
             "abs_pF": o.mismatch_abs_pf,
-            "formula": "c12_detector = c12 + (rel c12 + abs) z, z ~ N(0, 1) per bias (paper eq. 7)",
+            "corr_lnc": o.mismatch_corr_lnc,
+            "formula": "c12_detector = c12 + (rel c12 + abs) z, z ~ N(0, 1) (paper eq. 7); independent per bias when corr_lnc = 0, else z = h(ln c12) with correlation exp(-(ln c_i - ln c_j)^2 / (2 corr_lnc^2))",
         }),
         "c12_detector_pF": draws.detector_pf,
         "calibration": draws.calibration,
