@@ -6,6 +6,10 @@
 //!
 //! On Mesa's lavapipe (a software Vulkan, as in CI) the wgpu numbers are correctness runs, not
 //! speed claims. Without an adapter the wgpu benches are skipped with one line.
+//!
+//! `HPGE_BENCH_LARGE=1` adds two finer grids (0.25 and 0.125 mm, about 50 000 and 200 000
+//! nodes: where a hardware GPU can pay for its launches); `HPGE_BENCH_SECONDS=S` sets each
+//! bench's measurement time (default 10 s; criterion still takes its 10 samples).
 
 use std::hint::black_box;
 use std::time::Duration;
@@ -44,8 +48,17 @@ pub fn bench(c: &mut Criterion) {
         }
     };
     let mut g = c.benchmark_group("backends");
-    g.sample_size(10).measurement_time(Duration::from_secs(10));
-    for spacing in [2.0, 1.0, 0.5] {
+    let seconds = std::env::var("HPGE_BENCH_SECONDS")
+        .ok()
+        .and_then(|s| s.parse::<u64>().ok())
+        .unwrap_or(10);
+    g.sample_size(10)
+        .measurement_time(Duration::from_secs(seconds.max(1)));
+    let mut spacings = vec![2.0, 1.0, 0.5];
+    if std::env::var("HPGE_BENCH_LARGE").is_ok_and(|v| v == "1") {
+        spacings.extend([0.25, 0.125]);
+    }
+    for spacing in spacings {
         let gs = GridSettings {
             max_spacing_semiconductor_mm: spacing,
             max_spacing_mm: 4.0 * spacing,

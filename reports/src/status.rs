@@ -364,7 +364,12 @@ pub fn status_rows(root: &Path, model: &str) -> Result<Vec<StatusRow>> {
     });
     rows.push(StatusRow {
         what: "GPU backend (wgpu)".into(),
-        result: "tested only on Mesa's software Vulkan (lavapipe), never on a hardware GPU".into(),
+        result: "cross-checked against the CPU on Mesa's software Vulkan and on an NVIDIA H100 \
+                 (c12 to 7e-14 in f64); on the H100 a potential solve at the defaults' grid \
+                 size (13 846 nodes) takes 18 ms (CPU SOR: 79 ms on its 16-core host, 29 ms on \
+                 the 2-core EPYC), at 213 321 nodes 195 ms (host CPU: 629 ms); a whole 60-bias curve is faster on \
+                 the CPU (8.4 s against 17.0 s)"
+            .into(),
         target: "-".into(),
         verdict: Verdict::Note,
         source: "reports/gpu-backend.md".into(),
