@@ -8,15 +8,17 @@
 //! speed claims. Without an adapter the wgpu benches are skipped with one line.
 //!
 //! `HPGE_BENCH_LARGE=1` adds two finer grids (0.25 and 0.125 mm, about 50 000 and 200 000
-//! nodes: where a hardware GPU can pay for its launches); `HPGE_BENCH_SECONDS=S` sets each
-//! bench's measurement time (default 10 s; criterion still takes its 10 samples).
+//! nodes: where a hardware GPU can pay for its launches) and the wgpu potential with 50 sweeps
+//! per submission and read-back instead of 10 (`wgpu_sor_check50`); `HPGE_BENCH_SECONDS=S`
+//! sets each bench's measurement time (default 10 s; criterion still takes its 10 samples).
 
 use std::hint::black_box;
 use std::time::Duration;
 
 use criterion::Criterion;
 use hpge_solver::field::{
-    Mesh, solve_fast, solve_sor, solve_sor_wgpu, weighting_potentials, weighting_potentials_wgpu,
+    Mesh, SorSettings, solve_fast, solve_sor, solve_sor_wgpu, solve_sor_wgpu_with,
+    weighting_potentials, weighting_potentials_wgpu,
 };
 use hpge_solver::gpu::gpu_adapter;
 use hpge_solver::grid::Grid;
@@ -54,10 +56,15 @@ pub fn bench(c: &mut Criterion) {
         .unwrap_or(10);
     g.sample_size(10)
         .measurement_time(Duration::from_secs(seconds.max(1)));
+    let large = std::env::var("HPGE_BENCH_LARGE").is_ok_and(|v| v == "1");
     let mut spacings = vec![2.0, 1.0, 0.5];
-    if std::env::var("HPGE_BENCH_LARGE").is_ok_and(|v| v == "1") {
+    if large {
         spacings.extend([0.25, 0.125]);
     }
+    let check50 = SorSettings {
+        check_every: 50,
+        ..SorSettings::default()
+    };
     for spacing in spacings {
         let gs = GridSettings {
             max_spacing_semiconductor_mm: spacing,
@@ -86,6 +93,21 @@ pub fn bench(c: &mut Criterion) {
                         .expect("solves")
                 })
             });
+            if large {
+                g.bench_function(format!("potential/wgpu_sor_check50/{nodes}"), |b| {
+                    b.iter(|| {
+                        solve_sor_wgpu_with(
+                            &mesh,
+                            &det,
+                            black_box(BIAS_V),
+                            None,
+                            &check50,
+                            Precision::Auto,
+                        )
+                        .expect("solves")
+                    })
+                });
+            }
             g.bench_function(format!("weighting/wgpu_sor/{nodes}"), |b| {
                 b.iter(|| {
                     weighting_potentials_wgpu(

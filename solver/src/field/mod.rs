@@ -41,7 +41,9 @@ pub use point::{
 };
 pub use report::{Backend, Method, SolveReport, Termination};
 pub use settings::FieldSettings;
-pub use sor::{solve_sor, solve_sor_wgpu, weighting_potentials_wgpu};
+pub use sor::{
+    SorSettings, solve_sor, solve_sor_wgpu, solve_sor_wgpu_with, weighting_potentials_wgpu,
+};
 pub use weighting::{
     PAPER_EPSILON_FACTOR, WeightingMode, WeightingPotentials, weighting_potentials,
 };

@@ -61,8 +61,9 @@ pub fn solve_sor_wgpu(
     )
 }
 
-/// As [`solve_sor_wgpu`] with explicit settings.
-pub(crate) fn solve_sor_wgpu_with(
+/// As [`solve_sor_wgpu`] with explicit settings (the over-relaxation factor, tolerance and
+/// `check_every`: sweeps recorded per submission, one 4-byte read-back each).
+pub fn solve_sor_wgpu_with(
     mesh: &Mesh,
     det: &Detector,
     bias_v: f64,
