@@ -3,7 +3,8 @@
 /// Settings of the SOR iteration, with documented defaults.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SorSettings {
-    /// Over-relaxation factor in (0, 2); `None` (default): the optimal factor for the grid (`default_omega`).
+    /// Over-relaxation factor in (0, 2); `None` (default): the optimal factor for the grid
+    /// (`default_omega`).
     pub omega: Option<f64>,
     /// Stopping rule, relative to the bound span u - l (default 1e-10). With d the largest
     /// update of one sweep and rho the observed per-sweep contraction of d (the slower of the
