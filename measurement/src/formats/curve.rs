@@ -45,17 +45,13 @@ impl Row {
 /// within 1e-6 relative, and it must be positive semi-definite (a Cholesky factorisation with a
 /// relative jitter of 1e-12 on the diagonal must succeed).
 pub fn read_curve(csv: &Path, covariance: Option<&Path>) -> Result<CvData> {
-    let text = read_text(csv)?;
-    let rows = records(csv, &text)?;
-    let Some((header, body)) = rows.split_first() else {
-        return Err(Error::format(
-            csv,
-            format!(
-                "empty C-V curve: no header `{}` (the file holds only comments or blank lines)",
-                HEADER.join(",")
-            ),
-        ));
-    };
+    let (header, body) = header_and_rows(
+        csv,
+        format!(
+            "empty C-V curve: no header `{}` (the file holds only comments or blank lines)",
+            HEADER.join(",")
+        ),
+    )?;
     if header.cells != HEADER {
         return Err(Error::format(
             csv,
@@ -230,6 +226,15 @@ fn covariance_path(csv: &Path) -> PathBuf {
 }
 
 /// The non-comment, non-blank records of a CSV text, cells trimmed.
+/// The header row and the data rows of the table in `file` ([`records`]); a file with no row at
+/// all is the error `empty` (naming the file).
+fn header_and_rows(file: &Path, empty: impl Into<String>) -> Result<(Row, Vec<Row>)> {
+    let text = read_text(file)?;
+    let mut rows = records(file, &text)?.into_iter();
+    let header = rows.next().ok_or_else(|| Error::format(file, empty))?;
+    Ok((header, rows.collect()))
+}
+
 fn records(file: &Path, text: &str) -> Result<Vec<Row>> {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut reader = csv::ReaderBuilder::new()
@@ -260,14 +265,7 @@ fn records(file: &Path, text: &str) -> Result<Vec<Row>> {
 /// An unreadable file, a missing column, or a cell that breaks these rules, naming the file,
 /// the line and the column.
 pub fn read_model_curve(csv: &Path) -> Result<(Vec<f64>, Vec<f64>)> {
-    let text = read_text(csv)?;
-    let rows = records(csv, &text)?;
-    let Some((header, body)) = rows.split_first() else {
-        return Err(Error::format(
-            csv,
-            "empty: no header with voltage_V and c12_pF",
-        ));
-    };
+    let (header, body) = header_and_rows(csv, "empty: no header with voltage_V and c12_pF")?;
     let col = |name: &str| {
         header
             .cells
@@ -334,14 +332,10 @@ fn read_covariance(
     sigma_pf: &[f64],
 ) -> Result<Vec<Vec<f64>>> {
     let n = voltage_v.len();
-    let text = read_text(file)?;
-    let rows = records(file, &text)?;
-    let Some((header, body)) = rows.split_first() else {
-        return Err(Error::format(
-            file,
-            "empty covariance: no header `voltage_V,<v_1>,...,<v_N>`",
-        ));
-    };
+    let (header, body) = header_and_rows(
+        file,
+        "empty covariance: no header `voltage_V,<v_1>,...,<v_N>`",
+    )?;
     if header.cells[0] != "voltage_V" {
         return Err(Error::format(
             file,
