@@ -280,3 +280,80 @@ fn the_bz_slice_writes_the_full_spaces_columns_with_tied_knots() {
     assert_eq!(index, vec![1000000, 1000001, 1000002]);
     let _ = std::fs::remove_dir_all(&out);
 }
+
+/// `data/training/checkpoint.sh`: rows saved in parts during a run and after it, restored into a
+/// new folder, resume to the set one uninterrupted run writes; a second save adds nothing.
+#[test]
+fn checkpoint_parts_restore_to_a_resumable_run() {
+    let d = temp("checkpoint");
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/training/checkpoint.sh");
+    let parts = d.join("parts");
+    let sh = |args: &[&str]| {
+        let o = Command::new("bash")
+            .arg(&script)
+            .args(args)
+            .env("PARTS", &parts)
+            .output()
+            .unwrap();
+        (
+            o.status.code(),
+            String::from_utf8_lossy(&o.stdout).to_string() + &String::from_utf8_lossy(&o.stderr),
+        )
+    };
+    let reference = d.join("reference");
+    assert!(generate(&reference, "12", &[]).status.success());
+    // A run of another fingerprint (n = 5), to be refused below.
+    let other = d.join("other");
+    assert!(generate(&other, "5", &[]).status.success());
+    // What a session leaves: the run of 12 stopped after 5 rows (the reference's first 5).
+    let text = std::fs::read_to_string(reference.join("rows.csv")).unwrap();
+    let partial: Vec<&str> = text.lines().take(6).collect();
+    let stopped = d.join("stopped");
+    std::fs::create_dir_all(&stopped).unwrap();
+    std::fs::copy(
+        reference.join("generate.json"),
+        stopped.join("generate.json"),
+    )
+    .unwrap();
+    std::fs::write(stopped.join("rows.csv"), partial.join("\n") + "\n").unwrap();
+    let stopped_s = stopped.to_str().unwrap();
+    let (code, out) = sh(&["save", stopped_s, "run"]);
+    assert_eq!(code, Some(0), "{out}");
+    assert!(out.contains("5 rows saved"), "{out}");
+    let (code, out) = sh(&["save", stopped_s, "run"]);
+    assert_eq!(code, Some(0), "{out}");
+    assert!(out.contains("nothing new"), "{out}");
+    // A folder of another run is refused.
+    let (code, out) = sh(&["save", other.to_str().unwrap(), "run"]);
+    assert_eq!(code, Some(2), "{out}");
+    assert!(out.contains("another run"), "{out}");
+    // A new machine: restore, resume with the same command, save the rest.
+    let second = d.join("second");
+    let (code, out) = sh(&["restore", "run", second.to_str().unwrap()]);
+    assert_eq!(code, Some(0), "{out}");
+    let (code, _) = sh(&["restore", "run", second.to_str().unwrap()]);
+    assert_eq!(code, Some(2), "an existing folder is not overwritten");
+    let o = generate(&second, "12", &[]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(
+        rows(&second.join("rows.csv")),
+        rows(&reference.join("rows.csv"))
+    );
+    let (code, out) = sh(&["save", second.to_str().unwrap(), "run"]);
+    assert_eq!(code, Some(0), "{out}");
+    assert!(
+        out.contains("7 rows saved") && out.contains("12 in all"),
+        "{out}"
+    );
+    let (code, out) = sh(&["check", "run"]);
+    assert_eq!(code, Some(0), "{out}");
+    assert!(out.contains("12 rows, every index once"), "{out}");
+    // Everything restored: the whole set, nothing left to solve.
+    let third = d.join("third");
+    assert_eq!(sh(&["restore", "run", third.to_str().unwrap()]).0, Some(0));
+    assert_eq!(
+        rows(&third.join("rows.csv")),
+        rows(&reference.join("rows.csv"))
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}

@@ -18,11 +18,18 @@ cargo build --release -q
 B=target/release/hpge-cv
 S=spaces/super-siegfried-rz.toml
 D=detectors/super-siegfried-k1.toml
-$B generate --space $S --detector $D --n 60000 --out "$OUT/paper-60000"
+# A run saved in parts (checkpoint.sh: the generation spans sessions of a machine that keeps no
+# files) continues from them; the parts are the rows `generate` wrote, so the result is the same.
+for run in paper-60000 bz-slice-7500; do
+  if [ ! -e "$OUT/$run" ] && [ -f "data/training/parts/$run/generate.json" ]; then
+    bash data/training/checkpoint.sh restore "$run" "$OUT/$run"
+  fi
+done
+$B generate --space $S --detector $D --n 60000 --retry-failed --out "$OUT/paper-60000"
 $B generate --space $S --detector $D --n 5000 --offset 100000 --out "$OUT/heldout-5000"
 $B generate --space $S --detector $D --n 1200 --offset 200000 --out "$OUT/calibration-1200"
 $B generate --space spaces/super-siegfried-bz-slice.toml --detector $D --n 7500 --offset 1000000 \
-  --out "$OUT/bz-slice-7500"
+  --retry-failed --out "$OUT/bz-slice-7500"
 # Rows in index order (generation appends in completion order).
 sorted() { head -n 1 "$1"; tail -n +2 "$1" | sort -t, -k1,1n; }
 {
@@ -35,8 +42,12 @@ sorted() { head -n 1 "$1"; tail -n +2 "$1" | sort -t, -k1,1n; }
 } > "$OUT/test.csv"
 sorted "$OUT/heldout-5000/rows.csv" > "$OUT/heldout.csv"
 sorted "$OUT/calibration-1200/rows.csv" > "$OUT/calibration.csv"
-# Hash of the content that is deterministic: every column but `seconds` (wall time).
-canonical() { tail -n +2 "$1" | sed 's/,[^,]*$//' | sha256sum | cut -c1-64; }
+# Hash of the content that is deterministic: the columns index to status (so the hash is the same
+# for rows written before `c12_err_pF` was added in front of `seconds`, the wall time).
+canonical() {
+  local s; s=$(head -n 1 "$1" | tr ',' '\n' | grep -nx status | cut -d: -f1)
+  tail -n +2 "$1" | cut -d, -f"1-$s" | sha256sum | cut -c1-64
+}
 for f in train test heldout calibration; do
-  echo "$f.csv: $(($(wc -l < "$OUT/$f.csv") - 1)) rows, sha256 (without seconds) $(canonical "$OUT/$f.csv")"
+  echo "$f.csv: $(($(wc -l < "$OUT/$f.csv") - 1)) rows, sha256 (columns index to status) $(canonical "$OUT/$f.csv")"
 done

@@ -114,8 +114,17 @@ impl ExactSolver {
     /// c12 (pF) at one point `x` of the space (physical values in the space's column order,
     /// the bias included).
     pub fn solve(&self, x: &[f64]) -> Result<f64> {
+        Ok(self.solve_with_error(x)?.0)
+    }
+
+    /// [`ExactSolver::solve`] with the solver's own error estimate: (c12, estimated absolute
+    /// error |c12_h - c12_H|), both pF (`hpge_solver::field::Accuracy`). The estimate is above
+    /// the settings' tolerance where the adaptive grid could not reach it (a pocket's neck at
+    /// pinch-off).
+    pub fn solve_with_error(&self, x: &[f64]) -> Result<(f64, f64)> {
         let (det, bias) = self.configure(x)?;
-        Ok(solve_point(&det, bias, &self.settings, None)?.c12_pf)
+        let p = solve_point(&det, bias, &self.settings, None)?;
+        Ok((p.c12_pf, p.accuracy.c12_err_pf))
     }
 
     /// The detector with the space's non-bias values `params` (column order, a surrogate's
@@ -156,6 +165,21 @@ impl ExactSolver {
         volts: &[f64],
         continuation: Continuation,
     ) -> Result<Vec<f64>> {
+        Ok(self
+            .curve_with_error(params, volts, continuation)?
+            .into_iter()
+            .map(|(c, _)| c)
+            .collect())
+    }
+
+    /// [`ExactSolver::curve_with`] with the solver's error estimate per point: (c12, estimated
+    /// absolute error), both pF, as [`ExactSolver::solve_with_error`].
+    pub fn curve_with_error(
+        &self,
+        params: &[f64],
+        volts: &[f64],
+        continuation: Continuation,
+    ) -> Result<Vec<(f64, f64)>> {
         let det = self.detector(params)?;
         let curve = cv_curve_with(&det, volts, &self.settings, continuation, |_, _| {})?;
         if curve.points.len() != volts.len() {
@@ -164,7 +188,11 @@ impl ExactSolver {
                 message: "the voltages must be positive, increasing and distinct".into(),
             });
         }
-        Ok(curve.points.iter().map(|p| p.c12_pf).collect())
+        Ok(curve
+            .points
+            .iter()
+            .map(|p| (p.c12_pf, p.c12_err_pf))
+            .collect())
     }
 
     /// The detector with the sample's parameters and impurity model, and the bias (V).

@@ -65,7 +65,10 @@ pub fn format_row(s: &Sample) -> String {
         line.push(',');
         line.push_str(&v.to_string());
     }
-    line.push_str(&format!(",{},{},{}", s.c12_pf, s.status, s.seconds));
+    line.push_str(&format!(
+        ",{},{},{},{}",
+        s.c12_pf, s.status, s.c12_err_pf, s.seconds
+    ));
     line
 }
 

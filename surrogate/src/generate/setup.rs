@@ -131,6 +131,9 @@ pub struct Sample {
     pub c12_pf: f64,
     /// `ok`, or what failed (no commas).
     pub status: String,
+    /// The solver's estimated absolute error of c12, pF (`|c12_h - c12_H|` of the adaptive
+    /// grid; NaN when the solve failed).
+    pub c12_err_pf: f64,
     /// Wall time of the solve, s.
     pub seconds: f64,
 }
@@ -317,16 +320,17 @@ impl Generator {
         // Cold continuation: the biases lie (range / k) apart, too far for a neighbour's front to
         // help (seeded curves measured 1.7x slower, `validation/examples/curve_vs_points.rs`);
         // a row then equals the point-mode solve at its x bit for bit.
-        let result = self
-            .exact
-            .curve_with(&params, &volts, hpge_solver::field::Continuation::Cold);
+        let result =
+            self.exact
+                .curve_with_error(&params, &volts, hpge_solver::field::Continuation::Cold);
         let seconds = start.elapsed().as_secs_f64() / k as f64;
         rows.into_iter()
             .enumerate()
             .map(|(j, (u, x))| {
-                let (c12_pf, status) = match &result {
-                    Ok(c) => (c[j], "ok".to_string()),
+                let (c12_pf, c12_err_pf, status) = match &result {
+                    Ok(c) => (c[j].0, c[j].1, "ok".to_string()),
                     Err(e) => (
+                        f64::NAN,
                         f64::NAN,
                         format!("failed: {e}")
                             .replace([',', '\n', '\r'], ";")
@@ -339,19 +343,20 @@ impl Generator {
                     x,
                     c12_pf,
                     status,
+                    c12_err_pf,
                     seconds,
                 }
             })
             .collect()
     }
 
-    /// The CSV header: index, u_<name>..., <name>..., c12_pF, status, seconds.
+    /// The CSV header: index, u_<name>..., <name>..., c12_pF, status, c12_err_pF, seconds.
     pub fn header(&self) -> String {
         let names = self.space.dimensions.iter().map(|d| d.name.as_str());
         let u: Vec<String> = names.clone().map(|n| format!("u_{n}")).collect();
         let x: Vec<&str> = names.collect();
         format!(
-            "index,{},{},c12_pF,status,seconds",
+            "index,{},{},c12_pF,status,c12_err_pF,seconds",
             u.join(","),
             x.join(",")
         )
@@ -363,10 +368,11 @@ impl Generator {
     pub fn sample(&self, index: u64) -> Sample {
         let start = std::time::Instant::now();
         let (u, x) = self.space.from_sampled_unit(&self.sequence.point(index));
-        let result = self.exact.solve(&x);
-        let (c12_pf, status) = match result {
-            Ok(c) => (c, "ok".to_string()),
+        let result = self.exact.solve_with_error(&x);
+        let (c12_pf, c12_err_pf, status) = match result {
+            Ok((c, err)) => (c, err, "ok".to_string()),
             Err(e) => (
+                f64::NAN,
                 f64::NAN,
                 format!("failed: {e}")
                     .replace([',', '\n', '\r'], ";")
@@ -379,6 +385,7 @@ impl Generator {
             x,
             c12_pf,
             status,
+            c12_err_pf,
             seconds: start.elapsed().as_secs_f64(),
         }
     }

@@ -53,14 +53,21 @@ fn curve_rows_are_point_solves_on_bias_strata() {
         assert!(u_b >= j as f64 / k as f64 && u_b < (j + 1) as f64 / k as f64);
         assert!((r.x[b] - (lo + u_b * (hi - lo))).abs() < 1e-9 * hi);
         assert_eq!(r.u[..b], rows[0].u[..b]);
-        // The same number as point mode at this x (cold continuation).
-        let c = g.exact.solve(&r.x).unwrap();
+        // The same number as point mode at this x (cold continuation), and the same error
+        // estimate: finite, non-negative, written to the row.
+        let (c, err) = g.exact.solve_with_error(&r.x).unwrap();
         assert_eq!(
             c.to_bits(),
             r.c12_pf.to_bits(),
             "row {j}: {c} vs {}",
             r.c12_pf
         );
+        assert_eq!(err.to_bits(), r.c12_err_pf.to_bits(), "row {j}");
+        assert!(
+            err.is_finite() && err >= 0.0,
+            "row {j}: error estimate {err}"
+        );
+        assert!(super::format_row(r).contains(&format!(",ok,{err},")));
     }
     // The three strata's shift is the point's own quasi-random bias coordinate.
     let shift = rows[0].u[b] * k as f64;

@@ -30,12 +30,13 @@ fn write_set(path: &std::path::Path, sp: &ParameterSpace, n: usize, offset: usiz
     let g = |i: usize, k: usize| {
         ((i as f64 + 0.5) * [0.7548776662, 0.5698402910, 0.4301597090, 0.3247179572][k]).fract()
     };
-    let mut text = String::from("index,u_p0,u_p1,u_p2,u_U_B,p0,p1,p2,U_B,c12_pF,status,seconds\n");
+    let mut text =
+        String::from("index,u_p0,u_p1,u_p2,u_U_B,p0,p1,p2,U_B,c12_pF,status,c12_err_pF,seconds\n");
     for i in offset..offset + n {
         let u: Vec<f64> = (0..4).map(|k| g(i, k)).collect();
         let x = sp.from_unit(&u);
         let row: Vec<String> = u.iter().chain(&x).map(|v| v.to_string()).collect();
-        text += &format!("{i},{},{},ok,0.1\n", row.join(","), synthetic_c12(&x));
+        text += &format!("{i},{},{},ok,0.001,0.1\n", row.join(","), synthetic_c12(&x));
     }
     std::fs::write(path, text).unwrap();
 }
