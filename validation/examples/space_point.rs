@@ -1,7 +1,9 @@
 //! One point of a parameter space solved on the exact solver, with its pockets and solve reports:
 //! `cargo run --release -p hpge-validation --example space_point -- SPACE DETECTOR x1 ... xN`
 //! (x in the space's column order, the bias last). Used to reproduce a failed training row.
-//! `DUMP=file.csv` writes every node (r, z, phi, charge, undepleted, kind) for a look.
+//! `DUMP=file.csv` writes every node (r, z, phi, charge, undepleted, kind) for a look;
+//! `MAX_NODES=N` raises the adaptive grid's node limit (default 300 000) to N and its passes to 20,
+//! to see whether a row that missed its tolerance converges on finer grids.
 
 use hpge_solver::drift::Carrier;
 use hpge_solver::field::{NodeKind, deepest_depression_v, deepest_empty_depression_v};
@@ -15,7 +17,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         return Err("usage: space_point SPACE DETECTOR x1 ... xN".into());
     }
     let space = ParameterSpace::from_file(&repo_path(&args[0]))?;
-    let ex = ExactSolver::new(space, &repo_path(&args[1]), FieldSettings::default())?;
+    let mut settings = FieldSettings::default();
+    if let Ok(n) = std::env::var("MAX_NODES") {
+        settings.grid.max_nodes = n.parse()?;
+        settings.grid.max_adaptive_passes = 20;
+    }
+    let ex = ExactSolver::new(space, &repo_path(&args[1]), settings)?;
     let x: Vec<f64> = args[2..]
         .iter()
         .map(|a| a.parse())
