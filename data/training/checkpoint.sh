@@ -57,7 +57,9 @@ case "${1:-}" in
     [ ! -e "$dir" ] || die "$dir exists: refusing to overwrite a generation folder"
     mkdir -p "$dir"
     cp "$PARTS/$name/generate.json" "$dir/generate.json"
-    header=$(python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["header"])' "$dir/generate.json")
+    # generate.json is pretty-printed JSON; its header is a string of names without quotes.
+    header=$(sed -n 's/^ *"header": "\([^"]*\)",\{0,1\}$/\1/p' "$dir/generate.json")
+    [ -n "$header" ] || die "$dir/generate.json: no \"header\" line"
     { echo "$header"; xz -dc "$PARTS/$name"/part-*.csv.xz | sort -t, -k1,1n; } > "$dir/rows.csv"
     echo "$name: $(($(wc -l < "$dir/rows.csv") - 1)) rows restored to $dir"
     ;;
