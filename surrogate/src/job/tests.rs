@@ -52,7 +52,7 @@ fn write_set(path: &Path, sp: &ParameterSpace, n: usize, offset: usize) {
         let x = sp.from_unit(&u);
         let row: Vec<String> = u.iter().chain(&x).map(|v| v.to_string()).collect();
         if i == offset + n {
-            text += &format!("{i},{},NaN,failed: test,0.1\n", row.join(","));
+            text += &format!("{i},{},NaN,failed: test,NaN,0.1\n", row.join(","));
         } else {
             text += &format!("{i},{},{},ok,0.001,0.1\n", row.join(","), synthetic_c12(&x));
         }
