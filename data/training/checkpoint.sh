@@ -33,13 +33,14 @@ case "${1:-}" in
       die "$dir/generate.json differs from $PARTS/$name/generate.json: rows of another run"
     fi
     cp "$dir/generate.json" "$PARTS/$name/generate.json"
-    status_col=$(head -n 1 "$dir/rows.csv" | tr ',' '\n' | grep -nx status | cut -d: -f1)
+    names=$(head -n 1 "$dir/rows.csv" | tr ',' '\n')
+    status_col=$(grep -nx status <<< "$names" | cut -d: -f1)
     [ -n "$status_col" ] || die "$dir/rows.csv: no status column"
     saved=$(mktemp); new=$(mktemp); trap 'rm -f "$saved" "$new"' EXIT
     indices "$name" | sort -u > "$saved"
     # Whole lines only (a run writing now may have a torn last line), status ok, not saved yet.
     head -n "$(wc -l < "$dir/rows.csv")" "$dir/rows.csv" | tail -n +2 \
-      | awk -F, -v s="$status_col" -v n="$(head -n 1 "$dir/rows.csv" | tr ',' '\n' | wc -l)" \
+      | awk -F, -v s="$status_col" -v n="$(wc -l <<< "$names")" \
           -v saved="$saved" 'BEGIN { while ((getline i < saved) > 0) have[i] = 1 }
                              NF == n && $s == "ok" && !($1 in have)' \
       | sort -t, -k1,1n > "$new"
@@ -65,8 +66,10 @@ case "${1:-}" in
     ;;
   check)
     [ $# -eq 2 ] || die "usage: check NAME"
-    total=$(indices "$2" | wc -l); distinct=$(indices "$2" | sort -u | wc -l)
-    [ "$total" -eq "$distinct" ] || die "$2: $((total - distinct)) indices appear twice"
+    all=$(mktemp); trap 'rm -f "$all"' EXIT
+    indices "$2" | sort > "$all"
+    total=$(wc -l < "$all"); twice=$(uniq -d "$all" | wc -l)
+    [ "$twice" -eq 0 ] || die "$2: $twice indices appear twice"
     echo "$2: $total rows, every index once"
     ;;
   *) die "usage: save DIR NAME | restore NAME DIR | check NAME" ;;
