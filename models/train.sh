@@ -1,6 +1,9 @@
 #!/usr/bin/env bash
 # Retrains the shipped surrogate and remakes its figures and held-out figures (issue: surrogate).
 #   bash models/train.sh [RECIPE] [SEED]       default: split 0 (the fit's default model)
+#   EPOCHS_SCALE=F LOSS_H=H bash models/train.sh ...   the recipe trained F times as long and/or
+#     with the robust loss's scale h = H (train --epochs-scale/--loss-h); the files get the
+#     suffix -eF and/or -hH, so a variant never replaces the shipped model.
 # Needs data/training/{train,test}.csv (bash data/training/make.sh, ~40 min) and the committed
 # data/training/{heldout,calibration}.csv. Writes models/super-siegfried-rz-RECIPE.safetensors, its learning
 # curves (.curves.csv), the held-out figures (.heldout.json) and models/figures/RECIPE/.
@@ -9,6 +12,10 @@ cd "$(dirname "$0")/.."
 RECIPE=${1:-split}
 SEED=${2:-0}
 NAME=models/super-siegfried-rz-$RECIPE
+VARIANT=()
+if [ -n "${EPOCHS_SCALE:-}" ]; then NAME=$NAME-e$EPOCHS_SCALE; VARIANT+=(--epochs-scale "$EPOCHS_SCALE"); fi
+if [ -n "${LOSS_H:-}" ]; then NAME=$NAME-h$LOSS_H; VARIANT+=(--loss-h "$LOSS_H"); fi
+FIGS=models/figures/${NAME#models/super-siegfried-rz-}
 if [ ! -f data/training/train.csv ] || [ ! -f data/training/test.csv ]; then
   bash data/training/make.sh
 fi
@@ -16,8 +23,8 @@ cargo build --release -q
 B=target/release/hpge-cv
 $B train --data data/training/train.csv --test data/training/test.csv --space spaces/super-siegfried-rz.toml \
   --detector detectors/super-siegfried-k1.toml --recipe "$RECIPE" --seed "$SEED" --out "$NAME.safetensors" \
-  --plot "models/figures/$RECIPE"
+  "${VARIANT[@]}" --plot "$FIGS"
 # The per-point uncertainty sigma_s(p, U_B), fitted on rows neither training nor held out.
 $B calibrate --model "$NAME.safetensors" --data data/training/calibration.csv
 $B evaluate --model "$NAME.safetensors" --data data/training/heldout.csv --json > "$NAME.heldout.json"
-$B evaluate --model "$NAME.safetensors" --data data/training/heldout.csv --plot "models/figures/$RECIPE"
+$B evaluate --model "$NAME.safetensors" --data data/training/heldout.csv --plot "$FIGS"

@@ -111,6 +111,7 @@ pub fn resume_members(dir: &Path, info: &ModelInfo) -> Result<Vec<Member>> {
         }
         let s = Surrogate::load(&file)?;
         let same = s.info.recipe_name == info.recipe_name
+            && s.info.recipe == info.recipe
             && s.info.seed == info.seed
             && s.info.training.hash == info.training.hash
             && s.info.test.hash == info.test.hash
@@ -118,7 +119,7 @@ pub fn resume_members(dir: &Path, info: &ModelInfo) -> Result<Vec<Member>> {
         if !same {
             return Err(Error::Checkpoint {
                 message: format!(
-                    "a checkpoint of another run (recipe, seed or data differ); remove the \
+                    "a checkpoint of another run (recipe, its epochs or loss, seed or data differ); remove the \
                      folder {} or choose another --out",
                     dir.display()
                 ),

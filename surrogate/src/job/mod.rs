@@ -24,6 +24,6 @@ pub use evaluate::{
 pub use options::{DEFAULT_SHARD, DEFAULT_WORST, EvaluateOptions, GenerateOptions, PredictOptions};
 pub use params::parse_params;
 pub use train::{
-    DEFAULT_RECIPE, DEFAULT_SEED, DEFAULT_SPACE, POLYNOMIAL_RECIPE, TrainEvent, TrainJob,
-    TrainOutcome, detector_info,
+    DEFAULT_EPOCHS_SCALE, DEFAULT_RECIPE, DEFAULT_SEED, DEFAULT_SPACE, POLYNOMIAL_RECIPE,
+    TrainEvent, TrainJob, TrainOutcome, detector_info,
 };

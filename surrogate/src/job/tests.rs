@@ -74,6 +74,8 @@ fn job(dir: &Path, recipe: &str, seed: u64) -> TrainJob {
         seed,
         detector: None,
         out: dir.join(format!("{recipe}.safetensors")),
+        epochs_scale: DEFAULT_EPOCHS_SCALE,
+        loss_h: None,
     }
 }
 
@@ -179,16 +181,51 @@ fn a_tiny_network_trains_writes_its_files_and_resumes_from_a_checkpoint() {
     );
     assert_eq!(losses(&curves_file), l);
 
-    // A checkpoint of another run (another seed) is refused, naming the file.
+    // A checkpoint of another run (another seed, or the same recipe trained longer) is refused,
+    // naming the file.
     checkpoint();
-    let other = TrainJob { seed: 4, ..job };
-    let e = other.run(&mut |_| {}).unwrap_err();
-    assert!(matches!(e, Error::Checkpoint { .. }), "{e:?}");
-    let text = e.to_string();
+    let longer = TrainJob {
+        epochs_scale: 2.0,
+        ..job.clone()
+    };
+    for other in [
+        TrainJob {
+            seed: 4,
+            ..job.clone()
+        },
+        longer.clone(),
+    ] {
+        let e = other.run(&mut |_| {}).unwrap_err();
+        assert!(matches!(e, Error::Checkpoint { .. }), "{e:?}");
+        let text = e.to_string();
+        assert!(
+            text.contains("member-0.safetensors") && text.contains("another run"),
+            "{text}"
+        );
+    }
+
+    // tiny's loss is the squared relative error, which has no scale h: --loss-h is refused by
+    // name before any training.
+    let e = TrainJob {
+        loss_h: Some(25.0),
+        ..longer.clone()
+    }
+    .run(&mut |_| {})
+    .unwrap_err();
     assert!(
-        text.contains("member-0.safetensors") && text.contains("another run"),
-        "{text}"
+        matches!(&e, Error::Argument { name, .. } if name == "--loss-h"),
+        "{e:?}"
     );
+
+    // Trained twice as long: 24 epochs, recorded in the model file.
+    std::fs::remove_dir_all(&partial).unwrap();
+    let (outcome, log) = run_logged(&longer);
+    outcome.unwrap();
+    assert_eq!(log[1], "start 24 0 0 1");
+    assert_eq!(log.len(), 2 + 24 + 1);
+    let recipe = Surrogate::load(&longer.out).unwrap().info.recipe.unwrap();
+    let epochs: Vec<usize> = recipe.cycles.iter().map(|c| c.epochs).collect();
+    assert_eq!(epochs, [8, 16]);
     let _ = std::fs::remove_dir_all(&d);
 }
 
@@ -483,6 +520,8 @@ fn the_polynomial_needs_as_many_rows_as_coefficients() {
         seed: 0,
         detector: None,
         out: d.join("poly3.safetensors"),
+        epochs_scale: DEFAULT_EPOCHS_SCALE,
+        loss_h: None,
     };
     let e = job.run(&mut |_| {}).unwrap_err().to_string();
     assert!(

@@ -32,6 +32,8 @@ pub const DEFAULT_SPACE: &str = "spaces/super-siegfried-rz.toml";
 pub const DEFAULT_RECIPE: &str = "paper";
 /// Seed of a training run that is not given one.
 pub const DEFAULT_SEED: u64 = 0;
+/// Epoch multiplier of a training run that is not given one: the recipe as named.
+pub const DEFAULT_EPOCHS_SCALE: f64 = 1.0;
 
 /// One training run: its inputs and the model file it writes. The command line flattens this
 /// struct (feature `clap`), so every option of `train` and its default is declared here once.
@@ -62,6 +64,18 @@ pub struct TrainJob {
     /// model for another detector; checked against the space on the way).
     #[cfg_attr(feature = "clap", arg(long, value_name = "FILE"))]
     pub detector: Option<PathBuf>,
+    /// Multiplies every cycle's epochs of the recipe (2: train twice as long, the cosine decay
+    /// stretched with it); the model file records the epochs as trained.
+    #[cfg_attr(
+        feature = "clap",
+        arg(long, value_name = "F", default_value_t = DEFAULT_EPOCHS_SCALE)
+    )]
+    pub epochs_scale: f64,
+    /// Replaces the scale h of the recipe's robust loss (%^2 for the relative losses, pF^2 for
+    /// `paper`'s; the shipped recipes use 4): the loss is quadratic for errors well below
+    /// sqrt(h) and logarithmic beyond.
+    #[cfg_attr(feature = "clap", arg(long, value_name = "H"))]
+    pub loss_h: Option<f64>,
 }
 
 /// What a training run reports while it works, in this order.
@@ -177,6 +191,26 @@ impl TrainJob {
         Ok(())
     }
 
+    /// The recipe as this run trains it (`--epochs-scale` and `--loss-h` applied); `None` for
+    /// the polynomial, which takes neither.
+    pub fn recipe(&self) -> Result<Option<Recipe>> {
+        if self.recipe == POLYNOMIAL_RECIPE {
+            let adjusted = self.epochs_scale != DEFAULT_EPOCHS_SCALE || self.loss_h.is_some();
+            if adjusted {
+                return Err(Error::Argument {
+                    name: "--epochs-scale / --loss-h".into(),
+                    message: format!(
+                        "the recipe {POLYNOMIAL_RECIPE} is a least-squares fit without epochs or loss scale"
+                    ),
+                });
+            }
+            return Ok(None);
+        }
+        Recipe::named(&self.recipe)?
+            .adjusted(self.epochs_scale, self.loss_h)
+            .map(Some)
+    }
+
     /// Refuses a test set that is the training set itself (the same file): its figures and
     /// sigma_p would measure how well the model remembers, not how well it predicts.
     fn check_distinct(&self) -> Result<()> {
@@ -199,11 +233,7 @@ impl TrainJob {
     pub fn run(&self, progress: &mut dyn FnMut(TrainEvent<'_>)) -> Result<TrainOutcome> {
         self.check_out()?;
         let space = ParameterSpace::from_file(&self.space)?;
-        let recipe = if self.recipe == POLYNOMIAL_RECIPE {
-            None
-        } else {
-            Some(Recipe::named(&self.recipe)?)
-        };
+        let recipe = self.recipe()?;
         self.check_distinct()?;
         let train = DataSet::read(&self.data, &space)?;
         let test = DataSet::read(&self.test, &space)?;

@@ -282,6 +282,48 @@ impl Recipe {
         Ok(())
     }
 
+    /// This recipe trained longer or shorter, or with another robust-loss scale: every cycle's
+    /// epochs become round(epochs x `epochs_scale`) (at least 1; the cosine decay stretches with
+    /// them), and `loss_h`, when given, replaces h of the robust loss (`paper`'s
+    /// h ln((c_p - c_s)^2 / h + 1) in pF^2, or the relative losses' h ln(r^2 / h + 1) in %^2;
+    /// the loss is quadratic for |r| << sqrt(h)). The model file records the recipe as trained.
+    /// Scale 1 and no h give the recipe unchanged.
+    pub fn adjusted(mut self, epochs_scale: f64, loss_h: Option<f64>) -> Result<Self> {
+        let bad = |name: &str, m: String| Error::Argument {
+            name: name.into(),
+            message: m,
+        };
+        if !(epochs_scale.is_finite() && epochs_scale > 0.0) {
+            return Err(bad(
+                "--epochs-scale",
+                format!("{epochs_scale} is not a positive number"),
+            ));
+        }
+        for c in &mut self.cycles {
+            c.epochs = ((c.epochs as f64 * epochs_scale).round() as usize).max(1);
+        }
+        if let Some(h) = loss_h {
+            if !(h.is_finite() && h > 0.0) {
+                return Err(bad("--loss-h", format!("{h} is not a positive number")));
+            }
+            match &mut self.loss {
+                Loss::PaperRobust { h: old } | Loss::RelativeRobust { h: old } => *old = h,
+                other => {
+                    return Err(bad(
+                        "--loss-h",
+                        format!(
+                            "the recipe `{}` has no robust loss (its loss is {})",
+                            self.name,
+                            other.describe()
+                        ),
+                    ));
+                }
+            }
+        }
+        self.validate()?;
+        Ok(self)
+    }
+
     /// Total epochs over all cycles.
     pub fn total_epochs(&self) -> usize {
         self.cycles.iter().map(|c| c.epochs).sum()

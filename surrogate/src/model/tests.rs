@@ -374,3 +374,45 @@ fn a_resumed_ensemble_equals_an_uninterrupted_one() {
     assert_eq!(resumed.curves.len(), whole.curves.len());
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn a_recipe_adjusted_trains_longer_or_with_another_loss_scale() {
+    let split = Recipe::named("split").unwrap();
+    assert_eq!(split.clone().adjusted(1.0, None).unwrap(), split);
+    let epochs = |r: &Recipe| r.cycles.iter().map(|c| c.epochs).collect::<Vec<_>>();
+    assert_eq!(epochs(&split), [10, 150]);
+
+    let longer = split.clone().adjusted(2.5, Some(25.0)).unwrap();
+    assert_eq!(epochs(&longer), [25, 375]);
+    assert_eq!(longer.loss, Loss::RelativeRobust { h: 25.0 });
+    assert_eq!(longer.architecture, split.architecture);
+    for (a, b) in longer.cycles.iter().zip(&split.cycles) {
+        assert_eq!((a.lr, a.lr_end, a.batch), (b.lr, b.lr_end, b.batch));
+    }
+    // Never below one epoch per cycle.
+    assert_eq!(epochs(&split.clone().adjusted(1e-3, None).unwrap()), [1, 1]);
+    // The paper's loss in pF^2 takes an h too.
+    let paper = Recipe::named("paper")
+        .unwrap()
+        .adjusted(1.0, Some(1.0))
+        .unwrap();
+    assert_eq!(paper.loss, Loss::PaperRobust { h: 1.0 });
+
+    let refused = |r: crate::Result<Recipe>| match r {
+        Err(Error::Argument { name, message }) => format!("{name}: {message}"),
+        other => panic!("not refused: {other:?}"),
+    };
+    for bad in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+        let m = refused(split.clone().adjusted(bad, None));
+        assert!(m.starts_with("--epochs-scale"), "{m}");
+    }
+    for bad in [0.0, -4.0, f64::NAN] {
+        let m = refused(split.clone().adjusted(1.0, Some(bad)));
+        assert!(m.starts_with("--loss-h"), "{m}");
+    }
+    let m = refused(Recipe::named("tiny").unwrap().adjusted(1.0, Some(4.0)));
+    assert!(
+        m.starts_with("--loss-h") && m.contains("no robust loss"),
+        "{m}"
+    );
+}
