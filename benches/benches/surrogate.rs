@@ -1,13 +1,16 @@
 //! The surrogate's prediction path for inference: one whole 60-voltage curve (25..2975 V) for one
 //! parameter vector, values alone and values with the 60 x 9 Jacobian, on one core, for the
-//! paper's architecture and the split one (p through a trunk once, the bias joining late).
+//! paper's architecture, the split one (p through a trunk once, the bias joining late) and the
+//! steps head (p through all layers once, a closed form per voltage).
 //! The target: <= 20 us per curve on one core. Speed does not depend on the weights, so
 //! the networks are freshly initialised ones of the recipes' shapes (no model file needed).
 
 use std::hint::black_box;
 
 use criterion::Criterion;
-use hpge_surrogate::model::{DataInfo, FORMAT, FORMAT_VERSION, OutputTransform, initial_network};
+use hpge_surrogate::model::{
+    BiasMap, DataInfo, FORMAT, FORMAT_VERSION, OutputTransform, initial_network, network_order,
+};
 use hpge_surrogate::{Figures, ModelInfo, ParameterSpace, Predictor, Recipe, Surrogate};
 use hpge_validation::repo_path;
 
@@ -15,9 +18,12 @@ fn model(recipe: &str) -> Surrogate {
     let space = ParameterSpace::from_file(&repo_path("spaces/super-siegfried-rz.toml"))
         .expect("shipped space loads");
     let recipe = Recipe::named(recipe).expect("known recipe");
+    let order = network_order(&space).expect("one bias dimension");
+    let bias = BiasMap::of(&space.dimensions[order[9]]).expect("positive bias range");
     let nets = (0..recipe.members)
-        .map(|m| initial_network(&recipe.architecture, 9, m as u64))
-        .collect();
+        .map(|m| initial_network(&recipe.architecture, 9, Some(bias), m as u64))
+        .collect::<Result<_, _>>()
+        .expect("valid architecture");
     let none = DataInfo {
         file: String::new(),
         hash: String::new(),
@@ -52,7 +58,7 @@ pub fn bench(c: &mut Criterion) {
     let volts: Vec<f64> = (0..60).map(|k| 25.0 + 50.0 * k as f64).collect();
     let p = [2.6, 0.5, 0.5, 0.1, -0.2, 0.5, 0.45, 0.0, 0.1];
     let mut group = c.benchmark_group("surrogate");
-    for recipe in ["paper", "split", "split-ensemble"] {
+    for recipe in ["paper", "split", "split-ensemble", "split-steps"] {
         let m = model(recipe);
         let u = m.voltages(&volts).expect("in range");
         let mut out = vec![0.0; 60];

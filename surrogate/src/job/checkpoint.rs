@@ -5,7 +5,7 @@
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
-use crate::model::{EpochRecord, Member, ModelInfo, Predictor, Surrogate};
+use crate::model::{EpochRecord, Member, ModelInfo, Predictor, Recipe, Surrogate};
 use crate::{Error, Result};
 
 /// The learning-curve CSV beside a model: models/NAME.safetensors -> models/NAME.curves.csv.
@@ -110,8 +110,15 @@ pub fn resume_members(dir: &Path, info: &ModelInfo) -> Result<Vec<Member>> {
             return Ok(done);
         }
         let s = Surrogate::load(&file)?;
+        // A checkpoint holds one member: the recipes must agree in all but the member count.
+        let one = |r: &Option<Recipe>| {
+            r.clone().map(|r| Recipe {
+                members: 1,
+                ..r
+            })
+        };
         let same = s.info.recipe_name == info.recipe_name
-            && s.info.recipe == info.recipe
+            && one(&s.info.recipe) == one(&info.recipe)
             && s.info.seed == info.seed
             && s.info.training.hash == info.training.hash
             && s.info.test.hash == info.test.hash

@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 use super::transform::unit_to_z;
 use crate::error::{Error, Result};
 use crate::hash::fnv1a;
-use crate::space::{ParameterSpace, Target};
+use crate::space::{Dimension, ParameterSpace, Target};
 
 /// A data set of (p, U_B) -> c12 samples.
 #[derive(Debug, Clone)]
@@ -32,6 +32,8 @@ pub struct DataSet {
     pub excluded: usize,
     /// Number of input dimensions d.
     pub dim: usize,
+    /// The space's bias dimension (the last in network order).
+    pub bias: Dimension,
 }
 
 impl DataSet {
@@ -115,6 +117,7 @@ impl DataSet {
             c12_pf: Vec::new(),
             excluded: 0,
             dim: d,
+            bias: space.dimensions[order[d - 1]].clone(),
         };
         let mut u = vec![0.0; d];
         let mut x = vec![0.0; d];

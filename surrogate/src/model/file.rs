@@ -6,8 +6,10 @@ use std::path::Path;
 
 use safetensors::tensor::{Dtype, SafeTensors, TensorView};
 
+use super::dataset::network_order;
 use super::network::{Dense, Network};
 use super::polynomial::{Polynomial, monomials};
+use super::steps::{BiasMap, StepsHead};
 use super::surrogate::{FORMAT, FORMAT_VERSION, ModelInfo, Predictor, Surrogate};
 use crate::error::{Error, Result};
 
@@ -180,6 +182,16 @@ impl Surrogate {
                 recipe
                     .validate()
                     .map_err(|e| bad("metadata.recipe", e.to_string()))?;
+                let steps = match recipe.architecture.steps {
+                    Some(count) => {
+                        let order = network_order(&info.space)?;
+                        let bias = &info.space.dimensions[order[n_params]];
+                        let bias =
+                            BiasMap::of(bias).map_err(|e| bad("metadata.space", e.to_string()))?;
+                        Some(StepsHead { count, bias })
+                    }
+                    None => None,
+                };
                 let mut nets = Vec::new();
                 for m in 0..recipe.members {
                     let dense = |name: String, n_in: usize, n_out: usize| -> Result<Dense> {
@@ -200,18 +212,21 @@ impl Surrogate {
                         trunk.push(dense(format!("trunk.{i}"), width, w)?);
                         width = w;
                     }
-                    width += 1;
+                    if steps.is_none() {
+                        width += 1;
+                    }
                     let mut head = Vec::new();
                     for (i, &w) in arch.head.iter().enumerate() {
                         head.push(dense(format!("head.{i}"), width, w)?);
                         width = w;
                     }
-                    let out = dense("out".into(), width, 1)?;
+                    let out = dense("out".into(), width, steps.map_or(1, |s| s.outputs()))?;
                     nets.push(Network {
                         n_params,
                         trunk,
                         head,
                         out,
+                        steps,
                     });
                 }
                 Predictor::Networks(nets)

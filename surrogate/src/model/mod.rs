@@ -10,6 +10,7 @@ mod metrics;
 mod network;
 mod polynomial;
 mod recipe;
+mod steps;
 mod surrogate;
 mod train;
 mod transform;
@@ -28,7 +29,8 @@ pub use error_model::{
 pub use metrics::{Figures, gaussian_fit, quantile};
 pub use network::{Dense, Network};
 pub use polynomial::{Polynomial, monomials};
-pub use recipe::{Architecture, Cycle, Loss, OutputTransform, RECIPES, Recipe};
+pub use recipe::{Architecture, Cycle, Loss, OutputTransform, RECIPES, Recipe, STEPS};
+pub use steps::{BiasMap, StepsHead};
 pub use surrogate::{
     DetectorInfo, FORMAT, FORMAT_VERSION, ModelInfo, Predictor, Surrogate, Voltages,
 };

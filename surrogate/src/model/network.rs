@@ -4,6 +4,7 @@
 //! through the trunk).
 
 use super::gelu::{gelu_and_derivative, gelu_in_place};
+use super::steps::StepsHead;
 
 /// A dense layer y = W x + b, W stored transposed (`wt[j * n_out + i]` = W_ij) so that the
 /// product runs as vectorisable column updates.
@@ -135,17 +136,21 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
     (acc[0] + acc[1]) + (acc[2] + acc[3]) + tail
 }
 
-/// The network of [`super::Architecture`]: trunk on p, head on [h, z_U], a linear output.
+/// The network of [`super::Architecture`]: trunk on p, head on [h, z_U], a linear output; or,
+/// with a steps head, trunk and head on p, a linear output of 1 + 3K values and the steps'
+/// closed form in U ([`StepsHead`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Network {
     /// Number of model parameters (inputs without the bias).
     pub n_params: usize,
     /// Layers on p.
     pub trunk: Vec<Dense>,
-    /// Layers after the bias joins (the first takes [h, z_U]).
+    /// Layers after the bias joins (the first takes [h, z_U]); with `steps`, further layers on p.
     pub head: Vec<Dense>,
-    /// The output layer (n_out = 1).
+    /// The output layer (n_out = 1, or 1 + 3K with `steps`).
     pub out: Dense,
+    /// The steps head, when the architecture has one.
+    pub steps: Option<StepsHead>,
 }
 
 /// Buffers of one curve evaluation (no allocation per voltage).
@@ -174,7 +179,13 @@ impl Network {
                 j[k * np + k] = 1.0;
             }
         }
-        for layer in &self.trunk {
+        // A steps network's head sees p alone: its layers continue the trunk.
+        let on_p: &[Dense] = if self.steps.is_some() {
+            &self.head
+        } else {
+            &[]
+        };
+        for layer in self.trunk.iter().chain(on_p) {
             buf.tmp.resize(layer.n_out, 0.0);
             layer.apply(&buf.h, &mut buf.tmp);
             let mut d = vec![0.0; layer.n_out];
@@ -302,8 +313,54 @@ impl Network {
         }
     }
 
+    /// A steps network's curve: o = out(head(trunk(z_p))) once, the closed form per voltage;
+    /// with `jac`, dy_k/dz_p = (dy_k/do) (do/dz_p), do/dz_p by forward mode through the layers.
+    fn steps_curve(
+        &self,
+        s: &StepsHead,
+        zp: &[f64],
+        zu: &[f64],
+        y: &mut [f64],
+        jac: Option<&mut [f64]>,
+    ) {
+        let np = self.n_params;
+        let mut buf = Buffers::default();
+        let mut jh = Vec::new();
+        self.trunk_pass(zp, &mut buf, jac.is_some().then_some(&mut jh));
+        let n_out = self.out.n_out;
+        let mut o = vec![0.0; n_out];
+        self.out.apply(&buf.h, &mut o);
+        let Some(jac) = jac else {
+            s.curve(&o, zu, y);
+            return;
+        };
+        let mut jo = vec![0.0; n_out * np];
+        for (a, row) in jh.chunks_exact(np).enumerate() {
+            let col = &self.out.wt[a * n_out..(a + 1) * n_out];
+            for (i, &w) in col.iter().enumerate() {
+                for (x, &r) in jo[i * np..(i + 1) * np].iter_mut().zip(row) {
+                    *x += w * r;
+                }
+            }
+        }
+        let mut g = vec![0.0; n_out];
+        for (k, (yk, &z)) in y.iter_mut().zip(zu).enumerate() {
+            *yk = s.value_gradient(&o, z, &mut g);
+            let row = &mut jac[k * np..(k + 1) * np];
+            row.fill(0.0);
+            for (i, &gi) in g.iter().enumerate() {
+                for (x, &r) in row.iter_mut().zip(&jo[i * np..(i + 1) * np]) {
+                    *x += gi * r;
+                }
+            }
+        }
+    }
+
     #[inline(always)]
     fn curve_generic(&self, zp: &[f64], zu: &[f64], y: &mut [f64]) {
+        if let Some(s) = &self.steps {
+            return self.steps_curve(s, zp, zu, y, None);
+        }
         let mut buf = Buffers::default();
         self.trunk_pass(zp, &mut buf, None);
         self.head_base(&mut buf);
@@ -318,6 +375,9 @@ impl Network {
 
     #[inline(always)]
     fn curve_jacobian_generic(&self, zp: &[f64], zu: &[f64], y: &mut [f64], jac: &mut [f64]) {
+        if let Some(s) = &self.steps {
+            return self.steps_curve(s, zp, zu, y, Some(jac));
+        }
         let np = self.n_params;
         let nv = zu.len();
         let mut buf = Buffers::default();

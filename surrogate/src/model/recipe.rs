@@ -7,13 +7,18 @@ use crate::error::{Error, Result};
 
 /// Layer widths. Inputs are standard-normal coordinates: the model parameters p go through the
 /// `trunk` (none for the paper), then [h(p), z_U] goes through the `head`, then one linear output.
-/// GELU (tanh form, as Flux's `gelu`) follows every hidden layer, none the output.
+/// GELU (tanh form, as Flux's `gelu`) follows every hidden layer, none the output. With `steps`
+/// (K), the head sees h(p) alone and the linear output has 1 + 3K values, the amplitudes, places
+/// and widths of K steps in ln U_B that make the curve ([`super::StepsHead`]).
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Architecture {
     /// Widths of the layers that see only p.
     pub trunk: Vec<usize>,
-    /// Widths of the layers after the bias joins.
+    /// Widths of the layers after the bias joins (with `steps`: the further layers on p).
     pub head: Vec<usize>,
+    /// K of the steps head; `None`: the bias enters the head as an input.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub steps: Option<usize>,
 }
 
 /// What the network's single output y means (a closed set).
@@ -99,15 +104,21 @@ pub struct Recipe {
 }
 
 /// The recipe names `train --recipe` accepts.
-pub const RECIPES: [&str; 7] = [
+pub const RECIPES: [&str; 9] = [
     "paper",
     "paper-log",
     "paper-log-ensemble",
     "split",
     "split-wide",
     "split-ensemble",
+    "split-steps",
     "tiny",
+    "tiny-steps",
 ];
+
+/// K of `split-steps`: 16 steps over the log-bias range (8 gave a 10-15% larger held-out q90 and
+/// q99 in the prototype comparison of `reports/surrogate.md`).
+pub const STEPS: usize = 16;
 
 impl Recipe {
     /// The recipe called `name` (one of [`RECIPES`]).
@@ -135,10 +146,12 @@ impl Recipe {
         let paper_arch = Architecture {
             trunk: vec![],
             head: vec![128; 5],
+            steps: None,
         };
         let split_arch = Architecture {
             trunk: vec![128, 128, 128],
             head: vec![64, 32],
+            steps: None,
         };
         let split_cycles = vec![
             Cycle {
@@ -199,6 +212,7 @@ impl Recipe {
                 architecture: Architecture {
                     trunk: vec![128, 128, 128],
                     head: vec![128, 64],
+                    steps: None,
                 },
                 log_output: true,
                 loss: Loss::RelativeRobust { h: 4.0 },
@@ -213,12 +227,53 @@ impl Recipe {
                 cycles: split_cycles,
                 members: 4,
             },
+            // The split trunk, then a head on p alone whose outputs place 16 monotone steps in
+            // ln U_B (super::StepsHead): pinch-offs are steps at smooth places v_k(p).
+            "split-steps" => Recipe {
+                name: name.into(),
+                architecture: Architecture {
+                    trunk: vec![128, 128, 128],
+                    head: vec![64],
+                    steps: Some(STEPS),
+                },
+                log_output: true,
+                loss: Loss::RelativeRobust { h: 4.0 },
+                cycles: split_cycles,
+                members: 1,
+            },
+            // The steps head at test size.
+            "tiny-steps" => Recipe {
+                name: name.into(),
+                architecture: Architecture {
+                    trunk: vec![16],
+                    head: vec![16],
+                    steps: Some(4),
+                },
+                log_output: true,
+                loss: Loss::RelativeSquared,
+                cycles: vec![
+                    Cycle {
+                        lr: 1e-2,
+                        lr_end: None,
+                        epochs: 4,
+                        batch: 64,
+                    },
+                    Cycle {
+                        lr: 3e-3,
+                        lr_end: Some(1e-4),
+                        epochs: 8,
+                        batch: 64,
+                    },
+                ],
+                members: 1,
+            },
             // For tests and smoke runs: a small network, a few epochs.
             "tiny" => Recipe {
                 name: name.into(),
                 architecture: Architecture {
                     trunk: vec![16],
                     head: vec![16],
+                    steps: None,
                 },
                 log_output: true,
                 loss: Loss::RelativeSquared,
@@ -265,6 +320,16 @@ impl Recipe {
             .chain(&self.architecture.head);
         if self.architecture.head.is_empty() || widths.clone().any(|&w| w == 0) {
             return Err(bad("needs a non-empty head and non-zero widths".into()));
+        }
+        if let Some(k) = self.architecture.steps {
+            if k < 2 {
+                return Err(bad(format!("a steps head needs at least 2 steps, not {k}")));
+            }
+            if !self.log_output {
+                return Err(bad(
+                    "the steps head learns ln c12: it needs a log output".into()
+                ));
+            }
         }
         for c in &self.cycles {
             let lr_ok = c.lr > 0.0 && c.lr.is_finite() && c.lr_end.is_none_or(|l| l > 0.0);

@@ -41,8 +41,17 @@ fn write_set(path: &std::path::Path, sp: &ParameterSpace, n: usize, offset: usiz
     std::fs::write(path, text).unwrap();
 }
 
+/// The bias map of [`space`]'s U_B (10-3000 V, uniform).
+pub(super) fn test_bias() -> BiasMap {
+    BiasMap {
+        lo_v: 10.0,
+        hi_v: 3000.0,
+        log_uniform: false,
+    }
+}
+
 pub(super) fn random_network(arch: &Architecture, seed: u64) -> Network {
-    let mut net = initial_network(arch, 3, seed);
+    let mut net = initial_network(arch, 3, Some(test_bias()), seed).unwrap();
     // Non-zero biases so that every code path matters.
     for (k, l) in net.trunk.iter_mut().chain(net.head.iter_mut()).enumerate() {
         for (i, b) in l.b.iter_mut().enumerate() {
@@ -58,10 +67,17 @@ fn jacobian_matches_central_differences() {
         Architecture {
             trunk: vec![],
             head: vec![12, 12],
+            steps: None,
         },
         Architecture {
             trunk: vec![10, 8],
             head: vec![6, 5],
+            steps: None,
+        },
+        Architecture {
+            trunk: vec![10, 8],
+            head: vec![6],
+            steps: Some(5),
         },
     ] {
         let net = random_network(&arch, 3);
@@ -95,25 +111,79 @@ fn jacobian_matches_central_differences() {
 
 #[test]
 fn plain_path_matches_candle() {
-    let arch = Architecture {
-        trunk: vec![16, 16],
-        head: vec![16, 8],
+    for steps in [None, Some(6)] {
+        let arch = Architecture {
+            trunk: vec![16, 16],
+            head: vec![16, 8],
+            steps,
+        };
+        let net = random_network(&arch, 5);
+        let units: Vec<f64> = (0..40)
+            .map(|i| ((i as f64 + 0.5) * 0.618_033_988_7).fract())
+            .collect();
+        let c = candle_outputs(&net, &units, 4).unwrap();
+        for (i, row) in units.chunks(4).enumerate() {
+            let z: Vec<f64> = row.iter().map(|&u| unit_to_z(u)).collect();
+            let mut y = [0.0];
+            net.curve(&z[..3], &z[3..], &mut y);
+            assert!(
+                (y[0] - c[i]).abs() < 2e-5 * (1.0 + y[0].abs()),
+                "{steps:?} row {i}: {} vs {}",
+                y[0],
+                c[i]
+            );
+        }
+    }
+}
+
+#[test]
+fn the_steps_bias_map_is_the_log_bias_range() {
+    let m = test_bias();
+    assert_eq!(m.t_of_unit(0.0), 0.0);
+    assert!((m.t_of_unit(1.0) - 1.0).abs() < 1e-15);
+    // U = 100 V: u = 90/2990, t = ln(10)/ln(300).
+    let t = m.t_of_unit(90.0 / 2990.0);
+    assert!((t - 10f64.ln() / 300f64.ln()).abs() < 1e-14, "{t}");
+    for u in [1e-3, 0.2, 0.5, 0.97] {
+        assert!((m.t_of_z(unit_to_z(u)) - m.t_of_unit(u)).abs() < 1e-12);
+    }
+    let log = BiasMap {
+        log_uniform: true,
+        ..m
     };
-    let net = random_network(&arch, 5);
-    let units: Vec<f64> = (0..40)
-        .map(|i| ((i as f64 + 0.5) * 0.618_033_988_7).fract())
-        .collect();
-    let c = candle_outputs(&net, &units, 4).unwrap();
-    for (i, row) in units.chunks(4).enumerate() {
-        let z: Vec<f64> = row.iter().map(|&u| unit_to_z(u)).collect();
-        let mut y = [0.0];
-        net.curve(&z[..3], &z[3..], &mut y);
-        assert!(
-            (y[0] - c[i]).abs() < 2e-5 * (1.0 + y[0].abs()),
-            "row {i}: {} vs {}",
-            y[0],
-            c[i]
-        );
+    assert_eq!(log.t_of_unit(0.3), 0.3);
+    let mut sp = space();
+    sp.dimensions[3].range = [0.0, 3000.0];
+    let e = BiasMap::of(&sp.dimensions[3]).unwrap_err().to_string();
+    assert!(e.contains("U_B") && e.contains("positive"), "{e}");
+}
+
+#[test]
+fn a_steps_network_falls_with_the_bias_everywhere() {
+    let arch = Architecture {
+        trunk: vec![12],
+        head: vec![12],
+        steps: Some(8),
+    };
+    let zu: Vec<f64> = (1..400).map(|k| unit_to_z(k as f64 / 400.0)).collect();
+    let mut y = vec![0.0; zu.len()];
+    for seed in 0..20 {
+        let mut net = random_network(&arch, seed);
+        // Large outputs too: narrow, far-moved, tall steps.
+        for (i, b) in net.out.b.iter_mut().enumerate() {
+            *b = 3.0 * ((seed as usize * 13 + i * 5) as f64).sin();
+        }
+        for zp in [[0.0, 0.0, 0.0], [2.5, -1.0, 0.3], [-3.0, 3.0, -2.0]] {
+            net.curve(&zp, &zu, &mut y);
+            for k in 1..y.len() {
+                assert!(
+                    y[k] <= y[k - 1],
+                    "seed {seed} {zp:?} k {k}: {} > {}",
+                    y[k],
+                    y[k - 1]
+                );
+            }
+        }
     }
 }
 
@@ -295,6 +365,7 @@ fn physical_jacobian_matches_finite_differences() {
     let arch = Architecture {
         trunk: vec![8],
         head: vec![8],
+        steps: None,
     };
     let net = random_network(&arch, 9);
     let info = unit_info();
@@ -415,4 +486,39 @@ fn a_recipe_adjusted_trains_longer_or_with_another_loss_scale() {
         m.starts_with("--loss-h") && m.contains("no robust loss"),
         "{m}"
     );
+}
+
+#[test]
+fn a_tiny_steps_network_trains_reloads_and_falls_with_the_bias() {
+    let dir = std::env::temp_dir().join(format!("hpge-surrogate-steps-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let sp = space();
+    let (tr, te) = (dir.join("train.csv"), dir.join("test.csv"));
+    write_set(&tr, &sp, 600, 0);
+    write_set(&te, &sp, 150, 1000);
+    let train_set = DataSet::read(&tr, &sp).unwrap();
+    let test_set = DataSet::read(&te, &sp).unwrap();
+    let recipe = Recipe::named("tiny-steps").unwrap();
+    let t = train(&recipe, &train_set, &test_set, 2, &mut |_| {}).unwrap();
+    let (first, last) = (t.curves.first().unwrap(), t.curves.last().unwrap());
+    assert!(
+        last.train_loss < 0.5 * first.train_loss && last.test_loss < 0.5 * first.test_loss,
+        "{first:?} -> {last:?}"
+    );
+    let mut info = unit_info();
+    info.output = t.output;
+    info.recipe_name = recipe.name.clone();
+    info.recipe = Some(recipe);
+    let model = Surrogate::new(info, Predictor::Networks(t.members)).unwrap();
+    let file = dir.join("tiny-steps.safetensors");
+    model.save(&file).unwrap();
+    let back = Surrogate::load(&file).unwrap();
+    assert_eq!(back.predictor, model.predictor);
+    assert_eq!(back.predict_set(&test_set), model.predict_set(&test_set));
+    let volts: Vec<f64> = (0..60).map(|k| 25.0 + 50.0 * k as f64).collect();
+    for p in [[2.0, 0.5, 0.1], [0.3, 0.9, -0.8]] {
+        let c = back.curve(&p, &volts).unwrap();
+        assert!(c.windows(2).all(|w| w[1] <= w[0]), "{c:?}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
 }

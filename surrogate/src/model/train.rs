@@ -12,6 +12,7 @@ use serde::{Deserialize, Serialize};
 use super::dataset::DataSet;
 use super::network::{Dense, Network};
 use super::recipe::{Architecture, Loss, OutputTransform, Recipe};
+use super::steps::{BiasMap, StepsHead};
 use super::transform::unit_to_z;
 use crate::error::{Error, Result};
 
@@ -77,8 +78,24 @@ fn candle_err(e: candle_core::Error) -> Error {
     }
 }
 
-/// Glorot-uniform weights U(+-sqrt(6 / (n_in + n_out))) and zero biases, from `seed`.
-pub fn initial_network(arch: &Architecture, n_params: usize, seed: u64) -> Network {
+/// Glorot-uniform weights U(+-sqrt(6 / (n_in + n_out))) and zero biases, from `seed`. A steps
+/// head needs `bias`, the map of z_U ([`Error::Argument`] without it); other networks ignore it.
+pub fn initial_network(
+    arch: &Architecture,
+    n_params: usize,
+    bias: Option<BiasMap>,
+    seed: u64,
+) -> Result<Network> {
+    let steps = match (arch.steps, bias) {
+        (None, _) => None,
+        (Some(count), Some(bias)) => Some(StepsHead { count, bias }),
+        (Some(_), None) => {
+            return Err(Error::Argument {
+                name: "architecture.steps".into(),
+                message: "a steps head needs the bias dimension's map".into(),
+            });
+        }
+    };
     let mut rng = StdRng::seed_from_u64(seed);
     let mut layer = |n_in: usize, n_out: usize| {
         let a = (6.0 / (n_in + n_out) as f64).sqrt();
@@ -98,7 +115,9 @@ pub fn initial_network(arch: &Architecture, n_params: usize, seed: u64) -> Netwo
             l
         })
         .collect();
-    width += 1;
+    if steps.is_none() {
+        width += 1;
+    }
     let head: Vec<Dense> = arch
         .head
         .iter()
@@ -108,18 +127,20 @@ pub fn initial_network(arch: &Architecture, n_params: usize, seed: u64) -> Netwo
             l
         })
         .collect();
-    let out = layer(width, 1);
-    Network {
+    let out = layer(width, steps.map_or(1, |s| s.outputs()));
+    Ok(Network {
         n_params,
         trunk,
         head,
         out,
-    }
+        steps,
+    })
 }
 
 /// The network as candle variables (f32).
 struct CandleNet {
     n_params: usize,
+    steps: Option<StepsHead>,
     trunk: Vec<(Var, Var)>,
     head: Vec<(Var, Var)>,
     out: (Var, Var),
@@ -139,6 +160,7 @@ impl CandleNet {
         };
         Ok(CandleNet {
             n_params: net.n_params,
+            steps: net.steps,
             trunk: net.trunk.iter().map(var).collect::<Result<_>>()?,
             head: net.head.iter().map(var).collect::<Result<_>>()?,
             out: var(&net.out)?,
@@ -164,6 +186,7 @@ impl CandleNet {
             trunk: self.trunk.iter().map(dense).collect::<Result<_>>()?,
             head: self.head.iter().map(dense).collect::<Result<_>>()?,
             out: dense(&self.out)?,
+            steps: self.steps,
         })
     }
 
@@ -183,6 +206,12 @@ impl CandleNet {
         let u = x.narrow(1, self.n_params, 1)?;
         for l in &self.trunk {
             h = dense(&h, l)?.gelu()?;
+        }
+        if let Some(s) = &self.steps {
+            for l in &self.head {
+                h = dense(&h, l)?.gelu()?;
+            }
+            return s.forward(&dense(&h, &self.out)?, &u);
         }
         let mut a = Tensor::cat(&[&h, &u], 1)?;
         for l in &self.head {
@@ -323,6 +352,10 @@ pub fn train_resuming(
     on_member: &mut dyn FnMut(usize, &Member) -> Result<()>,
 ) -> Result<Trained> {
     recipe.validate()?;
+    let bias = match recipe.architecture.steps {
+        Some(_) => Some(BiasMap::of(&train.bias)?),
+        None => None,
+    };
     let start = std::time::Instant::now();
     let out = output_transform(recipe.log_output, train);
     let (xt, tt) = tensors(train, out)?;
@@ -342,8 +375,9 @@ pub fn train_resuming(
         let net = CandleNet::from_network(&initial_network(
             &recipe.architecture,
             train.dim - 1,
+            bias,
             member_seed,
-        ))?;
+        )?)?;
         let mut rng = StdRng::seed_from_u64(member_seed ^ 0x05ee_d0fb_a7c4);
         let mut order: Vec<u32> = (0..n as u32).collect();
         let mut epoch = 0;

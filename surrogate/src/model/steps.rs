@@ -1,0 +1,186 @@
+//! The steps head of the recipe `split-steps`: the C-V curve of one parameter point as a sum of
+//! K logistic steps in the log-bias coordinate. c12 then falls monotonically with U_B, as a
+//! depleting detector's does, and a pinch-off (c12 dropping by tens of percent within a few volts
+//! where an undepleted pocket loses its contact, `reports/surrogate.md`) is one narrow step whose
+//! place v_k(p) is a smooth function of the parameters: a network learns that place from far
+//! fewer rows than it needs to draw the step itself from a bias input.
+//!
+//! With o = (o_0, ..., o_3K) the network's outputs from the parameters alone (the trunk and head
+//! layers see p only), and t the bias coordinate,
+//!
+//!   y(p, U) = o_0 + ln(1 + sum_k a_k s_k),   s_k = sigmoid((v_k - t) / w_k),
+//!   a_k = softplus(o_{1+k}),   v_k = k/(K-1) + o_{1+K+k} / 2,
+//!   w_k = 0.05 softplus(o_{1+2K+k}) + 0.001,
+//!   t = ln(U / U_lo) / ln(U_hi / U_lo)   (t = u for a log-uniform bias),
+//!
+//! y the standardised ln c12 (the output transform of the log recipes). Every a_k >= 0 and every
+//! s_k falls with t, so dy/dU <= 0 everywhere.
+
+use candle_core::Tensor;
+
+use crate::error::{Error, Result};
+use crate::space::{Dimension, Distribution, normal_cdf};
+
+/// Scale of a step's width: w_k = WIDTH_SCALE softplus(.) + WIDTH_MIN (in t, the whole bias
+/// range being 1).
+pub const WIDTH_SCALE: f64 = 0.05;
+/// The narrowest step: 0.1% of the log-bias range (about 6 mV at 10 V, 1.7 V at 3000 V for the
+/// paper's 10-3000 V).
+pub const WIDTH_MIN: f64 = 1e-3;
+/// How far a step moves from its home k/(K-1) per unit of its output.
+pub const SHIFT_SCALE: f64 = 0.5;
+
+/// The map from the network's bias coordinate z_U to the steps' coordinate t.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BiasMap {
+    /// U_lo (V), the bias range's lower end (> 0).
+    pub lo_v: f64,
+    /// U_hi (V).
+    pub hi_v: f64,
+    /// The bias is sampled log-uniformly (then t = u).
+    pub log_uniform: bool,
+}
+
+impl BiasMap {
+    /// The map of a space's bias dimension; its range must be positive.
+    pub fn of(bias: &Dimension) -> Result<Self> {
+        let [lo, hi] = bias.range;
+        if !(lo > 0.0 && hi > lo && hi.is_finite()) {
+            return Err(Error::Argument {
+                name: format!("dimension {}", bias.name),
+                message: format!(
+                    "the steps head takes ln U_B: its range [{lo}, {hi}] must be positive"
+                ),
+            });
+        }
+        Ok(BiasMap {
+            lo_v: lo,
+            hi_v: hi,
+            log_uniform: bias.distribution == Distribution::LogUniform,
+        })
+    }
+
+    /// t of the unit coordinate u: ln(1 + u (U_hi/U_lo - 1)) / ln(U_hi/U_lo) (uniform bias),
+    /// u (log-uniform).
+    pub fn t_of_unit(&self, u: f64) -> f64 {
+        if self.log_uniform {
+            return u;
+        }
+        let r = self.hi_v / self.lo_v;
+        (u * (r - 1.0)).ln_1p() / r.ln()
+    }
+
+    /// t of the network coordinate z = Phi^-1(u).
+    pub fn t_of_z(&self, z: f64) -> f64 {
+        self.t_of_unit(normal_cdf(z))
+    }
+
+    /// The same map on a column of z (candle, f32): u = (1 + erf(z / sqrt 2)) / 2.
+    pub fn t_tensor(&self, z: &Tensor) -> candle_core::Result<Tensor> {
+        let u = (((z / std::f64::consts::SQRT_2)?.erf()? + 1.0)? * 0.5)?;
+        if self.log_uniform {
+            return Ok(u);
+        }
+        let r = self.hi_v / self.lo_v;
+        ((u * (r - 1.0))? + 1.0)?.log()? / r.ln()
+    }
+}
+
+/// The steps head: K steps and the bias map.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StepsHead {
+    /// K, the number of steps (>= 2).
+    pub count: usize,
+    /// z_U -> t.
+    pub bias: BiasMap,
+}
+
+/// One step's amplitude, place and width with their derivatives by their own outputs.
+#[derive(Debug, Clone, Copy)]
+struct Step {
+    a: f64,
+    v: f64,
+    w: f64,
+    da: f64,
+    dw: f64,
+}
+
+fn sigmoid(x: f64) -> f64 {
+    1.0 / (1.0 + (-x).exp())
+}
+
+/// ln(1 + e^x) without overflow.
+fn softplus(x: f64) -> f64 {
+    x.max(0.0) + (-x.abs()).exp().ln_1p()
+}
+
+impl StepsHead {
+    /// The network outputs the head takes: 1 + 3K.
+    pub fn outputs(&self) -> usize {
+        1 + 3 * self.count
+    }
+
+    fn home(&self, k: usize) -> f64 {
+        k as f64 / (self.count - 1) as f64
+    }
+
+    fn steps(&self, o: &[f64]) -> Vec<Step> {
+        let n = self.count;
+        (0..n)
+            .map(|k| Step {
+                a: softplus(o[1 + k]),
+                v: self.home(k) + SHIFT_SCALE * o[1 + n + k],
+                w: WIDTH_SCALE * softplus(o[1 + 2 * n + k]) + WIDTH_MIN,
+                da: sigmoid(o[1 + k]),
+                dw: WIDTH_SCALE * sigmoid(o[1 + 2 * n + k]),
+            })
+            .collect()
+    }
+
+    /// y at the bias coordinates z_U of a curve, from the outputs o (module formula).
+    pub fn curve(&self, o: &[f64], zu: &[f64], y: &mut [f64]) {
+        let steps = self.steps(o);
+        for (yk, &z) in y.iter_mut().zip(zu) {
+            let t = self.bias.t_of_z(z);
+            let sum: f64 = steps.iter().map(|s| s.a * sigmoid((s.v - t) / s.w)).sum();
+            *yk = o[0] + sum.ln_1p();
+        }
+    }
+
+    /// y at z_U and dy/do (len [`Self::outputs`]) into `g`:
+    /// dy/do_0 = 1; with D = 1 + sum_k a_k s_k and s'_k = s_k (1 - s_k),
+    /// dy/da_k = s_k / D, dy/dv_k = a_k s'_k / (w_k D), dy/dw_k = -a_k s'_k (v_k - t) / (w_k^2 D).
+    pub fn value_gradient(&self, o: &[f64], z: f64, g: &mut [f64]) -> f64 {
+        let n = self.count;
+        let steps = self.steps(o);
+        let t = self.bias.t_of_z(z);
+        let s: Vec<f64> = steps.iter().map(|st| sigmoid((st.v - t) / st.w)).collect();
+        let sum: f64 = steps.iter().zip(&s).map(|(st, &sk)| st.a * sk).sum();
+        let d = 1.0 + sum;
+        g[0] = 1.0;
+        for (k, (st, &sk)) in steps.iter().zip(&s).enumerate() {
+            let ds = sk * (1.0 - sk);
+            g[1 + k] = sk / d * st.da;
+            g[1 + n + k] = st.a * ds / (st.w * d) * SHIFT_SCALE;
+            g[1 + 2 * n + k] = -st.a * ds * (st.v - t) / (st.w * st.w * d) * st.dw;
+        }
+        o[0] + sum.ln_1p()
+    }
+
+    /// The head on candle outputs `o` (n x (1 + 3K), f32) and the bias column z (n x 1): y (n).
+    pub fn forward(&self, o: &Tensor, z: &Tensor) -> candle_core::Result<Tensor> {
+        let n = self.count;
+        let softplus = |x: Tensor| -> candle_core::Result<Tensor> {
+            x.relu()? + (x.abs()?.neg()?.exp()? + 1.0)?.log()?
+        };
+        let t = self.bias.t_tensor(z)?;
+        let homes: Vec<f32> = (0..n).map(|k| self.home(k) as f32).collect();
+        let homes = Tensor::from_vec(homes, (1, n), o.device())?;
+        let a = softplus(o.narrow(1, 1, n)?)?;
+        let v = (o.narrow(1, 1 + n, n)? * SHIFT_SCALE)?.broadcast_add(&homes)?;
+        let w = ((softplus(o.narrow(1, 1 + 2 * n, n)?)? * WIDTH_SCALE)? + WIDTH_MIN)?;
+        let s = candle_nn::ops::sigmoid(&(v.broadcast_sub(&t)? / w)?)?;
+        let sum = (a * s)?.sum_keepdim(1)?;
+        (o.narrow(1, 0, 1)? + (sum + 1.0)?.log()?)?.squeeze(1)
+    }
+}
