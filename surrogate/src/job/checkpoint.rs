@@ -111,12 +111,7 @@ pub fn resume_members(dir: &Path, info: &ModelInfo) -> Result<Vec<Member>> {
         }
         let s = Surrogate::load(&file)?;
         // A checkpoint holds one member: the recipes must agree in all but the member count.
-        let one = |r: &Option<Recipe>| {
-            r.clone().map(|r| Recipe {
-                members: 1,
-                ..r
-            })
-        };
+        let one = |r: &Option<Recipe>| r.clone().map(|r| Recipe { members: 1, ..r });
         let same = s.info.recipe_name == info.recipe_name
             && one(&s.info.recipe) == one(&info.recipe)
             && s.info.seed == info.seed

@@ -104,7 +104,7 @@ pub struct Recipe {
 }
 
 /// The recipe names `train --recipe` accepts.
-pub const RECIPES: [&str; 9] = [
+pub const RECIPES: [&str; 10] = [
     "paper",
     "paper-log",
     "paper-log-ensemble",
@@ -112,6 +112,7 @@ pub const RECIPES: [&str; 9] = [
     "split-wide",
     "split-ensemble",
     "split-steps",
+    "split-steps-ensemble",
     "tiny",
     "tiny-steps",
 ];
@@ -240,6 +241,20 @@ impl Recipe {
                 loss: Loss::RelativeRobust { h: 4.0 },
                 cycles: split_cycles,
                 members: 1,
+            },
+            // Four independently seeded split-steps networks: the mean predicts (sigma 0.82x
+            // one network's in the prototype), the spread estimates each prediction's error.
+            "split-steps-ensemble" => Recipe {
+                name: name.into(),
+                architecture: Architecture {
+                    trunk: vec![128, 128, 128],
+                    head: vec![64],
+                    steps: Some(STEPS),
+                },
+                log_output: true,
+                loss: Loss::RelativeRobust { h: 4.0 },
+                cycles: split_cycles,
+                members: 4,
             },
             // The steps head at test size.
             "tiny-steps" => Recipe {
