@@ -184,3 +184,62 @@ impl StepsHead {
         (o.narrow(1, 0, 1)? + (sum + 1.0)?.log()?)?.squeeze(1)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use proptest::prelude::*;
+
+    use super::*;
+    use crate::model::unit_to_z;
+
+    const K: usize = 5;
+
+    fn head() -> StepsHead {
+        StepsHead {
+            count: K,
+            bias: BiasMap {
+                lo_v: 10.0,
+                hi_v: 3000.0,
+                log_uniform: false,
+            },
+        }
+    }
+
+    proptest! {
+        /// Any outputs give a curve that never rises with U_B.
+        #[test]
+        fn the_curve_never_rises(o in proptest::collection::vec(-6.0f64..6.0, 1 + 3 * K)) {
+            let zu: Vec<f64> = (1..300).map(|k| unit_to_z(k as f64 / 300.0)).collect();
+            let mut y = vec![0.0; zu.len()];
+            head().curve(&o, &zu, &mut y);
+            for k in 1..y.len() {
+                prop_assert!(y[k] <= y[k - 1], "k {}: {} > {}", k, y[k], y[k - 1]);
+            }
+        }
+
+        /// dy/do of `value_gradient` against central differences, and its y against `curve`'s.
+        #[test]
+        fn the_gradient_is_the_derivative(
+            o in proptest::collection::vec(-3.0f64..3.0, 1 + 3 * K),
+            u in 0.01f64..0.99,
+        ) {
+            let h = head();
+            let z = unit_to_z(u);
+            let mut g = vec![0.0; h.outputs()];
+            let y = h.value_gradient(&o, z, &mut g);
+            let mut yc = [0.0];
+            h.curve(&o, &[z], &mut yc);
+            prop_assert_eq!(y, yc[0]);
+            for i in 0..o.len() {
+                let d = 1e-6;
+                let (mut a, mut b) = (o.clone(), o.clone());
+                a[i] += d;
+                b[i] -= d;
+                let fd = (h.value_gradient(&a, z, &mut vec![0.0; h.outputs()])
+                    - h.value_gradient(&b, z, &mut vec![0.0; h.outputs()]))
+                    / (2.0 * d);
+                prop_assert!((fd - g[i]).abs() < 1e-6 * (1.0 + fd.abs()), "output {}: {} vs {}", i, fd, g[i]);
+            }
+        }
+    }
+}
