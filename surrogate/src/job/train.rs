@@ -49,8 +49,9 @@ pub struct TrainJob {
     /// The parameter space the rows were generated from.
     #[cfg_attr(feature = "clap", arg(long, value_name = "FILE", default_value = DEFAULT_SPACE))]
     pub space: PathBuf,
-    /// Recipe: paper, paper-log, split, split-ensemble, tiny (networks) or poly3 (the
-    /// polynomial baseline).
+    /// Recipe: paper, paper-log, paper-log-ensemble, split, split-wide, split-ensemble,
+    /// split-steps, split-steps-ensemble, tiny, tiny-steps (networks) or poly3 (the polynomial
+    /// baseline).
     #[cfg_attr(feature = "clap", arg(long, default_value = DEFAULT_RECIPE))]
     pub recipe: String,
     /// The model file (.safetensors); learning curves go to <stem>.curves.csv beside it, the
