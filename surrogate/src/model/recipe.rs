@@ -168,6 +168,32 @@ impl Recipe {
                 batch: 512,
             },
         ];
+        // The trunk of `split`, then one layer on p and the steps head (super::StepsHead).
+        let steps_arch = Architecture {
+            trunk: vec![128, 128, 128],
+            head: vec![64],
+            steps: Some(STEPS),
+        };
+        // Test size: one layer of 16 before and after the bias would join.
+        let tiny_arch = |steps| Architecture {
+            trunk: vec![16],
+            head: vec![16],
+            steps,
+        };
+        let tiny_cycles = vec![
+            Cycle {
+                lr: 1e-2,
+                lr_end: None,
+                epochs: 4,
+                batch: 64,
+            },
+            Cycle {
+                lr: 3e-3,
+                lr_end: Some(1e-4),
+                epochs: 8,
+                batch: 64,
+            },
+        ];
         let r = match name {
             // Section 7 exactly.
             "paper" => Recipe {
@@ -232,11 +258,7 @@ impl Recipe {
             // ln U_B (super::StepsHead): pinch-offs are steps at smooth places v_k(p).
             "split-steps" => Recipe {
                 name: name.into(),
-                architecture: Architecture {
-                    trunk: vec![128, 128, 128],
-                    head: vec![64],
-                    steps: Some(STEPS),
-                },
+                architecture: steps_arch.clone(),
                 log_output: true,
                 loss: Loss::RelativeRobust { h: 4.0 },
                 cycles: split_cycles,
@@ -246,11 +268,7 @@ impl Recipe {
             // one network's in the prototype), the spread estimates each prediction's error.
             "split-steps-ensemble" => Recipe {
                 name: name.into(),
-                architecture: Architecture {
-                    trunk: vec![128, 128, 128],
-                    head: vec![64],
-                    steps: Some(STEPS),
-                },
+                architecture: steps_arch.clone(),
                 log_output: true,
                 loss: Loss::RelativeRobust { h: 4.0 },
                 cycles: split_cycles,
@@ -259,53 +277,19 @@ impl Recipe {
             // The steps head at test size.
             "tiny-steps" => Recipe {
                 name: name.into(),
-                architecture: Architecture {
-                    trunk: vec![16],
-                    head: vec![16],
-                    steps: Some(4),
-                },
+                architecture: tiny_arch(Some(4)),
                 log_output: true,
                 loss: Loss::RelativeSquared,
-                cycles: vec![
-                    Cycle {
-                        lr: 1e-2,
-                        lr_end: None,
-                        epochs: 4,
-                        batch: 64,
-                    },
-                    Cycle {
-                        lr: 3e-3,
-                        lr_end: Some(1e-4),
-                        epochs: 8,
-                        batch: 64,
-                    },
-                ],
+                cycles: tiny_cycles,
                 members: 1,
             },
             // For tests and smoke runs: a small network, a few epochs.
             "tiny" => Recipe {
                 name: name.into(),
-                architecture: Architecture {
-                    trunk: vec![16],
-                    head: vec![16],
-                    steps: None,
-                },
+                architecture: tiny_arch(None),
                 log_output: true,
                 loss: Loss::RelativeSquared,
-                cycles: vec![
-                    Cycle {
-                        lr: 1e-2,
-                        lr_end: None,
-                        epochs: 4,
-                        batch: 64,
-                    },
-                    Cycle {
-                        lr: 3e-3,
-                        lr_end: Some(1e-4),
-                        epochs: 8,
-                        batch: 64,
-                    },
-                ],
+                cycles: tiny_cycles,
                 members: 1,
             },
             _ => {

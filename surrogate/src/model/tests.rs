@@ -187,9 +187,10 @@ fn a_steps_network_falls_with_the_bias_everywhere() {
     }
 }
 
-#[test]
-fn tiny_training_lowers_the_loss_and_the_file_reloads_identically() {
-    let dir = std::env::temp_dir().join(format!("hpge-surrogate-unit-{}", std::process::id()));
+/// A fresh folder with 600 training and 150 test rows of [`synthetic_c12`]: (folder, space,
+/// training file, test file, both sets as read).
+fn synthetic_sets(name: &str) -> (PathBuf, ParameterSpace, PathBuf, PathBuf, DataSet, DataSet) {
+    let dir = std::env::temp_dir().join(format!("hpge-surrogate-{name}-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let sp = space();
     let (tr, te) = (dir.join("train.csv"), dir.join("test.csv"));
@@ -197,6 +198,12 @@ fn tiny_training_lowers_the_loss_and_the_file_reloads_identically() {
     write_set(&te, &sp, 150, 1000);
     let train_set = DataSet::read(&tr, &sp).unwrap();
     let test_set = DataSet::read(&te, &sp).unwrap();
+    (dir, sp, tr, te, train_set, test_set)
+}
+
+#[test]
+fn tiny_training_lowers_the_loss_and_the_file_reloads_identically() {
+    let (dir, sp, tr, _, train_set, test_set) = synthetic_sets("unit");
     let recipe = Recipe::named("tiny").unwrap();
     let mut epochs = 0;
     let t = train(&recipe, &train_set, &test_set, 11, &mut |_| epochs += 1).unwrap();
@@ -490,14 +497,7 @@ fn a_recipe_adjusted_trains_longer_or_with_another_loss_scale() {
 
 #[test]
 fn a_tiny_steps_network_trains_reloads_and_falls_with_the_bias() {
-    let dir = std::env::temp_dir().join(format!("hpge-surrogate-steps-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let sp = space();
-    let (tr, te) = (dir.join("train.csv"), dir.join("test.csv"));
-    write_set(&tr, &sp, 600, 0);
-    write_set(&te, &sp, 150, 1000);
-    let train_set = DataSet::read(&tr, &sp).unwrap();
-    let test_set = DataSet::read(&te, &sp).unwrap();
+    let (dir, _, _, _, train_set, test_set) = synthetic_sets("steps");
     let recipe = Recipe::named("tiny-steps").unwrap();
     let t = train(&recipe, &train_set, &test_set, 2, &mut |_| {}).unwrap();
     let (first, last) = (t.curves.first().unwrap(), t.curves.last().unwrap());
