@@ -6,7 +6,7 @@
 # The rows: the paper-60000 parts (data/training/parts/), restored. Training sets are index
 # ranges of the run: 0-1999 (2 000 rows), 0-3999 (4 000), 0-4803 and 30000-32914 (7 719); the
 # test set (learning curves only) is 32915-34849. Prints one line per model and writes
-# OUT/results.txt; about 1 min per model at 150 epochs on 2 cores.
+# OUT/results.txt; about 1 min per network at 150 epochs on 2 cores, 25 min in all.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 OUT=${1:-/tmp/surrogate-scaling}
@@ -53,3 +53,5 @@ for n in 2000 4000 7719; do
 done
 one train-7719 split e4 --epochs-scale 4
 one train-7719 split e4-h25 --epochs-scale 4 --loss-h 25
+one train-7719 split-steps e4 --epochs-scale 4
+one train-7719 split-steps-ensemble ""
