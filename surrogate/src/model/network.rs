@@ -343,9 +343,8 @@ impl Network {
                 }
             }
         }
-        let mut g = vec![0.0; n_out];
-        for (k, (yk, &z)) in y.iter_mut().zip(zu).enumerate() {
-            *yk = s.value_gradient(&o, z, &mut g);
+        s.curve_gradient(&o, zu, &mut |k, yk, g| {
+            y[k] = yk;
             let row = &mut jac[k * np..(k + 1) * np];
             row.fill(0.0);
             for (i, &gi) in g.iter().enumerate() {
@@ -353,7 +352,7 @@ impl Network {
                     *x += gi * r;
                 }
             }
-        }
+        });
     }
 
     #[inline(always)]

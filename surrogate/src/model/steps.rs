@@ -151,8 +151,22 @@ impl StepsHead {
     /// dy/do_0 = 1; with D = 1 + sum_k a_k s_k and s'_k = s_k (1 - s_k),
     /// dy/da_k = s_k / D, dy/dv_k = a_k s'_k / (w_k D), dy/dw_k = -a_k s'_k (v_k - t) / (w_k^2 D).
     pub fn value_gradient(&self, o: &[f64], z: f64, g: &mut [f64]) -> f64 {
-        let n = self.count;
+        self.gradient_at(&self.steps(o), o, z, g)
+    }
+
+    /// [`Self::value_gradient`] along a curve, the steps' amplitudes, places and widths computed
+    /// once: `each(k, y_k, dy_k/do)` for every z_U,k.
+    pub fn curve_gradient(&self, o: &[f64], zu: &[f64], each: &mut dyn FnMut(usize, f64, &[f64])) {
         let steps = self.steps(o);
+        let mut g = vec![0.0; self.outputs()];
+        for (k, &z) in zu.iter().enumerate() {
+            let y = self.gradient_at(&steps, o, z, &mut g);
+            each(k, y, &g);
+        }
+    }
+
+    fn gradient_at(&self, steps: &[Step], o: &[f64], z: f64, g: &mut [f64]) -> f64 {
+        let n = self.count;
         let t = self.bias.t_of_z(z);
         let s: Vec<f64> = steps.iter().map(|st| sigmoid((st.v - t) / st.w)).collect();
         let sum: f64 = steps.iter().zip(&s).map(|(st, &sk)| st.a * sk).sum();
