@@ -3,11 +3,18 @@
 //! (9 parameters, 60 voltages) without and with the gradient, the paper's likelihood and the
 //! measured-covariance one, and the whole B_Z fit with each sampler (4 chains, R-hat <= 1.01,
 //! ESS >= 1000). The B_RZ fit (about 30 s) is timed by `hpge-cv fit` (reports/inference.md).
+//! A refinement round's posterior is timed too: the surrogate corrected by an error model of
+//! 200 exact curves (the main job's second round has 208), with its variance fixed at one point
+//! (the default, `RefineVariance::Best`) and at each input. And the convergence diagnostics the
+//! sampler computes after every batch: bulk and tail ESS and R-hat of 4 chains of 25 000
+//! strongly autocorrelated draws (AR(1), phi = 0.98, as a Metropolis chain in 9 dimensions).
 
 use std::hint::black_box;
 
 use criterion::Criterion;
+use hpge_inference::diagnostics::Diagnostics;
 use hpge_inference::posterior::NoiseKind;
+use hpge_inference::refine::{CorrectedModel, GpCorrection, GpHyper};
 use hpge_inference::{
     CvModel, FitSettings, Likelihood, NoiseSettings, Posterior, Prior, PriorSpec, SampleSettings,
     SamplerKind, SurrogateModel, fit,
@@ -56,6 +63,85 @@ pub fn bench(c: &mut Criterion) {
             })
         });
     }
+    // A refinement round: 200 points near z = 0.1 (x of the prior's centre region), r small.
+    let (m, p, l) = setup("priors/b-rz.toml", NoiseKind::Covariance);
+    let z = vec![0.1; p.dim()];
+    let mut theta = vec![0.0; p.dim()];
+    p.from_unconstrained(&z, &mut theta);
+    let mut x0 = vec![0.0; m.inputs().len()];
+    p.expand(&theta, &mut x0);
+    let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+    let mut unit = move || {
+        state = state
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1);
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let n_v = m.voltages().len();
+    let xs: Vec<Vec<f64>> = (0..200)
+        .map(|_| {
+            x0.iter()
+                .map(|v| v * (1.0 + 0.05 * (unit() - 0.5)))
+                .collect()
+        })
+        .collect();
+    let r: Vec<Vec<f64>> = (0..200)
+        .map(|_| (0..n_v).map(|_| 0.01 * (unit() - 0.5)).collect())
+        .collect();
+    let hyper = GpHyper {
+        lengths: vec![2.0; x0.len()],
+        sf: 1.0,
+        sn: 0.1,
+    };
+    let gp = GpCorrection::with_hyper(&xs, &r, hyper).expect("error model");
+    for (name, fixed) in [("variance fixed", true), ("variance at each input", false)] {
+        let c = CorrectedModel::new(&m, gp.clone()).expect("corrected");
+        let c = if fixed { c.variance_fixed_at(&x0) } else { c };
+        let post = Posterior::new(&c, &p, &l).expect("posterior");
+        g.bench_function(format!("b-rz ln p, corrected by 200 curves, {name}"), |b| {
+            b.iter(|| black_box(post.ln_density_z(black_box(&z), None).expect("inside")))
+        });
+        let mut grad = vec![0.0; p.dim()];
+        g.bench_function(
+            format!("b-rz ln p + gradient, corrected by 200 curves, {name}"),
+            |b| {
+                b.iter(|| {
+                    black_box(
+                        post.ln_density_z(black_box(&z), Some(&mut grad))
+                            .expect("inside"),
+                    )
+                })
+            },
+        );
+    }
+    let chains: Vec<Vec<f64>> = (0..4)
+        .map(|c| {
+            let mut state = 0x2545_f491_4f6c_dd1d_u64 + c;
+            let mut normal = move || {
+                // Sum of 12 uniforms minus 6: a unit-variance, nearly normal deviate.
+                (0..12)
+                    .map(|_| {
+                        state = state
+                            .wrapping_mul(6_364_136_223_846_793_005)
+                            .wrapping_add(1);
+                        (state >> 11) as f64 / (1u64 << 53) as f64
+                    })
+                    .sum::<f64>()
+                    - 6.0
+            };
+            let phi: f64 = 0.98;
+            let mut x = 0.0;
+            (0..25_000)
+                .map(|_| {
+                    x = phi * x + (1.0 - phi * phi).sqrt() * normal();
+                    x
+                })
+                .collect()
+        })
+        .collect();
+    g.bench_function("diagnostics of 4 chains x 25 000 draws", |b| {
+        b.iter(|| black_box(Diagnostics::of(black_box(&chains))))
+    });
     g.sample_size(10);
     for kind in [SamplerKind::Metropolis, SamplerKind::Nuts] {
         let (m, p, l) = setup("priors/b-z.toml", NoiseKind::Paper);

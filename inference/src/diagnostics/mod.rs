@@ -27,12 +27,16 @@ pub struct Diagnostics {
 }
 
 impl Diagnostics {
-    /// Diagnostics of `chains` (each one chain's draws of one parameter, equal lengths >= 4).
+    /// Diagnostics of `chains` (each one chain's draws of one parameter, equal lengths >= 4):
+    /// [`rank_rhat`], [`ess_bulk`] and [`ess_tail`], the chains split and rank-normalised once
+    /// for all three.
     pub fn of(chains: &[Vec<f64>]) -> Diagnostics {
+        let split = split_chains(chains);
+        let normalised = rank_normalise(&split);
         Diagnostics {
-            rhat: rank_rhat(chains),
-            ess_bulk: ess_bulk(chains),
-            ess_tail: ess_tail(chains),
+            rhat: rhat::rank_rhat_of(&split, &normalised),
+            ess_bulk: ess(&normalised),
+            ess_tail: ess::ess_tail_of(&split),
         }
     }
 

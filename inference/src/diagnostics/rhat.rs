@@ -41,7 +41,13 @@ pub fn split_rhat(chains: &[Vec<f64>]) -> f64 {
 /// R-hat of the rank-normalised draws (location) and of the rank-normalised folded draws (scale).
 pub fn rank_rhat(chains: &[Vec<f64>]) -> f64 {
     let split = split_chains(chains);
-    let bulk = basic_rhat(&rank_normalise(&split));
-    let tail = basic_rhat(&rank_normalise(&fold(&split)));
+    rank_rhat_of(&split, &rank_normalise(&split))
+}
+
+/// [`rank_rhat`] from the split chains and their rank-normalised draws (computed once for
+/// R-hat and the bulk ESS by [`super::Diagnostics::of`]).
+pub(crate) fn rank_rhat_of(split: &[Vec<f64>], normalised: &[Vec<f64>]) -> f64 {
+    let bulk = basic_rhat(normalised);
+    let tail = basic_rhat(&rank_normalise(&fold(split)));
     bulk.max(tail)
 }

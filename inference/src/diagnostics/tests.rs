@@ -102,3 +102,55 @@ fn ranks_are_normal_scores_and_ties_share_a_rank() {
         vec![vec![1.5, 0.5], vec![0.5, 3.5]]
     );
 }
+
+#[test]
+fn fft_autocovariances_equal_the_direct_sums_at_every_lag() {
+    use super::ess::{autocov, autocovariances};
+    let mut planner = rustfft::FftPlanner::new();
+    // Lengths at, below and above a power of two; an AR(1) chain with long memory and one
+    // with a shifted mean.
+    for (n, phi, seed) in [(1, 0.0, 1), (7, 0.3, 2), (64, 0.9, 3), (1000, 0.95, 4)] {
+        let c = &ar1(1, n, phi, seed, &[3.0], &[2.0])[0];
+        let mean = c.iter().sum::<f64>() / n as f64;
+        let fast = autocovariances(c, mean, &mut planner);
+        assert_eq!(fast.len(), n);
+        for (t, a) in fast.iter().enumerate() {
+            let direct = autocov(c, mean, t);
+            assert!(
+                (a - direct).abs() <= 1e-12 * fast[0].abs().max(1e-300) + 1e-15,
+                "n {n}, lag {t}: fft {a}, direct {direct}"
+            );
+        }
+    }
+}
+
+proptest::proptest! {
+    #[test]
+    fn fft_autocovariances_match_the_direct_sum(
+        c in proptest::collection::vec(-1e3f64..1e3, 2..300),
+        lag_frac in 0.0f64..1.0,
+    ) {
+        let mean = c.iter().sum::<f64>() / c.len() as f64;
+        let mut planner = rustfft::FftPlanner::new();
+        let fast = super::ess::autocovariances(&c, mean, &mut planner);
+        let t = ((c.len() - 1) as f64 * lag_frac) as usize;
+        let direct = super::ess::autocov(&c, mean, t);
+        proptest::prop_assert!((fast[t] - direct).abs() <= 1e-10 * fast[0].max(1e-12));
+    }
+}
+
+#[test]
+fn diagnostics_of_equal_the_three_functions_apart() {
+    let c = ar1(
+        4,
+        999,
+        0.7,
+        11,
+        &[0.0, 0.1, 0.0, -0.1],
+        &[1.0, 1.0, 1.2, 1.0],
+    );
+    let d = Diagnostics::of(&c);
+    assert_eq!(d.rhat, rank_rhat(&c));
+    assert_eq!(d.ess_bulk, ess_bulk(&c));
+    assert_eq!(d.ess_tail, ess_tail(&c));
+}

@@ -87,8 +87,8 @@ impl CvModel for CorrectedModel<'_> {
 
     fn curve(&self, x: &[f64], c_pf: &mut [f64]) -> Result<()> {
         self.base.curve(x, c_pf)?;
-        let p = self.gp.predict(x, false);
-        for (c, m) in c_pf.iter_mut().zip(&p.mean) {
+        let mean = self.gp.mean(x);
+        for (c, m) in c_pf.iter_mut().zip(&mean) {
             *c *= m.exp();
         }
         Ok(())
@@ -102,10 +102,9 @@ impl CvModel for CorrectedModel<'_> {
     fn curve_jacobian(&self, x: &[f64], c_pf: &mut [f64], jac: &mut [f64]) -> Result<()> {
         self.base.curve_jacobian(x, c_pf, jac)?;
         let nx = x.len();
-        let p = self.gp.predict(x, true);
-        let dm = p.d_mean.as_deref().unwrap_or_default();
+        let (mean, dm) = self.gp.mean_gradient(x);
         for (k, c) in c_pf.iter_mut().enumerate() {
-            let e = p.mean[k].exp();
+            let e = mean[k].exp();
             *c *= e;
             for j in 0..nx {
                 jac[k * nx + j] = e * jac[k * nx + j] + *c * dm[k * nx + j];

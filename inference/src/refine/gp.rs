@@ -276,6 +276,46 @@ impl GpCorrection {
     /// The prediction at `x` (see the module text); with `gradients`, also d mean / dx and
     /// d var / dx.
     pub fn predict(&self, x: &[f64], gradients: bool) -> GpPrediction {
+        self.parts(
+            x,
+            Want {
+                mean: true,
+                var: true,
+                gradients,
+            },
+        )
+    }
+
+    /// mean_o(x) alone: k_* and one product with alpha, without the triangular solve of the
+    /// variance (what a corrected curve needs; `predict(x, false).mean`, the same numbers).
+    pub fn mean(&self, x: &[f64]) -> Vec<f64> {
+        self.parts(
+            x,
+            Want {
+                mean: true,
+                var: false,
+                gradients: false,
+            },
+        )
+        .mean
+    }
+
+    /// mean_o(x) and d mean_o / dx_j (row-major m x d) alone, without the variance's solves
+    /// (what a corrected curve's Jacobian needs).
+    pub fn mean_gradient(&self, x: &[f64]) -> (Vec<f64>, Vec<f64>) {
+        let p = self.parts(
+            x,
+            Want {
+                mean: true,
+                var: false,
+                gradients: true,
+            },
+        );
+        (p.mean, p.d_mean.unwrap_or_default())
+    }
+
+    /// The parts of the prediction `want` asks for; the others are left empty (None).
+    fn parts(&self, x: &[f64], want: Want) -> GpPrediction {
         let d = self.centre.len();
         let m = self.scale.len();
         let n = self.n;
@@ -292,49 +332,74 @@ impl GpCorrection {
             se_part[i] = s;
             ks[i] = s + 1.0 + u.iter().zip(ui).map(|(a, b)| a * b).sum::<f64>();
         }
-        let mut mean = vec![0.0; m];
-        for (k, row) in ks.iter().zip(self.alpha.chunks_exact(m)) {
-            for (mo, a) in mean.iter_mut().zip(row) {
-                *mo += k * a;
+        let mut mean = Vec::new();
+        if want.mean {
+            mean = vec![0.0; m];
+            for (k, row) in ks.iter().zip(self.alpha.chunks_exact(m)) {
+                for (mo, a) in mean.iter_mut().zip(row) {
+                    *mo += k * a;
+                }
+            }
+            for (mo, s) in mean.iter_mut().zip(&self.scale) {
+                *mo *= s;
             }
         }
         // Latent variance k(u, u) - |L^-1 k_*|^2 (R&W algorithm 2.1); v = K^-1 k_* for its
         // gradient.
-        let lk = self.chol.solve_lower(&ks);
-        let kuu = h.sf * h.sf + 1.0 + u.iter().map(|a| a * a).sum::<f64>();
-        let var0 = (kuu - lk.iter().map(|a| a * a).sum::<f64>()).max(0.0);
-        let v = if gradients {
+        let mut var0 = 0.0;
+        let mut var = Vec::new();
+        if want.var {
+            let lk = self.chol.solve_lower(&ks);
+            let kuu = h.sf * h.sf + 1.0 + u.iter().map(|a| a * a).sum::<f64>();
+            var0 = (kuu - lk.iter().map(|a| a * a).sum::<f64>()).max(0.0);
+            var = self.scale.iter().map(|s| s * s * var0).collect();
+        }
+        if !want.gradients {
+            return GpPrediction {
+                mean,
+                var,
+                d_mean: None,
+                d_var: None,
+            };
+        }
+        let v = if want.var {
             self.chol.solve(&ks)
         } else {
             Vec::new()
         };
-        let var: Vec<f64> = self.scale.iter().map(|s| s * s * var0).collect();
-        for (o, mo) in mean.iter_mut().enumerate() {
-            *mo *= self.scale[o];
-        }
-        let (d_mean, d_var) = if gradients {
-            // dk_i/du_j = -se_i (u_j - U_ij) / l_j^2 + U_ij.
-            let mut dmu = vec![0.0; m * d];
-            let mut dv0 = vec![0.0; d];
-            for i in 0..n {
-                let ui = &self.u[i * d..(i + 1) * d];
-                for j in 0..d {
-                    let dk = -se_part[i] * (u[j] - ui[j]) / (h.lengths[j] * h.lengths[j]) + ui[j];
-                    for o in 0..m {
-                        dmu[o * d + j] += dk * self.alpha[i * m + o];
+        // dk_i/du_j = -se_i (u_j - U_ij) / l_j^2 + U_ij. d mean is accumulated input-major
+        // (d x m), so that the inner loop runs along alpha's rows.
+        let mut dmu_t = vec![0.0; d * m];
+        let mut dv0 = vec![0.0; d];
+        for i in 0..n {
+            let ui = &self.u[i * d..(i + 1) * d];
+            let alpha_i = &self.alpha[i * m..(i + 1) * m];
+            for j in 0..d {
+                let dk = -se_part[i] * (u[j] - ui[j]) / (h.lengths[j] * h.lengths[j]) + ui[j];
+                if want.mean {
+                    for (acc, a) in dmu_t[j * m..(j + 1) * m].iter_mut().zip(alpha_i) {
+                        *acc += dk * a;
                     }
+                }
+                if want.var {
                     dv0[j] -= 2.0 * dk * v[i];
                 }
             }
+        }
+        let d_mean = want.mean.then(|| {
+            let mut dmu = vec![0.0; m * d];
+            for o in 0..m {
+                for j in 0..d {
+                    dmu[o * d + j] = dmu_t[j * m + o] * (self.scale[o] / self.spread[j]);
+                }
+            }
+            dmu
+        });
+        let d_var = want.var.then(|| {
             for j in 0..d {
                 dv0[j] += 2.0 * u[j];
                 if var0 <= 0.0 {
                     dv0[j] = 0.0;
-                }
-            }
-            for o in 0..m {
-                for j in 0..d {
-                    dmu[o * d + j] *= self.scale[o] / self.spread[j];
                 }
             }
             let mut dvar = vec![0.0; m * d];
@@ -343,10 +408,8 @@ impl GpCorrection {
                     dvar[o * d + j] = self.scale[o] * self.scale[o] * dv0[j] / self.spread[j];
                 }
             }
-            (Some(dmu), Some(dvar))
-        } else {
-            (None, None)
-        };
+            dvar
+        });
         GpPrediction {
             mean,
             var,
@@ -354,6 +417,14 @@ impl GpCorrection {
             d_var,
         }
     }
+}
+
+/// The parts of a prediction to compute.
+#[derive(Debug, Clone, Copy)]
+struct Want {
+    mean: bool,
+    var: bool,
+    gradients: bool,
 }
 
 #[cfg(test)]
@@ -435,6 +506,20 @@ mod tests {
                     dv[o * 2 + j]
                 );
             }
+        }
+    }
+
+    #[test]
+    fn the_mean_only_paths_give_predicts_numbers() {
+        let xs = grid_points(30);
+        let r: Vec<Vec<f64>> = xs.iter().map(|x| truth(x)).collect();
+        let gp = GpCorrection::fit(&xs, &r, None, 300).unwrap();
+        for x in [[0.31, -0.42], [2.0, 3.0], [-0.9, 0.05]] {
+            let full = gp.predict(&x, true);
+            assert_eq!(gp.mean(&x), full.mean);
+            let (mean, d_mean) = gp.mean_gradient(&x);
+            assert_eq!(mean, full.mean);
+            assert_eq!(Some(d_mean), full.d_mean);
         }
     }
 
