@@ -58,7 +58,13 @@ pub fn bench(c: &mut Criterion) {
     let volts: Vec<f64> = (0..60).map(|k| 25.0 + 50.0 * k as f64).collect();
     let p = [2.6, 0.5, 0.5, 0.1, -0.2, 0.5, 0.45, 0.0, 0.1];
     let mut group = c.benchmark_group("surrogate");
-    for recipe in ["paper", "split", "split-ensemble", "split-steps"] {
+    for recipe in [
+        "paper",
+        "split",
+        "split-ensemble",
+        "split-steps",
+        "split-steps-ensemble",
+    ] {
         let m = model(recipe);
         let u = m.voltages(&volts).expect("in range");
         let mut out = vec![0.0; 60];

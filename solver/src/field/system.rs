@@ -194,9 +194,10 @@ impl System {
         y
     }
 
-    /// The symbolic Cholesky analysis of the pattern (reusable for any values).
+    /// The symbolic Cholesky analysis of the pattern (reusable for any values), from the cache
+    /// of recent patterns where this one was analysed before ([`Symbolic::cached`]).
     pub fn symbolic(&self) -> Result<Symbolic> {
-        Symbolic::new(self.n, &self.col_ptr, &self.row_idx, Some(&self.order()))
+        Symbolic::cached(self.n, &self.col_ptr, &self.row_idx, &self.order())
     }
 
     /// Numeric Cholesky factorisation with values `val`.
