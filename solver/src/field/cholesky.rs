@@ -102,11 +102,28 @@ struct Cached {
 }
 
 /// Analyses found in the cache and analyses made, since the process started (tests).
+#[cfg(test)]
 static CACHE_COUNTS: Mutex<(u64, u64)> = Mutex::new((0, 0));
 
 /// (analyses taken from the cache, analyses made) so far in this process.
+#[cfg(test)]
 pub(crate) fn symbolic_cache_counts() -> (u64, u64) {
     *CACHE_COUNTS.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Counts a hit or a miss of the cache (tests only).
+fn count(hit: bool) {
+    #[cfg(test)]
+    {
+        let mut c = CACHE_COUNTS.lock().unwrap_or_else(|e| e.into_inner());
+        if hit {
+            c.0 += 1;
+        } else {
+            c.1 += 1;
+        }
+    }
+    #[cfg(not(test))]
+    let _ = hit;
 }
 
 impl Symbolic {
@@ -124,12 +141,12 @@ impl Symbolic {
                 let hit = cache.remove(k);
                 let inner = hit.inner.clone();
                 cache.insert(0, hit);
-                CACHE_COUNTS.lock().unwrap_or_else(|e| e.into_inner()).0 += 1;
+                count(true);
                 return Ok(Self { inner });
             }
         }
         let s = Self::new(n, col_ptr, row_idx, Some(order))?;
-        CACHE_COUNTS.lock().unwrap_or_else(|e| e.into_inner()).1 += 1;
+        count(false);
         if fits {
             let mut cache = CACHE.lock().unwrap_or_else(|e| e.into_inner());
             cache.insert(
