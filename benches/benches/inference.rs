@@ -1,5 +1,5 @@
 //! The fit's inner loop and a whole fit on the shipped data with the shipped surrogate
-//! (models/super-siegfried-rz-split.safetensors): one posterior evaluation of the B_RZ model
+//! (`hpge_inference::fit::DEFAULT_MODEL`): one posterior evaluation of the B_RZ model
 //! (9 parameters, 60 voltages) without and with the gradient, the paper's likelihood and the
 //! measured-covariance one, and the whole B_Z fit with each sampler (4 chains, R-hat <= 1.01,
 //! ESS >= 1000). The B_RZ fit (about 30 s) is timed by `hpge-cv fit` (reports/inference.md).
@@ -28,8 +28,7 @@ fn setup(prior: &str, noise: NoiseKind) -> (SurrogateModel, Prior, Likelihood) {
     else {
         panic!("the shipped data are a curve")
     };
-    let s =
-        Surrogate::load(&repo_path("models/super-siegfried-rz-split.safetensors")).expect("model");
+    let s = Surrogate::load(&repo_path(hpge_inference::fit::DEFAULT_MODEL)).expect("model");
     let m = SurrogateModel::new(s, &data.voltage_v, "split").expect("voltages in range");
     let spec = PriorSpec::from_file(&repo_path(prior)).expect("prior");
     let p = Prior::bind(&spec, &m.inputs(), &m.domain()).expect("prior binds");

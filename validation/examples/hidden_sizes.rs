@@ -11,7 +11,7 @@ use hpge_validation::studies::hidden::hidden_curve;
 use hpge_validation::{hidden_effects, repo_path};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let surrogate = Surrogate::load(&repo_path("models/super-siegfried-rz-split.safetensors"))?;
+    let surrogate = Surrogate::load(&repo_path(hpge_inference::fit::DEFAULT_MODEL))?;
     let exact = ExactSolver::new(
         surrogate.info.space.clone(),
         &repo_path("detectors/super-siegfried-k1.toml"),

@@ -21,7 +21,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if args.len() < 3 {
         return Err("usage: identifiability EFFECT PARAMETER VALUE...".into());
     }
-    let surrogate = Surrogate::load(&repo_path("models/super-siegfried-rz-split.safetensors"))?;
+    let surrogate = Surrogate::load(&repo_path(hpge_inference::fit::DEFAULT_MODEL))?;
     let exact = ExactSolver::new(
         surrogate.info.space.clone(),
         &repo_path("detectors/super-siegfried-k1.toml"),

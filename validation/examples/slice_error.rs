@@ -19,7 +19,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let seed: u64 = args.get(1).map_or(Ok(0), |a| a.parse())?;
     let model_file = args
         .get(2)
-        .map_or("models/super-siegfried-rz-split.safetensors", |s| s);
+        .map_or(hpge_inference::fit::DEFAULT_MODEL, |s| s);
     let model = Surrogate::load(&repo_path(model_file))?;
     let space = ParameterSpace::from_file(&repo_path("spaces/super-siegfried-rz.toml"))?;
     let ex = ExactSolver::new(

@@ -41,7 +41,7 @@ impl Progress for Quiet {
 
 #[test]
 fn discovery_names_each_hidden_effect_and_none_in_the_null_case() {
-    let surrogate = Surrogate::load(&repo_path("models/super-siegfried-rz-split.safetensors"))
+    let surrogate = Surrogate::load(&repo_path(hpge_inference::fit::DEFAULT_MODEL))
         .expect("the shipped surrogate");
     let exact = ExactSolver::new(
         surrogate.info.space.clone(),

@@ -43,7 +43,7 @@ impl Default for Inputs {
             space: "spaces/super-siegfried-rz.toml".into(),
             heldout: "data/training/heldout.csv".into(),
             paper_model: "models/super-siegfried-rz-paper.safetensors".into(),
-            fit_model: "models/super-siegfried-rz-split.safetensors".into(),
+            fit_model: hpge_inference::fit::DEFAULT_MODEL.into(),
             prior_bz: "priors/b-z.toml".into(),
             prior_brz: "priors/b-rz.toml".into(),
             exact_bz: "reports/discovery/super-siegfried/discovery.json".into(),

@@ -60,7 +60,7 @@ impl Default for Section9Inputs {
         };
         Self {
             detector: "detectors/super-siegfried-k1.toml".into(),
-            surrogate: "models/super-siegfried-rz-split.safetensors".into(),
+            surrogate: hpge_inference::fit::DEFAULT_MODEL.into(),
             fits: vec![
                 fit("b-z", "zeta_BZ (global mode of B_Z)"),
                 fit("b-rz", "zeta_BRZ (global mode of B_RZ)"),
