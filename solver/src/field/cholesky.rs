@@ -101,6 +101,13 @@ struct Cached {
     inner: Arc<SymbolicCholesky<usize>>,
 }
 
+impl Cached {
+    /// Whether this entry is the analysis of `col_ptr`, `row_idx` in `order`.
+    fn is(&self, col_ptr: &[usize], row_idx: &[usize], order: &[usize]) -> bool {
+        self.col_ptr == col_ptr && self.row_idx == row_idx && self.order == order
+    }
+}
+
 /// Analyses found in the cache and analyses made, since the process started (tests).
 #[cfg(test)]
 static CACHE_COUNTS: Mutex<(u64, u64)> = Mutex::new((0, 0));
@@ -134,10 +141,7 @@ impl Symbolic {
         let fits = row_idx.len() <= CACHE_MAX_NNZ && col_ptr.len() == n + 1;
         if fits {
             let mut cache = CACHE.lock().unwrap_or_else(|e| e.into_inner());
-            if let Some(k) = cache
-                .iter()
-                .position(|c| c.col_ptr == col_ptr && c.row_idx == row_idx && c.order == order)
-            {
+            if let Some(k) = cache.iter().position(|c| c.is(col_ptr, row_idx, order)) {
                 let hit = cache.remove(k);
                 let inner = hit.inner.clone();
                 cache.insert(0, hit);
@@ -149,6 +153,11 @@ impl Symbolic {
         count(false);
         if fits {
             let mut cache = CACHE.lock().unwrap_or_else(|e| e.into_inner());
+            // Two threads that start on one pattern together (a curve's voltage chunks) both
+            // analyse it; the second keeps its analysis but does not take a second slot.
+            if cache.iter().any(|c| c.is(col_ptr, row_idx, order)) {
+                return Ok(s);
+            }
             cache.insert(
                 0,
                 Cached {
