@@ -4,6 +4,9 @@
 #   EPOCHS_SCALE=F LOSS_H=H bash models/train.sh ...   the recipe trained F times as long and/or
 #     with the robust loss's scale h = H (train --epochs-scale/--loss-h); the files get the
 #     suffix -eF and/or -hH, so a variant never replaces the shipped model.
+#   TRUNK=W,W,W HEAD=W MEMBERS=N WEIGHT_DECAY=WD bash models/train.sh ...   other layer widths,
+#     ensemble size or AdamW's weight decay (train --trunk/--head/--members/--weight-decay);
+#     suffixes -tW-W-W, -hdW, -mN, -wdWD.
 # Needs data/training/{train,test}.csv (bash data/training/make.sh, ~40 min) and the committed
 # data/training/{heldout,calibration}.csv. Writes models/super-siegfried-rz-RECIPE.safetensors, its learning
 # curves (.curves.csv), the held-out figures (.heldout.json) and models/figures/RECIPE/.
@@ -15,6 +18,10 @@ NAME=models/super-siegfried-rz-$RECIPE
 VARIANT=()
 if [ -n "${EPOCHS_SCALE:-}" ]; then NAME=$NAME-e$EPOCHS_SCALE; VARIANT+=(--epochs-scale "$EPOCHS_SCALE"); fi
 if [ -n "${LOSS_H:-}" ]; then NAME=$NAME-h$LOSS_H; VARIANT+=(--loss-h "$LOSS_H"); fi
+if [ -n "${TRUNK:-}" ]; then NAME=$NAME-t${TRUNK//,/-}; VARIANT+=(--trunk "$TRUNK"); fi
+if [ -n "${HEAD:-}" ]; then NAME=$NAME-hd${HEAD//,/-}; VARIANT+=(--head "$HEAD"); fi
+if [ -n "${MEMBERS:-}" ]; then NAME=$NAME-m$MEMBERS; VARIANT+=(--members "$MEMBERS"); fi
+if [ -n "${WEIGHT_DECAY:-}" ]; then NAME=$NAME-wd$WEIGHT_DECAY; VARIANT+=(--weight-decay "$WEIGHT_DECAY"); fi
 FIGS=models/figures/${NAME#models/super-siegfried-rz-}
 if [ ! -f data/training/train.csv ] || [ ! -f data/training/test.csv ]; then
   bash data/training/make.sh

@@ -14,10 +14,15 @@ use hpge_surrogate::model::{
 use hpge_surrogate::{Figures, ModelInfo, ParameterSpace, Predictor, Recipe, Surrogate};
 use hpge_validation::repo_path;
 
-fn model(recipe: &str) -> Surrogate {
+/// A freshly initialised model of a recipe, its trunk and head widths replaced where given
+/// (`train --trunk/--head`).
+fn model(recipe: &str, widths: Option<(Vec<usize>, Vec<usize>)>) -> Surrogate {
     let space = ParameterSpace::from_file(&repo_path("spaces/super-siegfried-rz.toml"))
         .expect("shipped space loads");
-    let recipe = Recipe::named(recipe).expect("known recipe");
+    let (trunk, head) = widths.unzip();
+    let recipe = Recipe::named(recipe)
+        .and_then(|r| r.reshaped(trunk, head, None))
+        .expect("known recipe");
     let order = network_order(&space).expect("one bias dimension");
     let bias = BiasMap::of(&space.dimensions[order[9]]).expect("positive bias range");
     let nets = (0..recipe.members)
@@ -58,14 +63,25 @@ pub fn bench(c: &mut Criterion) {
     let volts: Vec<f64> = (0..60).map(|k| 25.0 + 50.0 * k as f64).collect();
     let p = [2.6, 0.5, 0.5, 0.1, -0.2, 0.5, 0.45, 0.0, 0.1];
     let mut group = c.benchmark_group("surrogate");
-    for recipe in [
-        "paper",
-        "split",
-        "split-ensemble",
-        "split-steps",
-        "split-steps-ensemble",
+    // The recipes as named, then the steps network with a wider trunk and head (the widths
+    // compared for the retraining, reports/surrogate.md).
+    let wide = |t: usize, h: usize| Some((vec![t; 3], vec![h]));
+    for (label, recipe, widths) in [
+        ("paper", "paper", None),
+        ("split", "split", None),
+        ("split-ensemble", "split-ensemble", None),
+        ("split-steps", "split-steps", None),
+        ("split-steps-ensemble", "split-steps-ensemble", None),
+        ("split-steps-t256-hd128", "split-steps", wide(256, 128)),
+        ("split-steps-t512-hd256", "split-steps", wide(512, 256)),
+        (
+            "split-steps-ensemble-t256-hd128",
+            "split-steps-ensemble",
+            wide(256, 128),
+        ),
     ] {
-        let m = model(recipe);
+        let m = model(recipe, widths);
+        let recipe = label;
         let u = m.voltages(&volts).expect("in range");
         let mut out = vec![0.0; 60];
         let mut jac = vec![0.0; 60 * 9];

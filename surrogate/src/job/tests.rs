@@ -76,6 +76,10 @@ fn job(dir: &Path, recipe: &str, seed: u64) -> TrainJob {
         out: dir.join(format!("{recipe}.safetensors")),
         epochs_scale: DEFAULT_EPOCHS_SCALE,
         loss_h: None,
+        trunk: None,
+        head: None,
+        members: None,
+        weight_decay: None,
     }
 }
 
@@ -226,6 +230,90 @@ fn a_tiny_network_trains_writes_its_files_and_resumes_from_a_checkpoint() {
     let recipe = Surrogate::load(&longer.out).unwrap().info.recipe.unwrap();
     let epochs: Vec<usize> = recipe.cycles.iter().map(|c| c.epochs).collect();
     assert_eq!(epochs, [8, 16]);
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// `--trunk`, `--head` and `--members` reshape the recipe: the model file records (and loads
+/// with) the widths and members as trained; a zero width or no members is refused by name.
+#[test]
+fn the_recipes_widths_and_members_can_be_replaced() {
+    let d = temp("reshape");
+    let job = TrainJob {
+        trunk: Some(vec![8, 8]),
+        head: Some(vec![4]),
+        members: Some(2),
+        ..job(&d, "tiny", 3)
+    };
+    let (outcome, log) = run_logged(&job);
+    outcome.unwrap();
+    assert_eq!(log[1], "start 24 0 0 2", "two members of 12 epochs");
+    let model = Surrogate::load(&job.out).unwrap();
+    let recipe = model.info.recipe.clone().unwrap();
+    assert_eq!(recipe.architecture.trunk, [8, 8]);
+    assert_eq!(recipe.architecture.head, [4]);
+    assert_eq!(recipe.members, 2);
+    let crate::model::Predictor::Networks(nets) = &model.predictor else {
+        panic!("networks")
+    };
+    assert_eq!(nets.len(), 2);
+    for (bad, name) in [
+        (
+            TrainJob {
+                members: Some(0),
+                ..job.clone()
+            },
+            "--members",
+        ),
+        (
+            TrainJob {
+                head: Some(vec![4, 0]),
+                ..job.clone()
+            },
+            "recipe",
+        ),
+        (
+            TrainJob {
+                weight_decay: Some(-0.1),
+                ..job.clone()
+            },
+            "--weight-decay",
+        ),
+    ] {
+        let e = bad.recipe().unwrap_err();
+        assert!(
+            matches!(&e, Error::Argument { name: n, .. } if n == name),
+            "{e:?}"
+        );
+    }
+    let e = TrainJob {
+        recipe: POLYNOMIAL_RECIPE.into(),
+        ..job.clone()
+    }
+    .recipe()
+    .unwrap_err();
+    assert!(e.to_string().contains("--members"), "{e}");
+
+    // Weight decay is recorded in the model file and changes the weights it trains.
+    let decayed = TrainJob {
+        weight_decay: Some(0.5),
+        members: Some(1),
+        out: d.join("decayed.safetensors"),
+        ..job.clone()
+    };
+    let plain = TrainJob {
+        members: Some(1),
+        out: d.join("plain.safetensors"),
+        ..job.clone()
+    };
+    decayed.run(&mut |_| {}).unwrap();
+    plain.run(&mut |_| {}).unwrap();
+    let (a, b) = (
+        Surrogate::load(&decayed.out).unwrap(),
+        Surrogate::load(&plain.out).unwrap(),
+    );
+    assert_eq!(a.info.recipe.as_ref().unwrap().weight_decay, 0.5);
+    assert_eq!(b.info.recipe.as_ref().unwrap().weight_decay, 0.0);
+    assert_ne!(a.predictor, b.predictor);
     let _ = std::fs::remove_dir_all(&d);
 }
 
@@ -522,6 +610,10 @@ fn the_polynomial_needs_as_many_rows_as_coefficients() {
         out: d.join("poly3.safetensors"),
         epochs_scale: DEFAULT_EPOCHS_SCALE,
         loss_h: None,
+        trunk: None,
+        head: None,
+        members: None,
+        weight_decay: None,
     };
     let e = job.run(&mut |_| {}).unwrap_err().to_string();
     assert!(

@@ -77,6 +77,29 @@ pub struct TrainJob {
     /// sqrt(h) and logarithmic beyond.
     #[cfg_attr(feature = "clap", arg(long, value_name = "H"))]
     pub loss_h: Option<f64>,
+    /// Replaces the widths of the recipe's trunk (the layers on the model parameters p alone),
+    /// e.g. `256,256,256`; the model file records the recipe as trained.
+    #[cfg_attr(
+        feature = "clap",
+        arg(long, value_name = "W,W,...", value_delimiter = ',')
+    )]
+    pub trunk: Option<Vec<usize>>,
+    /// Replaces the widths of the recipe's head (the layers after the trunk: on [h(p), z_U], or
+    /// on h(p) before a steps output), e.g. `128`.
+    #[cfg_attr(
+        feature = "clap",
+        arg(long, value_name = "W,W,...", value_delimiter = ',')
+    )]
+    pub head: Option<Vec<usize>>,
+    /// Replaces the recipe's number of independently seeded ensemble members (member m uses
+    /// seed + m); 1 trains a single network.
+    #[cfg_attr(feature = "clap", arg(long, value_name = "N"))]
+    pub members: Option<usize>,
+    /// Decoupled weight decay (AdamW) per unit learning rate, in every cycle: each step also
+    /// takes lr x WD x w off every weight (a regulariser where the rows, not the steps, limit
+    /// the network); the shipped recipes use 0.
+    #[cfg_attr(feature = "clap", arg(long, value_name = "WD"))]
+    pub weight_decay: Option<f64>,
 }
 
 /// What a training run reports while it works, in this order.
@@ -192,14 +215,21 @@ impl TrainJob {
         Ok(())
     }
 
-    /// The recipe as this run trains it (`--epochs-scale` and `--loss-h` applied); `None` for
-    /// the polynomial, which takes neither.
+    /// The recipe as this run trains it (`--epochs-scale`, `--loss-h`, `--trunk`, `--head`,
+    /// `--members` and `--weight-decay` applied); `None` for the polynomial, which takes none of them.
     pub fn recipe(&self) -> Result<Option<Recipe>> {
         if self.recipe == POLYNOMIAL_RECIPE {
-            let adjusted = self.epochs_scale != DEFAULT_EPOCHS_SCALE || self.loss_h.is_some();
+            let adjusted = self.epochs_scale != DEFAULT_EPOCHS_SCALE
+                || self.loss_h.is_some()
+                || self.trunk.is_some()
+                || self.head.is_some()
+                || self.members.is_some()
+                || self.weight_decay.is_some();
             if adjusted {
                 return Err(Error::Argument {
-                    name: "--epochs-scale / --loss-h".into(),
+                    name:
+                        "--epochs-scale / --loss-h / --trunk / --head / --members / --weight-decay"
+                            .into(),
                     message: format!(
                         "the recipe {POLYNOMIAL_RECIPE} is a least-squares fit without epochs or loss scale"
                     ),
@@ -208,7 +238,9 @@ impl TrainJob {
             return Ok(None);
         }
         Recipe::named(&self.recipe)?
-            .adjusted(self.epochs_scale, self.loss_h)
+            .adjusted(self.epochs_scale, self.loss_h)?
+            .reshaped(self.trunk.clone(), self.head.clone(), self.members)?
+            .with_weight_decay(self.weight_decay)
             .map(Some)
     }
 

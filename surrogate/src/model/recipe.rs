@@ -101,6 +101,16 @@ pub struct Recipe {
     /// Ensemble members (independently initialised and shuffled networks); the prediction is their
     /// mean and their spread estimates the error of each prediction.
     pub members: usize,
+    /// Decoupled weight decay of every Adam step (AdamW, Loshchilov and Hutter 2019: each
+    /// weight and bias w <- w - lr x weight_decay x w beside the Adam update); 0 (the shipped
+    /// recipes, and model files written before it existed) is plain Adam.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub weight_decay: f64,
+}
+
+/// Serde: a zero weight decay is left out of the model file (files stay as they were).
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
 }
 
 /// The recipe names `train --recipe` accepts.
@@ -203,6 +213,7 @@ impl Recipe {
                 loss: Loss::PaperRobust { h: 4.0 },
                 cycles: paper_cycles,
                 members: 1,
+                weight_decay: 0.0,
             },
             // The paper's network and schedule, learning ln c12 with the relative error as loss.
             "paper-log" => Recipe {
@@ -212,6 +223,7 @@ impl Recipe {
                 loss: Loss::RelativeRobust { h: 4.0 },
                 cycles: paper_cycles.clone(),
                 members: 1,
+                weight_decay: 0.0,
             },
             // p through a trunk once per curve, the bias joining late: a whole curve costs one
             // trunk pass and 60 small head passes (the microsecond path), cosine-decayed Adam.
@@ -222,6 +234,7 @@ impl Recipe {
                 loss: Loss::RelativeRobust { h: 4.0 },
                 cycles: split_cycles,
                 members: 1,
+                weight_decay: 0.0,
             },
             // Three independently seeded paper-log networks: the mean predicts, the spread
             // estimates each prediction's error.
@@ -232,6 +245,7 @@ impl Recipe {
                 loss: Loss::RelativeRobust { h: 4.0 },
                 cycles: paper_cycles.clone(),
                 members: 3,
+                weight_decay: 0.0,
             },
             // A wider head after the bias joins, with the paper's three cycles.
             "split-wide" => Recipe {
@@ -245,6 +259,7 @@ impl Recipe {
                 loss: Loss::RelativeRobust { h: 4.0 },
                 cycles: paper_cycles.clone(),
                 members: 1,
+                weight_decay: 0.0,
             },
             "split-ensemble" => Recipe {
                 name: name.into(),
@@ -253,6 +268,7 @@ impl Recipe {
                 loss: Loss::RelativeRobust { h: 4.0 },
                 cycles: split_cycles,
                 members: 4,
+                weight_decay: 0.0,
             },
             // The split trunk, then a head on p alone whose outputs place 16 monotone steps in
             // ln U_B (super::StepsHead): pinch-offs are steps at smooth places v_k(p).
@@ -263,6 +279,7 @@ impl Recipe {
                 loss: Loss::RelativeRobust { h: 4.0 },
                 cycles: split_cycles,
                 members: 1,
+                weight_decay: 0.0,
             },
             // Four independently seeded split-steps networks: the mean predicts (sigma 0.82x
             // one network's in the prototype), the spread estimates each prediction's error.
@@ -273,6 +290,7 @@ impl Recipe {
                 loss: Loss::RelativeRobust { h: 4.0 },
                 cycles: split_cycles,
                 members: 4,
+                weight_decay: 0.0,
             },
             // The steps head at test size.
             "tiny-steps" => Recipe {
@@ -282,6 +300,7 @@ impl Recipe {
                 loss: Loss::RelativeSquared,
                 cycles: tiny_cycles,
                 members: 1,
+                weight_decay: 0.0,
             },
             // For tests and smoke runs: a small network, a few epochs.
             "tiny" => Recipe {
@@ -291,6 +310,7 @@ impl Recipe {
                 loss: Loss::RelativeSquared,
                 cycles: tiny_cycles,
                 members: 1,
+                weight_decay: 0.0,
             },
             _ => {
                 return Err(Error::Argument {
@@ -385,6 +405,51 @@ impl Recipe {
             }
         }
         self.validate()?;
+        Ok(self)
+    }
+
+    /// This recipe with other layer widths or another ensemble size: `trunk` and `head`, when
+    /// given, replace the architecture's widths (an empty trunk is allowed, as `paper` has;
+    /// the head must keep at least one layer), `members` the number of independently seeded
+    /// networks. The steps output and the training schedule stay. The model file records the
+    /// recipe as trained; nothing given returns the recipe unchanged.
+    pub fn reshaped(
+        mut self,
+        trunk: Option<Vec<usize>>,
+        head: Option<Vec<usize>>,
+        members: Option<usize>,
+    ) -> Result<Self> {
+        if let Some(t) = trunk {
+            self.architecture.trunk = t;
+        }
+        if let Some(h) = head {
+            self.architecture.head = h;
+        }
+        if let Some(m) = members {
+            if m == 0 {
+                return Err(Error::Argument {
+                    name: "--members".into(),
+                    message: "0 networks: an ensemble needs at least one member".into(),
+                });
+            }
+            self.members = m;
+        }
+        self.validate()?;
+        Ok(self)
+    }
+
+    /// This recipe with decoupled weight decay (AdamW) of `weight_decay` per unit learning rate
+    /// in every cycle; `None` returns it unchanged.
+    pub fn with_weight_decay(mut self, weight_decay: Option<f64>) -> Result<Self> {
+        if let Some(wd) = weight_decay {
+            if !(wd.is_finite() && wd >= 0.0) {
+                return Err(Error::Argument {
+                    name: "--weight-decay".into(),
+                    message: format!("{wd} is not a non-negative number"),
+                });
+            }
+            self.weight_decay = wd;
+        }
         Ok(self)
     }
 

@@ -384,7 +384,7 @@ pub fn train_resuming(
         for (c, cycle) in recipe.cycles.iter().enumerate() {
             let params = ParamsAdamW {
                 lr: cycle.lr,
-                weight_decay: 0.0,
+                weight_decay: recipe.weight_decay,
                 ..Default::default()
             };
             let mut opt = AdamW::new(net.vars(), params).map_err(candle_err)?;
