@@ -81,17 +81,16 @@ pub fn bench(c: &mut Criterion) {
         ),
     ] {
         let m = model(recipe, widths);
-        let recipe = label;
         let u = m.voltages(&volts).expect("in range");
         let mut out = vec![0.0; 60];
         let mut jac = vec![0.0; 60 * 9];
-        group.bench_function(format!("curve_60/{recipe}"), |b| {
+        group.bench_function(format!("curve_60/{label}"), |b| {
             b.iter(|| {
                 m.curve_into(black_box(&p), &u, &mut out, None)
                     .expect("in range")
             })
         });
-        group.bench_function(format!("curve_60_jacobian/{recipe}"), |b| {
+        group.bench_function(format!("curve_60_jacobian/{label}"), |b| {
             b.iter(|| {
                 m.curve_jacobian_into(black_box(&p), &u, &mut out, &mut jac)
                     .expect("in range")

@@ -231,7 +231,7 @@ impl TrainJob {
                         "--epochs-scale / --loss-h / --trunk / --head / --members / --weight-decay"
                             .into(),
                     message: format!(
-                        "the recipe {POLYNOMIAL_RECIPE} is a least-squares fit without epochs or loss scale"
+                        "the recipe {POLYNOMIAL_RECIPE} is a least-squares fit without epochs, loss scale, layers or members"
                     ),
                 });
             }
