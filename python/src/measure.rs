@@ -47,20 +47,11 @@ pub(crate) fn measure<'py>(
     }
     d.set_item("depletion_voltage_V", m.depletion_voltage_v)?;
     let problems = PyList::empty(py);
-    let all = run
-        .problems
-        .iter()
-        .map(|p| (p.file.clone(), p.bias_v, p.message.clone()))
-        .chain(
-            m.problems
-                .iter()
-                .map(|p| (p.file.clone(), p.bias_v, p.message.clone())),
-        );
-    for (file, bias, message) in all {
+    for p in run.problems.iter().chain(&m.problems) {
         let q = PyDict::new(py);
-        q.set_item("file", file)?;
-        q.set_item("bias_V", bias)?;
-        q.set_item("message", message)?;
+        q.set_item("file", &p.file)?;
+        q.set_item("bias_V", p.bias_v)?;
+        q.set_item("message", &p.message)?;
         problems.append(q)?;
     }
     d.set_item("problems", problems)?;

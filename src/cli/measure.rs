@@ -131,13 +131,8 @@ fn report_json(
 ) -> serde_json::Value {
     let problems: Vec<serde_json::Value> = read_problems
         .iter()
-        .map(|p| (p.file.clone(), p.bias_v, p.message.clone()))
-        .chain(
-            m.problems
-                .iter()
-                .map(|p| (p.file.clone(), p.bias_v, p.message.clone())),
-        )
-        .map(|(f, v, msg)| json!({"file": f.display().to_string(), "voltage_V": v, "message": msg}))
+        .chain(&m.problems)
+        .map(|p| json!({"file": p.file.display().to_string(), "voltage_V": p.bias_v, "message": p.message}))
         .collect();
     json!({
         "raw": raw.display().to_string(),

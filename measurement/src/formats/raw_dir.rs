@@ -8,6 +8,7 @@ use super::lh5::read_lh5_pulses;
 use super::npy::read_pulses;
 use super::sidecar;
 use crate::error::{Error, Result};
+use crate::measure::Problem;
 use crate::types::PulseSet;
 
 /// The formats of a pulse file, by extension; each has the sidecar `<stem>.toml`.
@@ -65,17 +66,12 @@ pub struct RawRun {
     pub problems: Vec<RawProblem>,
 }
 
-/// A file of a raw-data directory that could not be used, or an expected bias without data.
-#[derive(Debug, Clone)]
-pub struct RawProblem {
-    /// The file at fault (the directory itself for an expected bias without a pulse file).
-    pub file: PathBuf,
-    /// The bias the problem concerns, V, when known (from the sidecar, read loosely, or from the
-    /// expected voltages).
-    pub bias_v: Option<f64>,
-    /// What is wrong (for a file that failed to read, the full error message).
-    pub message: String,
-}
+/// A file of a raw-data directory that could not be used, or an expected bias without data:
+/// the same record as a measurement's [`Problem`] (`file`: the file at fault, the directory
+/// itself for an expected bias without a pulse file; `bias_v`: from the sidecar, read loosely,
+/// or from the expected voltages; `message`: for a file that failed to read, the full error),
+/// so the two lists of a run chain into one.
+pub type RawProblem = Problem;
 
 /// Reads every pulse file of a directory (not recursive, in file-name order) with
 /// [`read_pulse_file`]: `.npy` and `.lh5` files (see [`PulseFormat`]). `dir` may also be one

@@ -17,6 +17,18 @@ struct Walk {
 }
 
 impl Walk {
+    /// The walk's start for a p+ contact of radius `rp` (mm) on the bottom face, recessed by
+    /// `dp` (mm; 0: flush): along the contact's face, then up the recess wall (passivated) to
+    /// the face z = 0.
+    fn p_plus_disc(rp: f64, dp: f64) -> Self {
+        let mut w = Self::start(0.0, dp);
+        w.to(rp, dp, Surface::PPlus);
+        if dp > 0.0 {
+            w.to(rp, 0.0, Surface::Passive);
+        }
+        w
+    }
+
     fn start(r: f64, z: f64) -> Self {
         Self {
             pts: vec![[r, z]],
@@ -70,27 +82,12 @@ pub(super) fn outline(rd: &Reader<'_>, g: &Value, kind: &str) -> Result<Outline>
     } else {
         let rp = rd.length(g, "pp_contact.radius_in_mm", true)?;
         let dp = rd.opt_length(g, "pp_contact.depth_in_mm")?;
-        if kind == "ppc" {
-            if dp > 0.0 {
-                w = Walk::start(0.0, dp);
-                w.to(rp, dp, PPlus);
-                w.to(rp, 0.0, Passive);
-            } else {
-                w = Walk::start(0.0, 0.0);
-                w.to(rp, 0.0, PPlus);
-            }
-        } else {
+        w = Walk::p_plus_disc(rp, dp);
+        if kind != "ppc" {
+            // The groove around the contact (bege, icpc).
             let ri = rd.length(g, "groove.radius_in_mm.inner", false)?;
             let ro = rd.length(g, "groove.radius_in_mm.outer", false)?;
             let dg = rd.length(g, "groove.depth_in_mm", false)?;
-            if dp > 0.0 {
-                w = Walk::start(0.0, dp);
-                w.to(rp, dp, PPlus);
-                w.to(rp, 0.0, Passive);
-            } else {
-                w = Walk::start(0.0, 0.0);
-                w.to(rp, 0.0, PPlus);
-            }
             w.to(ri, 0.0, Passive);
             w.to(ri, dg, Passive);
             w.to(ro, dg, Passive);
