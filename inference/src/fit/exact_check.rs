@@ -139,6 +139,14 @@ pub struct ExactCheck {
     /// Effective sample size of the smoothed weights, 1 / sum w^2.
     #[serde(deserialize_with = "super::round::f64_or_nan")]
     pub ess: f64,
+    /// Standard deviation of the draws' log importance ratios ln(p_exact / p_surrogate) (the
+    /// draws whose exact solve succeeded). k-hat is the shape of the ratios' tail whatever its
+    /// scale: beside a large k-hat, a spread of a few hundredths means near-equal weights.
+    #[serde(default = "nan", deserialize_with = "super::round::f64_or_nan")]
+    pub log_ratio_sd: f64,
+    /// max - min of those log ratios.
+    #[serde(default = "nan", deserialize_with = "super::round::f64_or_nan")]
+    pub log_ratio_range: f64,
     /// Per parameter.
     pub parameters: Vec<ParameterShift>,
     /// Largest |c_exact - c_surrogate| / c_exact over the voltages at the global mode.
@@ -325,6 +333,7 @@ pub fn exact_check(
         .map(|r| if r.0.is_finite() { r.0 } else { -1e300 })
         .collect();
     let p = psis(&log_ratios);
+    let (log_ratio_sd, log_ratio_range) = spread(draws.iter().map(|r| r.0));
     let names = prior.names();
     let mut parameters = Vec::new();
     for (j, name) in names.iter().enumerate() {
@@ -358,6 +367,8 @@ pub fn exact_check(
         failed,
         pareto_k: p.k_hat,
         ess: p.ess,
+        log_ratio_sd,
+        log_ratio_range,
         pass: p.k_hat <= K_HAT_LIMIT && max_abs_shift_sd <= SHIFT_LIMIT_SD,
         parameters,
         max_rel_diff_at_mode: max_rel,
@@ -436,4 +447,24 @@ pub fn add_grid_check(
 /// serde's `skip_serializing_if` for counters.
 fn is_zero(n: &usize) -> bool {
     *n == 0
+}
+
+/// NaN (the serde default of a figure an older file lacks).
+fn nan() -> f64 {
+    f64::NAN
+}
+
+/// Sample standard deviation and range (max - min) of the finite values of `v` (NaN for fewer
+/// than two).
+fn spread(v: impl Iterator<Item = f64>) -> (f64, f64) {
+    let x: Vec<f64> = v.filter(|x| x.is_finite()).collect();
+    if x.len() < 2 {
+        return (f64::NAN, f64::NAN);
+    }
+    let n = x.len() as f64;
+    let m = x.iter().sum::<f64>() / n;
+    let sd = (x.iter().map(|v| (v - m).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
+    let lo = x.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = x.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    (sd, hi - lo)
 }

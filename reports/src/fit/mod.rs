@@ -266,7 +266,7 @@ pub fn summary_text(fit: &Fit, out: &Path) -> String {
         let rounds = s.refinement.as_ref().map_or(1, Vec::len);
         let _ = writeln!(
             t,
-            "exact check{} ({} draws on {}, {:.1} s): Pareto k {:.2}, largest mean shift {:.2} sd, |c_exact - c_model|/c at the mode <= {:.2}%: {}",
+            "exact check{} ({} draws on {}, {:.1} s): Pareto k {:.2} (weights' ESS {:.0}, log ratios' sd {:.3}), largest mean shift {:.2} sd, |c_exact - c_model|/c at the mode <= {:.2}%: {}",
             if rounds > 1 {
                 format!(
                     " after {} rounds of refinement (the surrogate corrected by {} exact curves)",
@@ -283,6 +283,8 @@ pub fn summary_text(fit: &Fit, out: &Path) -> String {
             grids_text(c),
             c.seconds,
             c.pareto_k,
+            c.ess,
+            c.log_ratio_sd,
             c.max_abs_shift_sd,
             100.0 * c.max_rel_diff_at_mode,
             if c.pass { "pass" } else { "FAIL" }

@@ -207,7 +207,7 @@ pub fn write_report(
         let _ = writeln!(r, "## Exact-solver check\n");
         let _ = writeln!(
             r,
-            "{} posterior draws re-weighted with the exact field solver{}, solved on {} ({} failed solves) in {:.1} s: Pareto k-hat {:.2} ({}), weights' ESS {:.0}; |c_exact - c_model| / c_exact at the global mode up to {:.2}%; chi^2 of the exact curve at the mode {:.1}. **{}** (pass: k-hat <= {}, every shift <= {} sd, and no exact ascent from a local mode ends more than {} above the mode's exact ln p).\n",
+            "{} posterior draws re-weighted with the exact field solver{}, solved on {} ({} failed solves) in {:.1} s: Pareto k-hat {:.2} ({}), weights' ESS {:.0} (log ratios' sd {:.3}, range {:.3}); |c_exact - c_model| / c_exact at the global mode up to {:.2}%; chi^2 of the exact curve at the mode {:.1}. **{}** (pass: k-hat <= {}, every shift <= {} sd, and no exact ascent from a local mode ends more than {} above the mode's exact ln p).\n",
             c.draws,
             c.solver_tolerance
                 .map(|t| format!(" at a tolerance of {}% of c12", 100.0 * t))
@@ -224,6 +224,8 @@ pub fn write_report(
                 "the surrogate posterior is too far from the exact one for re-weighting"
             },
             c.ess,
+            c.log_ratio_sd,
+            c.log_ratio_range,
             100.0 * c.max_rel_diff_at_mode,
             c.chi2_exact_at_mode,
             if c.pass { "Pass" } else { "Fail" },
