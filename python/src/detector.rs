@@ -62,13 +62,7 @@ impl PyDetector {
         n_plus_thickness_mm: Option<f64>,
         can_gap_mm: Option<f64>,
     ) -> PyResult<Self> {
-        let (text, source) = crate::legend::record_text(py, record)?;
-        let toml = hpge_solver::detector::legend::convert_json(
-            &text,
-            &source,
-            &legend_options(n_plus_thickness_mm, can_gap_mm),
-        )
-        .map_err(err)?;
+        let (toml, source) = crate::legend::convert(py, record, n_plus_thickness_mm, can_gap_mm)?;
         let det = Detector::from_toml_str(&toml, &source, &Parameters::new()).map_err(err)?;
         Ok(Self { det })
     }
@@ -113,20 +107,6 @@ impl PyDetector {
             self.contacts()
         )
     }
-}
-
-pub(crate) fn legend_options(
-    n_plus_thickness_mm: Option<f64>,
-    can_gap_mm: Option<f64>,
-) -> hpge_solver::detector::legend::LegendOptions {
-    let mut o = hpge_solver::detector::legend::LegendOptions::default();
-    if let Some(t) = n_plus_thickness_mm {
-        o.n_plus_thickness_mm = t;
-    }
-    if let Some(g) = can_gap_mm {
-        o.can_gap_mm = g;
-    }
-    o
 }
 
 /// The solver settings the command line uses, with `--tolerance` and `--grid KEY=VALUE`.

@@ -3,10 +3,10 @@
 
 use std::path::PathBuf;
 
+use hpge_solver::detector::legend::LegendOptions;
 use numpy::PyArray1;
 use pyo3::prelude::*;
 
-use crate::detector::legend_options;
 use crate::{HpgeError, array, err};
 
 /// The record's JSON text and the path that names it in messages (the file, or `<dict>`).
@@ -34,6 +34,26 @@ pub fn record_text(py: Python<'_>, record: &Bound<'_, PyAny>) -> PyResult<(Strin
     Ok((text, PathBuf::from(format!("<dict {name}>"))))
 }
 
+/// The detector TOML text of a record (`hpge-cv detector --from-legend`'s conversion, the
+/// options not given at their defaults) and the path that names the record in messages.
+pub(crate) fn convert(
+    py: Python<'_>,
+    record: &Bound<'_, PyAny>,
+    n_plus_thickness_mm: Option<f64>,
+    can_gap_mm: Option<f64>,
+) -> PyResult<(String, PathBuf)> {
+    let (text, source) = record_text(py, record)?;
+    let mut o = LegendOptions::default();
+    if let Some(t) = n_plus_thickness_mm {
+        o.n_plus_thickness_mm = t;
+    }
+    if let Some(g) = can_gap_mm {
+        o.can_gap_mm = g;
+    }
+    let toml = hpge_solver::detector::legend::convert_json(&text, &source, &o).map_err(err)?;
+    Ok((toml, source))
+}
+
 /// The detector TOML text converted from a LEGEND diode record (a path to the JSON file, or the
 /// record as a dict), as `hpge-cv detector --from-legend DIODE.json --out D.toml` writes it.
 /// `n_plus_thickness_mm` (mm): the n+ dead layer where the record's `characterization` has none;
@@ -46,13 +66,7 @@ pub(crate) fn legend_to_toml(
     n_plus_thickness_mm: Option<f64>,
     can_gap_mm: Option<f64>,
 ) -> PyResult<String> {
-    let (text, source) = crate::legend::record_text(py, record)?;
-    hpge_solver::detector::legend::convert_json(
-        &text,
-        &source,
-        &legend_options(n_plus_thickness_mm, can_gap_mm),
-    )
-    .map_err(err)
+    Ok(convert(py, record, n_plus_thickness_mm, can_gap_mm)?.0)
 }
 
 /// r (mm), z (mm) and the surface of each segment.
@@ -71,12 +85,8 @@ pub(crate) fn legend_outline<'py>(
     record: &Bound<'py, PyAny>,
 ) -> PyResult<Outline<'py>> {
     let (text, source) = crate::legend::record_text(py, record)?;
-    let d = hpge_solver::detector::legend::read_json(
-        &text,
-        &source,
-        &hpge_solver::detector::legend::LegendOptions::default(),
-    )
-    .map_err(err)?;
+    let d = hpge_solver::detector::legend::read_json(&text, &source, &LegendOptions::default())
+        .map_err(err)?;
     let surfaces = d
         .surfaces
         .iter()

@@ -338,9 +338,7 @@ pub fn exact_check(
     let mut parameters = Vec::new();
     for (j, name) in names.iter().enumerate() {
         let vals: Vec<f64> = idx.iter().map(|&i| all[i][j]).collect();
-        let m = vals.iter().sum::<f64>() / vals.len() as f64;
-        let sd =
-            (vals.iter().map(|v| (v - m).powi(2)).sum::<f64>() / (vals.len() as f64 - 1.0)).sqrt();
+        let (m, sd) = mean_sd(&vals);
         let mw: f64 = vals.iter().zip(&p.weights).map(|(v, w)| v * w).sum();
         parameters.push(ParameterShift {
             name: name.clone(),
@@ -461,10 +459,16 @@ fn spread(v: impl Iterator<Item = f64>) -> (f64, f64) {
     if x.len() < 2 {
         return (f64::NAN, f64::NAN);
     }
-    let n = x.len() as f64;
-    let m = x.iter().sum::<f64>() / n;
-    let sd = (x.iter().map(|v| (v - m).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
+    let (_, sd) = mean_sd(&x);
     let lo = x.iter().copied().fold(f64::INFINITY, f64::min);
     let hi = x.iter().copied().fold(f64::NEG_INFINITY, f64::max);
     (sd, hi - lo)
+}
+
+/// Mean and sample standard deviation (n - 1) of `x`.
+fn mean_sd(x: &[f64]) -> (f64, f64) {
+    let n = x.len() as f64;
+    let m = x.iter().sum::<f64>() / n;
+    let sd = (x.iter().map(|v| (v - m).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
+    (m, sd)
 }
