@@ -135,10 +135,12 @@ pub fn fit(
         let mean = all.iter().sum::<f64>() / n;
         let std = (all.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
         let range = draw_range(&all, p.support);
-        let si = smallest_intervals(&all, None, range, settings.bins, &LEVELS);
+        let dg = samples.diagnostics[j];
+        // The histogram's counting noise is that of the chains' effective draws.
+        let ess = dg.ess_bulk.min(dg.ess_tail);
+        let si = smallest_intervals(&all, None, Some(ess), range, settings.bins, &LEVELS);
         let width = (range[1] - range[0]) / settings.bins as f64;
         let si: Vec<Vec<[f64; 2]>> = si.into_iter().map(|v| close_gaps(v, 2.0 * width)).collect();
-        let dg = samples.diagnostics[j];
         parameters.push(ParameterSummary {
             name: p.name.clone(),
             mean,

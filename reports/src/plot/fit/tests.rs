@@ -115,7 +115,7 @@ fn synthetic_fit(d: usize, chains: usize) -> Fit {
             };
             let n = all.len() as f64;
             let mean = all.iter().sum::<f64>() / n;
-            let si = smallest_intervals(&all, None, support, 100, &LEVELS);
+            let si = smallest_intervals(&all, None, None, support, 100, &LEVELS);
             ParameterSummary {
                 name: names[j].clone(),
                 mean,

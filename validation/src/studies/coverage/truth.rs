@@ -129,7 +129,10 @@ pub(super) fn fit_truth(
         record.jitter.push(rng.random::<f64>());
         let draws: Vec<f64> = all.iter().map(|t| t[j]).collect();
         let range = draw_range(&draws, p.support);
-        let si = smallest_intervals(&draws, None, range, fs.bins, &COVERAGE_LEVELS);
+        // As the fit's summary: the histogram's noise is that of the chains' effective draws.
+        let dg = f.samples.diagnostics[j];
+        let ess = dg.ess_bulk.min(dg.ess_tail);
+        let si = smallest_intervals(&draws, None, Some(ess), range, fs.bins, &COVERAGE_LEVELS);
         record.inside.push(
             si.iter()
                 .map(|iv| interval_contains(iv, truth[j]))
