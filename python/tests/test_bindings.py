@@ -86,6 +86,21 @@ def test_predict_with_jacobian(cli_json):
     np.testing.assert_allclose(got["jacobian_pF"][:, k], (up - dn) / (2 * h), rtol=1e-3, atol=1e-6)
 
 
+def test_predict_refuses_unsupported_voltages_unless_asked(cli_json):
+    # 10 V is inside the bias range [10, 3000] V but below the voltages the training rows
+    # support (the command line's support guard, tests/surrogate_edges.rs): refused as there.
+    with pytest.raises(hpge_cv.HpgeError, match="U_B.*extrapolate"):
+        hpge_cv.predict(MODEL, PARAMS, [100.0, 10.0])
+    got = hpge_cv.predict(MODEL, PARAMS, [10.0], extrapolate=True)
+    ref = cli_json(
+        "predict", "--model", MODEL,
+        "--params", ",".join(f"{k}={v}" for k, v in PARAMS.items()),
+        "--voltages", "10", "--extrapolate", "--json",
+    )
+    np.testing.assert_allclose(got["c12_pF"], ref["c12_pf"], rtol=1e-12)
+    np.testing.assert_allclose(got["sigma_pF"], ref["sigma_pf"], rtol=1e-12)
+
+
 def test_errors_are_hpge_errors_naming_the_input(tmp_path):
     with pytest.raises(hpge_cv.HpgeError, match="nowhere.toml"):
         hpge_cv.Detector(tmp_path / "nowhere.toml")

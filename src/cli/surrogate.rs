@@ -331,9 +331,11 @@ pub fn predict(o: &PredictOptions, json: bool) -> Result<()> {
     let model = Surrogate::load(&o.model)?;
     let params = parse_params(&model, &o.params).map_err(|e| anyhow::anyhow!("--params: {e}"))?;
     let voltages = &o.voltages.0;
-    let u = model.voltages(voltages)?;
-    // The support guard (issue 24): inside the training range but where the training rows thin
-    // out the surrogate extrapolates; refuse unless asked to extrapolate.
+    let n = voltages.len();
+    // The domain guard (voltages, then parameters), then the support guard (issue 24): inside
+    // the training range but where the training rows thin out the surrogate extrapolates;
+    // refuse unless asked to extrapolate.
+    model.voltages(voltages)?;
     model.check_params(&params)?;
     if let Err(e) = model.check_support(&params, voltages) {
         if !o.extrapolate {
@@ -343,21 +345,13 @@ pub fn predict(o: &PredictOptions, json: bool) -> Result<()> {
         }
         eprintln!("warning: {e}; predicting anyway (--extrapolate)");
     }
-    let n = voltages.len();
-    let mut c = vec![0.0; n];
-    let mut spread = vec![0.0; n];
-    model.curve_into(&params, &u, &mut c, Some(&mut spread))?;
-    let np = model.n_params();
-    let jac = if o.jacobian {
-        let mut j = vec![0.0; n * np];
-        let mut c2 = vec![0.0; n];
-        model.curve_jacobian_into(&params, &u, &mut c2, &mut j)?;
-        Some(j.chunks(np).map(<[f64]>::to_vec).collect::<Vec<_>>())
-    } else {
-        None
-    };
     // sigma_s(p, U) c12 with a calibrated error model, sigma_p c12 without.
-    let sigma = model.curve_sigma_pf(&params, &u, &c)?;
+    let hpge_surrogate::model::Prediction {
+        c12_pf: c,
+        spread_pf: spread,
+        sigma_pf: sigma,
+        jacobian_pf: jac,
+    } = model.predict(&params, voltages, o.jacobian)?;
     let sigma_kind = model.sigma_kind();
     let ensemble = model.members() > 1;
     if json {

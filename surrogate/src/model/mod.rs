@@ -9,6 +9,7 @@ mod gelu;
 mod metrics;
 mod network;
 mod polynomial;
+mod predict;
 mod recipe;
 mod steps;
 mod surrogate;
@@ -29,6 +30,7 @@ pub use error_model::{
 pub use metrics::{Figures, gaussian_fit, quantile};
 pub use network::{Dense, Network};
 pub use polynomial::{Polynomial, monomials};
+pub use predict::Prediction;
 pub use recipe::{Architecture, Cycle, Loss, OutputTransform, RECIPES, Recipe, STEPS};
 pub use steps::{BiasMap, StepsHead};
 pub use surrogate::{
