@@ -141,8 +141,8 @@ pub fn train(job: &TrainJob, plot: Option<&Path>, quiet: bool) -> Result<()> {
         for ext in ["svg", "png"] {
             hpge_reports::plot::scatter_sets(
                 &[
-                    ("training", &train_pred, &outcome.train_set.c12_pf),
-                    ("test", &outcome.test_predictions, &outcome.test_c12_pf),
+                    ("training set", &train_pred, &outcome.train_set.c12_pf),
+                    ("test set", &outcome.test_predictions, &outcome.test_c12_pf),
                 ],
                 &model.info,
                 &dir.join(format!("scatter-train-test.{ext}")),

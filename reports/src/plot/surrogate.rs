@@ -128,9 +128,10 @@ pub fn surrogate_errors(
     for ext in ["svg", "png"] {
         let p = dir.join(format!("{label}-scatter.{ext}"));
         let one = |f: Result<()>| f;
+        let name = format!("{label} set");
         one(render!(&p, (800, 800), |root, _svg| scatter(
             &root,
-            &[(label, pred, truth)],
+            &[(name.as_str(), pred, truth)],
             info
         )))?;
         let p = dir.join(format!("{label}-errors.{ext}"));
@@ -142,7 +143,8 @@ pub fn surrogate_errors(
 }
 
 /// `path` (.svg or .png): c_p over c_s of several sets on log axes, one colour each (e.g. the
-/// training and test sets of a `train` run, as the paper's Fig. 18), each named with its size.
+/// training and test sets of a `train` run, as the paper's Fig. 18), each named (`"training
+/// set"`) with the number of points drawn.
 pub fn scatter_sets(sets: &[(&str, &[f64], &[f64])], info: &ModelInfo, path: &Path) -> Result<()> {
     if sets.is_empty() || sets.iter().any(|(_, p, t)| p.len() != t.len()) {
         invalid!("a scatter needs sets with one prediction per solver value");
@@ -173,7 +175,7 @@ fn scatter<DB: DrawingBackend>(
     };
     let names: Vec<String> = sets
         .iter()
-        .map(|(label, _, t)| format!("{label} set ({} rows)", t.len()))
+        .map(|(label, _, t)| format!("{label} ({} rows)", t.len()))
         .collect();
     let mut chart = ChartBuilder::on(root)
         .caption(
