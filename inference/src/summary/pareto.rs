@@ -249,6 +249,37 @@ mod tests {
     }
 
     #[test]
+    fn small_gaussian_log_ratios_are_not_flagged_an_upper_tail_is() {
+        // The exact check's case (S = 100 draws, tail M = 20): near-equal weights with Gaussian
+        // log ratios are not a heavy tail, whatever their small scale; several draws far up in
+        // the tail are (docs/own-detector.md reads a point contact's k-hat with this).
+        let khats = |sd: f64, outliers: usize| -> Vec<f64> {
+            (0..400u64)
+                .map(|seed| {
+                    let mut rng = StdRng::seed_from_u64(1000 + seed);
+                    let g = Normal::new(0.0, sd).unwrap();
+                    let mut lr: Vec<f64> = (0..100).map(|_| g.sample(&mut rng)).collect();
+                    for (k, v) in lr.iter_mut().take(outliers).enumerate() {
+                        *v = sd * (4.0 + 1.5 * k as f64);
+                    }
+                    psis(&lr).k_hat
+                })
+                .collect()
+        };
+        for sd in [0.01, 0.039, 0.3] {
+            let k = khats(sd, 0);
+            let flagged = k.iter().filter(|&&v| v > 0.7).count();
+            assert!(flagged <= 4, "sd {sd}: {flagged} of 400 above 0.7");
+            assert!(median(k) < 0.25, "sd {sd}");
+        }
+        // Five draws 4-10 sd up: the tail reads heavy (one alone does not: median about 0.5).
+        let k = median(khats(0.039, 5));
+        assert!(k > 0.7, "five outliers: median {k}");
+        let k = median(khats(0.039, 1));
+        assert!(k < 0.7, "one outlier: median {k}");
+    }
+
+    #[test]
     fn narrow_proposal_is_flagged_wide_is_not() {
         // Proposal N(0, q^2) for the N(0, 1) target: r ~ exp((1 - q^2) z^2 / 2), whose tail has
         // k = 1 - q^2 (0.75 for q = 0.5, 0.91 for q = 0.3). At finite S the fitted tail
