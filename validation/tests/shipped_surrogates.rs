@@ -52,9 +52,35 @@ fn best_recipe_reproduces_its_committed_figures() {
     assert!(f.rel_sigma < paper.rel_sigma && f.abs_rel_q90 < paper.abs_rel_q90);
 }
 
+/// The fit's default model's name as `check` takes it (no folder, no extension).
+fn default_name() -> &'static str {
+    hpge_inference::fit::DEFAULT_MODEL
+        .trim_start_matches("models/")
+        .trim_end_matches(".safetensors")
+}
+
+#[test]
+fn default_model_reproduces_its_figures_and_its_sigma_s_covers() {
+    // Issue 21's held-out line for the default: coverage_2sigma within [0.93, 0.97] holds; the
+    // Gaussian sigma (0.73% against 0.5%) and the q99 (14% against 2%) are short of it
+    // (models/README.md says why).
+    let f = check(default_name());
+    let paper = check("super-siegfried-rz-paper");
+    assert!(f.rel_sigma < paper.rel_sigma && f.abs_rel_q90 < paper.abs_rel_q90);
+    let text = std::fs::read_to_string(repo_path(&format!(
+        "models/{}.heldout.json",
+        default_name()
+    )))
+    .unwrap();
+    let j: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let c2 = j["coverage_2sigma"].as_f64().unwrap();
+    assert!((0.93..=0.97).contains(&c2), "coverage_2sigma {c2}");
+}
+
 #[test]
 fn shipped_models_carry_the_error_model_their_calibration_set_gives() {
     for name in [
+        default_name(),
         "super-siegfried-rz-split",
         "super-siegfried-rz-paper",
         "super-siegfried-rz-paper-log-ensemble",

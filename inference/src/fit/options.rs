@@ -20,8 +20,12 @@ use crate::{Error, Result};
 
 /// The shipped Super-Siegfried curve (a stand-in made by this program; data/super-siegfried-k1/).
 pub const DEFAULT_DATA: &str = "data/super-siegfried-k1/cv.csv";
-/// The shipped surrogate a fit uses by default (the `split` recipe, models/README.md).
-pub const DEFAULT_MODEL: &str = "models/super-siegfried-rz-split.safetensors";
+/// The shipped surrogate a fit uses by default: the `split-steps` recipe with a 256 x 3 trunk, a
+/// 128 head and AdamW's weight decay 0.01, trained on the regenerated training set
+/// (`TRUNK=256,256,256 HEAD=128 WEIGHT_DECAY=0.01 bash models/train.sh split-steps 0`;
+/// models/README.md).
+pub const DEFAULT_MODEL: &str =
+    "models/super-siegfried-rz-split-steps-t256-256-256-hd128-wd0.01.safetensors";
 /// The paper's B_RZ prior (section 8.2).
 pub const DEFAULT_PRIOR: &str = "priors/b-rz.toml";
 /// The detector of the shipped data.
