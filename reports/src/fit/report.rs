@@ -59,7 +59,7 @@ pub fn write_report(
     );
     let _ = writeln!(
         r,
-        "Reproduce: `hpge-cv fit --data {} --model {} --prior {} --detector {} --sampler {} --seed {} --likelihood {} --out {}`\n",
+        "Reproduce: `hpge-cv fit --data {} --model {} --prior {} --detector {} --sampler {} --seed {} --likelihood {}{} --out {}`\n",
         o.data.display(),
         o.model.display(),
         o.prior.display(),
@@ -67,6 +67,9 @@ pub fn write_report(
         o.sampler,
         o.seed,
         o.likelihood,
+        o.truth
+            .as_ref()
+            .map_or(String::new(), |t| format!(" --truth {}", t.display())),
         out.display()
     );
     let _ = writeln!(r, "## Convergence\n");
