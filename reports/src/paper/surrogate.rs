@@ -57,15 +57,20 @@ fn heldout(model: &Surrogate, data: &Path) -> Result<(Vec<f64>, Vec<f64>, Figure
 /// drawing a regular subsample (an SVG of 54 000 circles is some 6 MB).
 const MAX_DRAWN: usize = 6000;
 
+/// One of a model's own data sets with its predictions.
+struct TrainedSet {
+    label: &'static str,
+    pred: Vec<f64>,
+    truth: Vec<f64>,
+    figures: Figures,
+}
+
 /// The model's own training and test sets (the paper's Fig. 18 shows both), read from the
 /// files its metadata records when they are present with the recorded FNV-1a hash: per set its
 /// label, its predictions, its solver values and its error figures. `Err` says why not (the
 /// sets are made by `bash data/training/make.sh`, not committed; a file of other rows, such as
 /// the regenerated set beside a model trained on the old one, is not that model's set).
-#[allow(clippy::type_complexity)]
-fn trained_sets(
-    model: &Surrogate,
-) -> std::result::Result<Vec<(&'static str, Vec<f64>, Vec<f64>, Figures)>, String> {
+fn trained_sets(model: &Surrogate) -> std::result::Result<Vec<TrainedSet>, String> {
     let mut out = Vec::new();
     for (label, rec) in [
         ("training set", &model.info.training),
@@ -86,8 +91,13 @@ fn trained_sets(
             ));
         }
         let pred = model.predict_set(&set);
-        let f = Figures::of(&pred, &set.c12_pf);
-        out.push((label, pred, set.c12_pf, f));
+        let figures = Figures::of(&pred, &set.c12_pf);
+        out.push(TrainedSet {
+            label,
+            pred,
+            truth: set.c12_pf,
+            figures,
+        });
     }
     Ok(out)
 }
@@ -167,8 +177,9 @@ pub fn run(ctx: &mut Ctx) -> Result<()> {
         Ok(sets) => {
             let mut shown: Vec<(String, Vec<f64>, Vec<f64>)> = sets
                 .iter()
-                .map(|(label, p, t, _)| {
-                    let (p, t, stride) = drawn(p, t);
+                .map(|set| {
+                    let (p, t, stride) = drawn(&set.pred, &set.truth);
+                    let label = set.label;
                     let name = if stride > 1 {
                         format!("{label}, every {stride}th row")
                     } else {
@@ -187,12 +198,13 @@ pub fn run(ctx: &mut Ctx) -> Result<()> {
                 plot::scatter_sets(&refs, &info, path)
             })?;
             sets.iter()
-                .map(|(label, _, t, f)| {
+                .map(|set| {
                     format!(
-                        "{label} ({} rows): sigma {:.3}%, q99 {:.1}%",
-                        t.len(),
-                        100.0 * f.rel_sigma,
-                        100.0 * f.abs_rel_q99
+                        "{} ({} rows): sigma {:.3}%, q99 {:.1}%",
+                        set.label,
+                        set.truth.len(),
+                        100.0 * set.figures.rel_sigma,
+                        100.0 * set.figures.abs_rel_q99
                     )
                 })
                 .collect::<Vec<_>>()
@@ -268,7 +280,7 @@ pub fn run(ctx: &mut Ctx) -> Result<()> {
             "paper_model": ctx.inputs.paper_model.display().to_string(),
             "paper_heldout": f,
             "paper_trained_sets": match &trained {
-                Ok(sets) => json!(sets.iter().map(|(label, _, _, f)| json!({"set": label, "figures": f})).collect::<Vec<_>>()),
+                Ok(sets) => json!(sets.iter().map(|set| json!({"set": set.label, "figures": set.figures})).collect::<Vec<_>>()),
                 Err(why) => json!({"not_drawn": why}),
             },
             "fit_model": ctx.inputs.fit_model.display().to_string(),
