@@ -23,7 +23,9 @@ $B fit --prior priors/b-z.toml --sampler nuts --no-exact-check --out reports/fit
 # NUTS cannot cross between B_RZ's modes: it runs to its time limit and reports it (exit 3).
 $B fit --prior priors/b-rz.toml --truth $T --sampler nuts --no-exact-check --max-seconds 120 \
   --out reports/fits/b-rz-nuts || true
-# The coverage studies (reports/coverage/): about 15 min (B_Z), 60 min (B_RZ), 10 min (exact data).
-#   $B validate coverage --truths 200 --prior priors/b-z.toml
-#   $B validate coverage --truths 200 --prior priors/b-rz.toml --ess 200 --mode-starts 12
-#   $B validate coverage --truths 24 --prior priors/b-rz.toml --exact --ess 200 --mode-starts 12
+# The coverage studies (reports/coverage/), each resuming per truth when started again:
+# about 40 min (B_RZ, surrogate data, 200 truths) and 2-4 min per truth with exact data (the
+# full pipeline of `fit`, refinement included; 100 truths, several hours):
+#   $B validate coverage --truths 200 --prior priors/b-rz.toml --out reports/coverage/b-rz
+#   $B validate coverage --truths 100 --prior priors/b-rz.toml --exact --out reports/coverage/b-rz-exact
+#   $B validate coverage --truths 200 --prior priors/b-z.toml --out reports/coverage/b-z
