@@ -181,7 +181,7 @@ pub fn run(ctx: &mut Ctx) -> Result<()> {
                     let (p, t, stride) = drawn(&set.pred, &set.truth);
                     let label = set.label;
                     let name = if stride > 1 {
-                        format!("{label}, every {stride}th row")
+                        format!("{label}, every {} row", ordinal(stride))
                     } else {
                         label.to_string()
                     };
@@ -291,4 +291,36 @@ pub fn run(ctx: &mut Ctx) -> Result<()> {
         }),
     );
     Ok(())
+}
+
+/// "1st", "2nd", "3rd", "4th", ..., "11th", "12th", "13th", "21st", ...
+fn ordinal(n: usize) -> String {
+    let suffix = match (n % 10, n % 100) {
+        (_, 11..=13) => "th",
+        (1, _) => "st",
+        (2, _) => "nd",
+        (3, _) => "rd",
+        _ => "th",
+    };
+    format!("{n}{suffix}")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::ordinal;
+
+    #[test]
+    fn ordinals_take_english_suffixes() {
+        let got: Vec<String> = [1, 2, 3, 4, 9, 11, 12, 13, 21, 22, 23, 101, 111]
+            .into_iter()
+            .map(ordinal)
+            .collect();
+        assert_eq!(
+            got,
+            [
+                "1st", "2nd", "3rd", "4th", "9th", "11th", "12th", "13th", "21st", "22nd", "23rd",
+                "101st", "111th"
+            ]
+        );
+    }
 }

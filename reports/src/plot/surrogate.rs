@@ -179,10 +179,14 @@ fn scatter<DB: DrawingBackend>(
         .collect();
     let mut chart = ChartBuilder::on(root)
         .caption(
+            // The sets by name only (the legend gives their rows), so the title fits the figure.
             format!(
-                "{}: c12 surrogate vs solver, recipe {}",
-                names.join(", "),
-                info.recipe_name
+                "c12 surrogate vs solver, recipe {}: {}",
+                info.recipe_name,
+                sets.iter()
+                    .map(|(label, _, _)| label.split(',').next().unwrap_or(label))
+                    .collect::<Vec<_>>()
+                    .join(" / ")
             ),
             ("sans-serif", 18),
         )

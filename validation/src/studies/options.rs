@@ -55,7 +55,8 @@ pub struct CoverageOptions {
     )]
     pub detector: PathBuf,
     /// Simulate the data with the exact field solver instead of the surrogate (what surrogate
-    /// error does to coverage; about 2 CPU-seconds per truth more).
+    /// error does to coverage): each fit then runs `fit`'s full pipeline, exact check and
+    /// refinement included (1-4 min per B_RZ truth on 2 cores; `--no-exact-check` leaves them out).
     #[cfg_attr(feature = "clap", arg(long))]
     pub exact: bool,
     /// Likelihood: paper, covariance, or auto (covariance where the data have one, else paper).
