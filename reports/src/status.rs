@@ -213,10 +213,40 @@ fn stand_in_row(root: &Path) -> Result<StatusRow> {
     })
 }
 
-/// A coverage study (`reports/coverage/NAME/coverage.json`) against the truths it needs.
-fn coverage_row(root: &Path, name: &str, what: &str, needed: u64) -> Result<StatusRow> {
+/// What makes a coverage study's record stale: its model is not the default surrogate `model`,
+/// or its model or data file has changed since (their FNV-1a hashes against the recorded ones).
+/// None when the record describes the files as they are.
+fn coverage_stale(root: &Path, s: &Value, model: &str) -> Option<String> {
+    let input = |key: &str| s.pointer(&format!("/inputs/{key}")).and_then(Value::as_str);
+    let (Some(used), Some(used_hash)) = (input("model"), input("model_hash")) else {
+        return Some("its record names no model".into());
+    };
+    if used != model {
+        return Some(format!("made with {used}, not the default surrogate"));
+    }
+    if hpge_inference::fit::file_hash(&root.join(used)) != used_hash {
+        return Some(format!("{used} has changed since"));
+    }
+    if let (Some(data), Some(data_hash)) = (input("data"), input("data_hash")) {
+        if hpge_inference::fit::file_hash(&root.join(data)) != data_hash {
+            return Some(format!("{data} has changed since"));
+        }
+    }
+    None
+}
+
+/// A coverage study (`reports/coverage/NAME/coverage.json`) against the truths it needs, made
+/// with the default surrogate `model` on the data as they are (a stale study fails).
+fn coverage_row(
+    root: &Path,
+    name: &str,
+    what: &str,
+    needed: u64,
+    model: &str,
+) -> Result<StatusRow> {
     let rel = format!("reports/coverage/{name}/coverage.json");
     let s = read_json(root, &rel)?;
+    let stale = coverage_stale(root, &s, model);
     let n = num(&s, &rel, "/n_truths")? as u64;
     let pass = flag(&s, &rel, "/pass")?;
     let failing: Vec<String> = s
@@ -229,11 +259,14 @@ fn coverage_row(root: &Path, name: &str, what: &str, needed: u64) -> Result<Stat
                 .collect()
         })
         .unwrap_or_default();
-    let detail = if failing.is_empty() {
+    let mut detail = if failing.is_empty() {
         "every parameter inside its bands".to_string()
     } else {
         format!("outside: {}", failing.join(", "))
     };
+    if let Some(why) = &stale {
+        detail = format!("{detail}; stale: {why}");
+    }
     Ok(StatusRow {
         what: what.into(),
         result: format!(
@@ -245,7 +278,7 @@ fn coverage_row(root: &Path, name: &str, what: &str, needed: u64) -> Result<Stat
         ),
         // The acceptance's test per parameter (KS p > 0.01, stricter than the study's own
         // 0.01 / d) and the study's pass.
-        verdict: Verdict::of(pass && failing.is_empty() && n >= needed),
+        verdict: Verdict::of(pass && failing.is_empty() && n >= needed && stale.is_none()),
         source: rel,
     })
 }
@@ -338,18 +371,21 @@ pub fn status_rows(root: &Path, model: &str) -> Result<Vec<StatusRow>> {
         "b-rz-exact",
         "coverage, B_RZ, exact-solver data",
         exact_n,
+        model,
     )?);
     rows.push(coverage_row(
         root,
         "b-rz",
         "coverage, B_RZ, surrogate data",
         surrogate_n,
+        model,
     )?);
     rows.push(coverage_row(
         root,
         "b-z",
         "coverage, B_Z, surrogate data",
         surrogate_n,
+        model,
     )?);
     rows.push(heldout_row(root, model)?);
     rows.push(accuracy_row(root)?);
@@ -424,6 +460,34 @@ pub fn with_table(text: &str, table: &str, file: &Path) -> Result<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_coverage_study_of_another_model_or_changed_files_is_stale() {
+        let root = std::env::temp_dir().join(format!("hpge-status-stale-{}", std::process::id()));
+        std::fs::create_dir_all(root.join("m")).unwrap();
+        std::fs::write(root.join("m/a.safetensors"), b"model a").unwrap();
+        std::fs::write(root.join("cv.csv"), b"U_V,c_pF\n").unwrap();
+        let hash = |p: &str| hpge_inference::fit::file_hash(&root.join(p));
+        let record = |model: &str| {
+            serde_json::json!({"inputs": {"model": model, "model_hash": hash("m/a.safetensors"),
+                "data": "cv.csv", "data_hash": hash("cv.csv")}})
+        };
+        assert_eq!(
+            coverage_stale(&root, &record("m/a.safetensors"), "m/a.safetensors"),
+            None
+        );
+        let other = coverage_stale(&root, &record("m/b.safetensors"), "m/a.safetensors").unwrap();
+        assert!(other.contains("not the default"), "{other}");
+        let s = record("m/a.safetensors");
+        std::fs::write(root.join("cv.csv"), b"U_V,c_pF\n25,436\n").unwrap();
+        let data = coverage_stale(&root, &s, "m/a.safetensors").unwrap();
+        assert!(data.contains("cv.csv has changed"), "{data}");
+        std::fs::write(root.join("m/a.safetensors"), b"model a, retrained").unwrap();
+        let model = coverage_stale(&root, &s, "m/a.safetensors").unwrap();
+        assert!(model.contains("a.safetensors has changed"), "{model}");
+        assert!(coverage_stale(&root, &serde_json::json!({}), "m/a.safetensors").is_some());
+        std::fs::remove_dir_all(&root).unwrap();
+    }
 
     #[test]
     fn the_table_is_replaced_between_the_markers_only() {
