@@ -73,6 +73,9 @@ pub fn coverage(o: &CoverageOptions, as_json: bool) -> Result<()> {
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     let lines = !std::io::IsTerminal::is_terminal(&std::io::stderr());
+    // Without a terminal a line per 10 truths, or per truth where each runs the full pipeline
+    // (minutes each).
+    let every = if settings.pipeline.is_some() { 1 } else { 10 };
     let outcome = run_coverage(
         CoverageModels {
             fit: &s.surrogate,
@@ -89,8 +92,11 @@ pub fn coverage(o: &CoverageOptions, as_json: bool) -> Result<()> {
         &|done, total| {
             bar.set_length(total as u64);
             bar.set_position(done as u64);
-            if lines && (done % 10 == 0 || done == total) {
-                eprintln!("{done}/{total} truths of this run");
+            if lines && (done % every == 0 || done == total) {
+                eprintln!(
+                    "{done}/{total} truths of this run ({:.0} s)",
+                    bar.elapsed().as_secs_f64()
+                );
             }
         },
     )?;
