@@ -193,6 +193,12 @@ pub fn coverage(o: &CoverageOptions, as_json: bool) -> Result<()> {
                 "exact check of the fits: {} passed, {} failed after refinement; {:.2} rounds per fit on average, at most {}",
                 c.passed, c.failed, c.rounds_mean, c.rounds_max
             );
+            if let Some(t) = c.seconds_split {
+                println!(
+                    "their wall time over the {} fits that record it: {:.0} s sampling, {:.0} s exact solves, {:.0} s error models",
+                    c.split_truths, t.sampling, t.exact, t.error_model
+                );
+            }
         }
         println!(
             "{:<10} {:>8} {:>10} {:>17} {:>10} {:>17}",

@@ -20,7 +20,7 @@ pub mod store;
 mod truth;
 
 pub use settings::{COVERAGE_LEVELS, CoverageSettings, PipelineSettings};
-use store::{TruthCheck, TruthFit, TruthStore};
+use store::{SecondsSplit, TruthCheck, TruthFit, TruthStore};
 pub use truth::CoverageModels;
 use truth::fit_truth;
 
@@ -124,6 +124,12 @@ pub struct CheckTally {
     pub rounds_mean: f64,
     /// Most rounds of one fit.
     pub rounds_max: usize,
+    /// The fits' wall time by part, summed over the `split_truths` fits that record it, s.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub seconds_split: Option<SecondsSplit>,
+    /// Fits that record their split (those written since 2026-11-29).
+    #[serde(default)]
+    pub split_truths: usize,
 }
 
 /// One-sample Kolmogorov-Smirnov test of `u` (in [0, 1]) against uniform: the asymptotic p-value
@@ -362,6 +368,15 @@ fn summarise(truths: &[&TruthFit], prior: &Prior, l: usize) -> CoverageReport {
         failed: checks.iter().filter(|c| !c.pass).count(),
         rounds_mean: checks.iter().map(|c| c.rounds as f64).sum::<f64>() / checks.len() as f64,
         rounds_max: checks.iter().map(|c| c.rounds).max().unwrap_or(0),
+        seconds_split: checks
+            .iter()
+            .filter_map(|c| c.seconds_split)
+            .reduce(|a, b| SecondsSplit {
+                sampling: a.sampling + b.sampling,
+                exact: a.exact + b.exact,
+                error_model: a.error_model + b.error_model,
+            }),
+        split_truths: checks.iter().filter(|c| c.seconds_split.is_some()).count(),
     });
     CoverageReport {
         n_truths: m,

@@ -41,6 +41,22 @@ pub struct TruthCheck {
     /// Its largest |mean shift| in posterior sd.
     #[serde(deserialize_with = "hpge_inference::fit::f64_or_nan")]
     pub max_abs_shift_sd: f64,
+    /// Where the fit's wall time went, summed over its rounds: sampling and summaries, exact
+    /// solves (checks, ascents, curves at local modes), error-model fits, s. Absent in records
+    /// written before 2026-11-29.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub seconds_split: Option<SecondsSplit>,
+}
+
+/// A pipeline fit's wall time by part, s (sums of [`hpge_inference::fit::RefineRound`]'s).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct SecondsSplit {
+    /// Sampling and summaries.
+    pub sampling: f64,
+    /// Exact solves.
+    pub exact: f64,
+    /// Error-model fits.
+    pub error_model: f64,
 }
 
 /// One truth of a study as written.
@@ -161,5 +177,19 @@ impl TruthStore {
             message: e.to_string(),
         })?;
         Ok(write_whole(&self.path(t.index), &text)?)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::TruthCheck;
+
+    #[test]
+    fn a_check_written_before_the_time_split_still_reads() {
+        let old = r#"{"pass": true, "rounds": 3, "pareto_k": 0.21, "max_abs_shift_sd": 0.16}"#;
+        let c: TruthCheck = serde_json::from_str(old).unwrap();
+        assert_eq!((c.pass, c.rounds, c.seconds_split), (true, 3, None));
+        let again: TruthCheck = serde_json::from_str(&serde_json::to_string(&c).unwrap()).unwrap();
+        assert_eq!(again, c);
     }
 }

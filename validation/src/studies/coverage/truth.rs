@@ -12,7 +12,7 @@ use rand::SeedableRng;
 use rand::rngs::StdRng;
 
 use super::settings::{COVERAGE_LEVELS, CoverageSettings};
-use super::store::{TruthCheck, TruthFit};
+use super::store::{SecondsSplit, TruthCheck, TruthFit};
 use crate::error::Result;
 
 /// The models of a study.
@@ -115,6 +115,11 @@ pub(super) fn fit_truth(
                 rounds: r.rounds.len(),
                 pareto_k: c.pareto_k,
                 max_abs_shift_sd: c.max_abs_shift_sd,
+                seconds_split: Some(SecondsSplit {
+                    sampling: r.rounds.iter().map(|k| k.sampling_seconds).sum(),
+                    exact: r.rounds.iter().map(|k| k.exact_seconds).sum(),
+                    error_model: r.rounds.iter().map(|k| k.error_model_seconds).sum(),
+                }),
             });
             r.fit
         }
