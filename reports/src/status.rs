@@ -227,10 +227,10 @@ fn coverage_stale(root: &Path, s: &Value, model: &str) -> Option<String> {
     if hpge_inference::fit::file_hash(&root.join(used)) != used_hash {
         return Some(format!("{used} has changed since"));
     }
-    if let (Some(data), Some(data_hash)) = (input("data"), input("data_hash")) {
-        if hpge_inference::fit::file_hash(&root.join(data)) != data_hash {
-            return Some(format!("{data} has changed since"));
-        }
+    if let (Some(data), Some(data_hash)) = (input("data"), input("data_hash"))
+        && hpge_inference::fit::file_hash(&root.join(data)) != data_hash
+    {
+        return Some(format!("{data} has changed since"));
     }
     None
 }

@@ -210,5 +210,8 @@ fn a_study_resumes_extends_shards_and_never_mixes_runs() {
     // Every fit records where its time went; the parts are positive where they ran.
     assert_eq!(tally.split_truths, 3, "{tally:?}");
     let split = tally.seconds_split.expect("the fits' time split");
-    assert!(split.sampling > 0.0 && split.exact > 0.0 && split.error_model >= 0.0, "{split:?}");
+    assert!(
+        split.sampling > 0.0 && split.exact > 0.0 && split.error_model >= 0.0,
+        "{split:?}"
+    );
 }
