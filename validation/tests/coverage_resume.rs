@@ -215,3 +215,109 @@ fn a_study_resumes_extends_shards_and_never_mixes_runs() {
         "{split:?}"
     );
 }
+
+/// The exact toy model, which stops the process (a panic, as a kill would) at its first call
+/// after a truth's first refinement round was written under `out`.
+struct StopAfterARound<'a> {
+    exact: Toy,
+    out: &'a Path,
+}
+
+fn saved_rounds(out: &Path) -> usize {
+    let Ok(truths) = std::fs::read_dir(out.join("truth-rounds")) else {
+        return 0;
+    };
+    truths
+        .flatten()
+        .filter_map(|t| std::fs::read_dir(t.path().join("rounds")).ok())
+        .map(|r| r.count())
+        .sum()
+}
+
+impl CvModel for StopAfterARound<'_> {
+    fn inputs(&self) -> Vec<String> {
+        self.exact.inputs()
+    }
+    fn domain(&self) -> Vec<[f64; 2]> {
+        self.exact.domain()
+    }
+    fn voltages(&self) -> &[f64] {
+        &VOLTS
+    }
+    fn has_jacobian(&self) -> bool {
+        false
+    }
+    fn describe(&self) -> String {
+        "toy, stopping after a saved round".into()
+    }
+    fn sigma_rel(&self) -> f64 {
+        0.0
+    }
+    fn curve(&self, x: &[f64], c: &mut [f64]) -> Result<()> {
+        assert!(saved_rounds(self.out) == 0, "stopped after a saved round");
+        self.exact.curve(x, c)
+    }
+    fn curve_jacobian(&self, _x: &[f64], _c: &mut [f64], _jac: &mut [f64]) -> Result<()> {
+        unreachable!("has_jacobian is false")
+    }
+}
+
+#[test]
+fn a_truth_interrupted_inside_its_refinement_takes_its_rounds_back() {
+    let (exact, sur) = (Toy { bias: 0.0 }, Toy { bias: 0.03 });
+    let pipeline = PipelineSettings {
+        check: ExactCheckSettings {
+            draws: 60,
+            grids: ExactGrids::Own,
+            grid_check: 0,
+            ascents: 0,
+        },
+        refine: RefineSettings {
+            max_rounds: 3,
+            ..RefineSettings::default()
+        },
+    };
+    let s = settings(3, Some(pipeline));
+    fn on<'a>(fit: &'a dyn CvModel, data: &'a dyn CvModel) -> CoverageModels<'a> {
+        CoverageModels {
+            fit,
+            data,
+            data_sigma_rel: 0.0,
+        }
+    }
+    // One thread: the truths one after the other, so the stop falls inside one truth's fit.
+    let one = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap();
+    let whole = done(one.install(|| run(on(&sur, &exact), &s, None, Shard::WHOLE)));
+    let out = folder("rounds");
+    let stopping = StopAfterARound {
+        exact: Toy { bias: 0.0 },
+        out: &out,
+    };
+    {
+        let store = TruthStore::open(&out, "run-r".into(), Shard::WHOLE).unwrap();
+        let stopped = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            one.install(|| run(on(&sur, &stopping), &s, Some(&store), Shard::WHOLE))
+        }));
+        assert!(
+            stopped.is_err(),
+            "the study ran through without a refined truth"
+        );
+    }
+    // The interrupted truth's round is on disk; the study started again takes it back and ends
+    // with the uninterrupted study's statistics, leaving no rounds behind.
+    assert!(saved_rounds(&out) >= 1);
+    let store = TruthStore::open(&out, "run-r".into(), Shard::WHOLE).unwrap();
+    let again = done(one.install(|| run(on(&sur, &exact), &s, Some(&store), Shard::WHOLE)));
+    assert_eq!(again.parameters, whole.parameters);
+    assert_eq!(saved_rounds(&out), 0);
+    assert_eq!(
+        std::fs::read_dir(out.join("truth-rounds")).unwrap().count(),
+        0,
+        "a written truth's rounds folder is removed"
+    );
+    drop(store);
+    let _ = std::fs::remove_dir_all(&out);
+}

@@ -282,9 +282,19 @@ pub fn coverage(
     let fitted: Vec<Result<TruthFit>> = todo
         .into_par_iter()
         .map(|i| {
-            let t = fit_truth(i, models, prior, template, settings, fingerprint)?;
+            let rounds = run.store.map(|s| s.rounds_dir(i));
+            let t = fit_truth(
+                i,
+                models,
+                prior,
+                template,
+                settings,
+                fingerprint,
+                rounds.as_deref(),
+            )?;
             if let Some(s) = run.store {
                 s.save(&t)?;
+                s.forget_rounds(i)?;
             }
             progress(
                 count.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1,

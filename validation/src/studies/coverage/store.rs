@@ -27,6 +27,11 @@ use crate::error::Result;
 
 /// The folder inside a study's output folder that holds its truths.
 pub const TRUTHS_DIR: &str = "truths";
+/// The folder inside a study's output folder that holds, per truth still being fitted with the
+/// full pipeline, its finished refinement rounds (`truth-rounds/truth-NNNNN/rounds/`): an
+/// interrupted truth takes them back instead of solving them again. A truth's folder is removed
+/// once the truth is written.
+pub const TRUTH_ROUNDS_DIR: &str = "truth-rounds";
 
 /// What the full pipeline's exact check said about one truth's fit (studies with refinement).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -137,6 +142,32 @@ impl TruthStore {
     /// The run's fingerprint.
     pub fn fingerprint(&self) -> &str {
         &self.fingerprint
+    }
+
+    /// Where truth `index`'s pipeline fit keeps its finished rounds while it runs
+    /// ([`TRUTH_ROUNDS_DIR`]; `hpge_inference::fit::Checkpoint` writes `rounds/` inside).
+    pub fn rounds_dir(&self, index: usize) -> PathBuf {
+        self.dir
+            .parent()
+            .unwrap_or(&self.dir)
+            .join(TRUTH_ROUNDS_DIR)
+            .join(format!("truth-{index:05}"))
+    }
+
+    /// Removes truth `index`'s rounds folder (after the truth is written).
+    ///
+    /// # Errors
+    /// The folder exists and cannot be removed.
+    pub fn forget_rounds(&self, index: usize) -> Result<()> {
+        match std::fs::remove_dir_all(self.rounds_dir(index)) {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(hpge_inference::Error::Io {
+                file: self.rounds_dir(index),
+                action: "cannot remove the folder",
+                source: e,
+            }
+            .into()),
+            _ => Ok(()),
+        }
     }
 
     fn path(&self, index: usize) -> PathBuf {

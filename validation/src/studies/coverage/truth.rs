@@ -2,9 +2,13 @@
 //! surrogate fit, or the full pipeline of `fit`: exact check, exact ascents, refinement), and
 //! ranked among the posterior draws.
 
+use std::path::Path;
 use std::time::Instant;
 
-use hpge_inference::fit::{RefineInputs, RefineProgress, draw_range, refine_fit};
+use hpge_inference::fit::{
+    Checkpoint, RefineInputs, RefineProgress, Resume, draw_range,
+    fingerprint as checkpoint_fingerprint, refine_fit,
+};
 use hpge_inference::summary::{interval_contains, smallest_intervals};
 use hpge_inference::{CvModel, Likelihood, Posterior, Prior, fit};
 use rand::RngExt;
@@ -35,7 +39,10 @@ fn truth_seed(seed: u64, i: usize) -> u64 {
 }
 
 /// Truth `i` of the study: drawn, simulated, fitted and ranked. A truth whose data curve fails
-/// recoverably comes back with `skipped` set.
+/// recoverably comes back with `skipped` set. With the full pipeline and a `rounds` folder the
+/// fit writes each finished round there and takes back those an interrupted run of the same
+/// study and truth left (`hpge_inference::fit::Checkpoint`; the seeded sampler makes the
+/// result the same as an uninterrupted fit's).
 ///
 /// # Errors
 /// Any other model error, a fit or refinement that fails.
@@ -46,6 +53,7 @@ pub(super) fn fit_truth(
     template: &Likelihood,
     settings: &CoverageSettings,
     fingerprint: &str,
+    rounds: Option<&Path>,
 ) -> Result<TruthFit> {
     let start = Instant::now();
     let nv = template.len();
@@ -101,6 +109,24 @@ pub(super) fn fit_truth(
                 prior,
                 likelihood: &like,
             };
+            // The study's run and the truth: rounds of another run or truth are cleared.
+            let checkpoint = match rounds {
+                Some(dir) => {
+                    std::fs::create_dir_all(dir).map_err(|e| hpge_inference::Error::Io {
+                        file: dir.to_path_buf(),
+                        action: "cannot create the folder",
+                        source: e,
+                    })?;
+                    let run =
+                        checkpoint_fingerprint(&[fingerprint.to_string(), format!("truth {i}")]);
+                    Some(Checkpoint::open(dir, run)?)
+                }
+                None => None,
+            };
+            let resume = checkpoint.as_ref().map(|(checkpoint, saved)| Resume {
+                saved: saved.clone(),
+                checkpoint,
+            });
             let r = refine_fit(
                 m,
                 &fs,
@@ -108,7 +134,7 @@ pub(super) fn fit_truth(
                 &p.refine,
                 &Default::default(),
                 RefineProgress::quiet(),
-                None,
+                resume,
             )?;
             record.check = r.fit.summary.exact_check.as_ref().map(|c| TruthCheck {
                 pass: c.pass,
