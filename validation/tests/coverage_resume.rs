@@ -91,6 +91,22 @@ fn settings(n: usize, pipeline: Option<PipelineSettings>) -> CoverageSettings {
     }
 }
 
+/// The full pipeline at test size: a 60-draw check, no ascents, at most 3 rounds.
+fn pipeline() -> PipelineSettings {
+    PipelineSettings {
+        check: ExactCheckSettings {
+            draws: 60,
+            grids: ExactGrids::Own,
+            grid_check: 0,
+            ascents: 0,
+        },
+        refine: RefineSettings {
+            max_rounds: 3,
+            ..RefineSettings::default()
+        },
+    }
+}
+
 fn folder(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("hpge-coverage-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&d);
@@ -181,21 +197,9 @@ fn a_study_resumes_extends_shards_and_never_mixes_runs() {
     };
     let plain = done(run(on_exact, &settings(3, None), None, Shard::WHOLE));
     assert!(plain.exact_check.is_none());
-    let pipeline = PipelineSettings {
-        check: ExactCheckSettings {
-            draws: 60,
-            grids: ExactGrids::Own,
-            grid_check: 0,
-            ascents: 0,
-        },
-        refine: RefineSettings {
-            max_rounds: 3,
-            ..RefineSettings::default()
-        },
-    };
     let full = done(run(
         on_exact,
-        &settings(3, Some(pipeline)),
+        &settings(3, Some(pipeline())),
         None,
         Shard::WHOLE,
     ));
@@ -265,19 +269,7 @@ impl CvModel for StopAfterARound<'_> {
 #[test]
 fn a_truth_interrupted_inside_its_refinement_takes_its_rounds_back() {
     let (exact, sur) = (Toy { bias: 0.0 }, Toy { bias: 0.03 });
-    let pipeline = PipelineSettings {
-        check: ExactCheckSettings {
-            draws: 60,
-            grids: ExactGrids::Own,
-            grid_check: 0,
-            ascents: 0,
-        },
-        refine: RefineSettings {
-            max_rounds: 3,
-            ..RefineSettings::default()
-        },
-    };
-    let s = settings(3, Some(pipeline));
+    let s = settings(3, Some(pipeline()));
     fn on<'a>(fit: &'a dyn CvModel, data: &'a dyn CvModel) -> CoverageModels<'a> {
         CoverageModels {
             fit,
