@@ -123,8 +123,9 @@ pub(super) fn fit_truth(
                 }
                 None => None,
             };
-            let resume = checkpoint.as_ref().map(|(checkpoint, saved)| Resume {
-                saved: saved.clone(),
+            let (checkpoint, saved) = checkpoint.unzip();
+            let resume = checkpoint.as_ref().map(|checkpoint| Resume {
+                saved: saved.unwrap_or_default(),
                 checkpoint,
             });
             let r = refine_fit(
