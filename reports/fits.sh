@@ -24,8 +24,9 @@ $B fit --prior priors/b-z.toml --sampler nuts --no-exact-check --out reports/fit
 $B fit --prior priors/b-rz.toml --truth $T --sampler nuts --no-exact-check --max-seconds 120 \
   --out reports/fits/b-rz-nuts || true
 # The coverage studies (reports/coverage/), each resuming per truth when started again:
-# about 40 min (B_RZ, surrogate data, 200 truths) and 2-4 min per truth with exact data (the
-# full pipeline of `fit`, refinement included; 100 truths, several hours):
+# about 40 min (B_RZ, surrogate data, 200 truths) and 8-60 min per truth with exact data on
+# 2 cores (the full pipeline of `fit`, refinement included, almost all of it exact solves; 100
+# truths, 20-60 h: run it across sessions or machines with --shard K/M; it resumes inside a truth):
 #   $B validate coverage --truths 200 --prior priors/b-rz.toml --out reports/coverage/b-rz
 #   $B validate coverage --truths 100 --prior priors/b-rz.toml --exact --out reports/coverage/b-rz-exact
 #   $B validate coverage --truths 200 --prior priors/b-z.toml --out reports/coverage/b-z
