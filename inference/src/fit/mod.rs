@@ -10,6 +10,7 @@ pub mod outputs;
 mod predictive;
 mod refine;
 mod refine_settings;
+mod reproduce;
 mod round;
 mod run;
 mod summary;

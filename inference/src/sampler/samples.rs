@@ -36,7 +36,8 @@ pub struct ChainDraws {
     pub theta: Vec<Vec<f64>>,
     /// ln p(theta | data) per kept draw (up to a constant).
     pub ln_posterior: Vec<f64>,
-    /// Acceptance over the sampling phase (NUTS: mean acceptance statistic).
+    /// Acceptance over the sampling phase (NUTS: the fraction of non-divergent transitions;
+    /// nuts-rs's draw does not return its mean acceptance statistic).
     pub acceptance: f64,
     /// Divergent transitions (NUTS) in the sampling phase.
     pub divergences: usize,

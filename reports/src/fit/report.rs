@@ -24,6 +24,16 @@ fn misfit(fit: &Fit, split_v: f64) -> (f64, f64) {
     (lo, hi)
 }
 
+/// A rate with about three significant figures (an unconverged fit's 0.019 per second is not 0).
+fn per_second(v: f64) -> String {
+    if v.abs() >= 100.0 || v == 0.0 || !v.is_finite() {
+        format!("{v:.0}")
+    } else {
+        let decimals = (2.0 - v.abs().log10().floor()).max(0.0) as usize;
+        format!("{v:.decimals$}")
+    }
+}
+
 fn intervals(v: &[[f64; 2]]) -> String {
     v.iter()
         .map(|[a, b]| format!("[{a:.4}, {b:.4}]"))
@@ -59,23 +69,13 @@ pub fn write_report(
     );
     let _ = writeln!(
         r,
-        "Reproduce: `hpge-cv fit --data {} --model {} --prior {} --detector {} --sampler {} --seed {} --likelihood {}{} --out {}`\n",
-        o.data.display(),
-        o.model.display(),
-        o.prior.display(),
-        o.detector.display(),
-        o.sampler,
-        o.seed,
-        o.likelihood,
-        o.truth
-            .as_ref()
-            .map_or(String::new(), |t| format!(" --truth {}", t.display())),
-        out.display()
+        "Reproduce: `hpge-cv fit {}`\n",
+        o.reproduce_args(out).join(" ")
     );
     let _ = writeln!(r, "## Convergence\n");
     let _ = writeln!(
         r,
-        "**{}** after {:.1} s ({:.1} s tuning, {} cycles{}): {} kept draws per chain, stop reason `{:?}`; targets R-hat <= {} and bulk and tail ESS >= {}. Acceptance per chain: {}. Divergent transitions: {}. Log-density evaluations: {}. Smallest bulk ESS per second: {:.0}.\n",
+        "**{}** after {:.1} s ({:.1} s tuning, {} cycles{}): {} kept draws per chain, stop reason `{:?}`; targets R-hat <= {} and bulk and tail ESS >= {}. {} per chain: {}. Divergent transitions: {}. Log-density evaluations: {}. Smallest bulk ESS per second: {}.\n",
         if sm.converged {
             "Converged"
         } else {
@@ -93,6 +93,10 @@ pub fn write_report(
         sm.stop,
         sm.settings.rhat_max,
         sm.settings.ess_min,
+        match sm.settings.sampler {
+            hpge_inference::SamplerKind::Nuts => "Non-divergent fraction of transitions",
+            hpge_inference::SamplerKind::Metropolis => "Acceptance",
+        },
         sm.acceptance
             .iter()
             .map(|a| format!("{a:.3}"))
@@ -100,7 +104,7 @@ pub fn write_report(
             .join(", "),
         sm.divergences,
         sm.evaluations,
-        sm.ess_bulk_per_second
+        per_second(sm.ess_bulk_per_second)
     );
     let _ = writeln!(r, "## Parameters\n");
     let _ = writeln!(
@@ -345,4 +349,18 @@ pub fn write_report(
         "Files: `samples.csv` (chain, draw, parameters, ln posterior), `summary.json`, `predictive.csv` (c_p - c_m bands per voltage), `zeta-mode.csv` (zeta at the global mode, the posterior's 68.3% and 95.5% bands, the truth where given), `figures/`; after refinement `error-model.json` (the error model's exact curves and hyperparameters) and `rounds/` (each round's check and exact curves, what a restarted fit takes back)."
     );
     std::fs::write(path, r).map_err(Error::io(path, "cannot write"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::per_second;
+
+    #[test]
+    fn rates_keep_three_figures_below_a_hundred() {
+        assert_eq!(per_second(200.89), "201");
+        assert_eq!(per_second(36.83), "36.8");
+        assert_eq!(per_second(1.834), "1.83");
+        assert_eq!(per_second(0.019_275), "0.0193");
+        assert_eq!(per_second(0.0), "0");
+    }
 }
