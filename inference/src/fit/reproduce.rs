@@ -23,22 +23,19 @@ impl FitOptions {
         push("--sampler", self.sampler.clone());
         push("--seed", self.seed.to_string());
         push("--likelihood", self.likelihood.clone());
-        let numbers: [(&str, f64, f64); 4] = [
+        for (flag, v, dv) in [
             ("--ess", self.ess, d.ess),
             ("--rhat", self.rhat, d.rhat),
             ("--max-seconds", self.max_seconds, d.max_seconds),
-            (
-                "--tolerance",
-                self.grid.tolerance.unwrap_or(f64::NAN),
-                f64::NAN,
-            ),
-        ];
-        for (flag, v, dv) in numbers {
-            if !v.is_nan() && v != dv {
+        ] {
+            if v != dv {
                 push(flag, v.to_string());
             }
         }
-        let counts: [(&str, usize, usize); 6] = [
+        if let Some(t) = self.grid.tolerance {
+            push("--tolerance", t.to_string());
+        }
+        for (flag, v, dv) in [
             ("--chains", self.chains, d.chains),
             ("--exact-draws", self.exact_draws, d.exact_draws),
             (
@@ -49,8 +46,7 @@ impl FitOptions {
             ("--exact-ascents", self.exact_ascents, d.exact_ascents),
             ("--refine-rounds", self.refine_rounds, d.refine_rounds),
             ("--mode-starts", self.mode_starts, d.mode_starts),
-        ];
-        for (flag, v, dv) in counts {
+        ] {
             if v != dv {
                 push(flag, v.to_string());
             }
