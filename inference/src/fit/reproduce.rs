@@ -146,4 +146,50 @@ mod tests {
         }
         assert!(!line.contains("--ess"), "{line}");
     }
+
+    /// The line is what the command line reads back to the same options.
+    #[cfg(feature = "clap")]
+    #[test]
+    fn the_line_parses_back_to_the_same_options() {
+        use clap::Parser;
+        #[derive(Parser)]
+        struct Fit {
+            #[command(flatten)]
+            o: FitOptions,
+        }
+        let o = FitOptions {
+            out: Some(PathBuf::from("out/x")),
+            sampler: "nuts".into(),
+            seed: 7,
+            ess: 400.0,
+            max_seconds: 90.5,
+            chains: 6,
+            exact_draws: 40,
+            refine_rounds: 3,
+            refine_variance: "local".into(),
+            truth: Some(PathBuf::from("t.toml")),
+            allow_exact_mismatch: true,
+            no_plots: true,
+            grid: hpge_solver::GridOverrides {
+                tolerance: Some(0.005),
+                grid: vec![("front_spacing_mm".into(), "0.1".into())],
+            },
+            ..FitOptions::default()
+        };
+        let args = o.reproduce_args(Path::new("out/x"));
+        let back = Fit::try_parse_from(std::iter::once("fit".to_string()).chain(args))
+            .expect("the line parses")
+            .o;
+        assert_eq!(back, o);
+        let plain = FitOptions {
+            out: Some(PathBuf::from("o")),
+            ..FitOptions::default()
+        };
+        let back = Fit::try_parse_from(
+            std::iter::once("fit".to_string()).chain(plain.reproduce_args(Path::new("o"))),
+        )
+        .expect("the line parses")
+        .o;
+        assert_eq!(back, plain);
+    }
 }
