@@ -4,6 +4,7 @@ use std::io::Write as _;
 
 use anyhow::{Context, Result};
 use hpge_inference::{CvModel, ExactModel};
+use hpge_validation::studies::coverage::TruthEvent;
 use hpge_validation::studies::coverage::store::{TruthStore, study_fingerprint};
 use hpge_validation::{
     CoverageModels, CoverageOptions, CoverageOutcome, CoverageRun, coverage as run_coverage,
@@ -88,6 +89,16 @@ pub fn coverage(o: &CoverageOptions, as_json: bool) -> Result<()> {
         CoverageRun {
             store: Some(&store),
             shard,
+            events: &|i, e| {
+                if let Some(line) = truth_event_line(i, &e) {
+                    let line = format!("[{:>7.0} s] {line}", bar.elapsed().as_secs_f64());
+                    if lines {
+                        eprintln!("{line}");
+                    } else {
+                        bar.println(line);
+                    }
+                }
+            },
         },
         &|done, total| {
             bar.set_length(total as u64);
@@ -223,4 +234,29 @@ pub fn coverage(o: &CoverageOptions, as_json: bool) -> Result<()> {
         std::process::exit(1);
     }
     Ok(())
+}
+
+/// The line a truth's event prints, if any: each round's start of the exact check and its end,
+/// and the exact check's curves in steps of a quarter.
+fn truth_event_line(i: usize, e: &TruthEvent) -> Option<String> {
+    match *e {
+        TruthEvent::Sampled { round } => Some(format!(
+            "truth {i}: round {round} sampled, exact check running"
+        )),
+        TruthEvent::Exact { done, total } => {
+            let quarter = total.div_ceil(4).max(1);
+            (done > 0 && (done % quarter == 0 || done == total))
+                .then(|| format!("truth {i}: {done}/{total} exact curves"))
+        }
+        TruthEvent::Round(r) => Some(format!(
+            "truth {i}: round {} {}: k-hat {:.2}, largest shift {:.2} sd, {} (sampling {:.0} s, exact {:.0} s)",
+            r.round,
+            if r.resumed { "taken back" } else { "ended" },
+            r.pareto_k,
+            r.max_abs_shift_sd,
+            if r.pass { "pass" } else { "fail" },
+            r.sampling_seconds,
+            r.exact_seconds
+        )),
+    }
 }

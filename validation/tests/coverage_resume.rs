@@ -8,8 +8,8 @@ use hpge_inference::fit::{ExactCheckSettings, ExactGrids, FitSettings, RefineSet
 use hpge_inference::sampler::{SampleSettings, SamplerKind};
 use hpge_inference::{CvData, CvModel, Likelihood, NoiseSettings, Prior, PriorSpec, Result};
 use hpge_surrogate::Shard;
-use hpge_validation::studies::coverage::PipelineSettings;
 use hpge_validation::studies::coverage::store::TruthStore;
+use hpge_validation::studies::coverage::{PipelineSettings, TruthEvent, TruthEvents};
 use hpge_validation::{
     CoverageModels, CoverageOutcome, CoverageReport, CoverageRun, CoverageSettings, coverage,
 };
@@ -120,13 +120,28 @@ fn run(
     store: Option<&TruthStore>,
     shard: Shard,
 ) -> CoverageOutcome {
+    run_telling(models, s, store, shard, &|_, _| {})
+}
+
+/// [`run`] with each truth's events going to `events`.
+fn run_telling(
+    models: CoverageModels,
+    s: &CoverageSettings,
+    store: Option<&TruthStore>,
+    shard: Shard,
+    events: TruthEvents,
+) -> CoverageOutcome {
     let p = prior(models.data);
     coverage(
         models,
         &p,
         &template(),
         s,
-        CoverageRun { store, shard },
+        CoverageRun {
+            store,
+            shard,
+            events,
+        },
         &|_, _| {},
     )
     .unwrap()
@@ -197,13 +212,36 @@ fn a_study_resumes_extends_shards_and_never_mixes_runs() {
     };
     let plain = done(run(on_exact, &settings(3, None), None, Shard::WHOLE));
     assert!(plain.exact_check.is_none());
-    let full = done(run(
+    // Each truth tells its rounds as they go: (sampled, rounds ended, exact checks completed).
+    let told = std::sync::Mutex::new((0usize, 0usize, 0usize));
+    let full = done(run_telling(
         on_exact,
         &settings(3, Some(pipeline())),
         None,
         Shard::WHOLE,
+        &|i, e| {
+            assert!(i < 3, "truth {i}");
+            let mut t = told.lock().unwrap();
+            match e {
+                TruthEvent::Sampled { .. } => t.0 += 1,
+                TruthEvent::Round(r) => {
+                    assert!(!r.resumed);
+                    t.1 += 1;
+                }
+                TruthEvent::Exact { done, total } => {
+                    assert!(done <= total, "{done}/{total}");
+                    t.2 += usize::from(done == total);
+                }
+            }
+        },
     ));
     let tally = full.exact_check.expect("the pipeline's checks");
+    let rounds = (tally.rounds_mean * 3.0).round() as usize;
+    assert_eq!(
+        *told.lock().unwrap(),
+        (rounds, rounds, rounds),
+        "one sampling, one completed check and one end per round"
+    );
     eprintln!("{tally:?}");
     assert_eq!(tally.passed + tally.failed, 3, "{tally:?}");
     assert!(tally.rounds_max >= 1 && tally.rounds_max <= 3, "{tally:?}");

@@ -21,8 +21,8 @@ mod truth;
 
 pub use settings::{COVERAGE_LEVELS, CoverageSettings, PipelineSettings};
 use store::{SecondsSplit, TruthCheck, TruthFit, TruthStore};
-pub use truth::CoverageModels;
-use truth::fit_truth;
+pub use truth::{CoverageModels, TruthEvent, TruthEvents};
+use truth::{TruthIo, fit_truth};
 
 use crate::error::Result;
 
@@ -242,6 +242,8 @@ pub struct CoverageRun<'a> {
     pub store: Option<&'a TruthStore>,
     /// This process's share of the truths.
     pub shard: Shard,
+    /// Each truth's progress inside its full-pipeline fit (rounds, exact curves).
+    pub events: TruthEvents<'a>,
 }
 
 /// Runs the study (see the module text): `models.data` simulates the data with `template`'s
@@ -289,8 +291,11 @@ pub fn coverage(
                 prior,
                 template,
                 settings,
-                fingerprint,
-                rounds.as_deref(),
+                TruthIo {
+                    fingerprint,
+                    rounds: rounds.as_deref(),
+                    events: run.events,
+                },
             )?;
             if let Some(s) = run.store {
                 s.save(&t)?;

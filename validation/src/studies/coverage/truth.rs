@@ -6,7 +6,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use hpge_inference::fit::{
-    Checkpoint, RefineInputs, RefineProgress, Resume, draw_range,
+    Checkpoint, RefineInputs, RefineProgress, RefineRound, Resume, draw_range,
     fingerprint as checkpoint_fingerprint, refine_fit,
 };
 use hpge_inference::summary::{interval_contains, smallest_intervals};
@@ -33,16 +33,49 @@ pub struct CoverageModels<'a> {
     pub data_sigma_rel: f64,
 }
 
+/// What a truth's full-pipeline fit reports as it goes: with exact data one truth takes minutes
+/// to hours, most of it in the exact check's curves.
+#[derive(Debug, Clone, Copy)]
+pub enum TruthEvent<'a> {
+    /// A round's sampling ended and its exact check starts.
+    Sampled {
+        /// The round (0: the plain surrogate).
+        round: usize,
+    },
+    /// Exact curves of the running check done, of `total`.
+    Exact {
+        /// Curves done.
+        done: usize,
+        /// Curves of this check.
+        total: usize,
+    },
+    /// A round ended (taken back from a saved round, or run).
+    Round(&'a RefineRound),
+}
+
+/// Receives truth `i`'s events ([`TruthEvent`]).
+pub type TruthEvents<'a> = &'a (dyn Fn(usize, TruthEvent) + Sync);
+
+/// What a truth's fit is tied to outside itself: the study's fingerprint, the folder its
+/// finished rounds go to (None: not written) and where its events go.
+#[derive(Clone, Copy)]
+pub(super) struct TruthIo<'a> {
+    pub(super) fingerprint: &'a str,
+    pub(super) rounds: Option<&'a Path>,
+    pub(super) events: TruthEvents<'a>,
+}
+
 /// The seed of truth `i`'s draw and noise (the fit uses seed + i + 1).
 fn truth_seed(seed: u64, i: usize) -> u64 {
     seed.wrapping_mul(0x2545_F491_4F6C_DD1D) ^ i as u64
 }
 
 /// Truth `i` of the study: drawn, simulated, fitted and ranked. A truth whose data curve fails
-/// recoverably comes back with `skipped` set. With the full pipeline and a `rounds` folder the
-/// fit writes each finished round there and takes back those an interrupted run of the same
+/// recoverably comes back with `skipped` set. With the full pipeline and a `rounds` folder in `io`
+/// the fit writes each finished round there and takes back those an interrupted run of the same
 /// study and truth left (`hpge_inference::fit::Checkpoint`; the seeded sampler makes the
-/// result the same as an uninterrupted fit's).
+/// result the same as an uninterrupted fit's); its rounds and exact curves go to `io.events`
+/// as they finish.
 ///
 /// # Errors
 /// Any other model error, a fit or refinement that fails.
@@ -52,9 +85,13 @@ pub(super) fn fit_truth(
     prior: &Prior,
     template: &Likelihood,
     settings: &CoverageSettings,
-    fingerprint: &str,
-    rounds: Option<&Path>,
+    io: TruthIo,
 ) -> Result<TruthFit> {
+    let TruthIo {
+        fingerprint,
+        rounds,
+        events,
+    } = io;
     let start = Instant::now();
     let nv = template.len();
     let mut rng = StdRng::seed_from_u64(truth_seed(settings.seed, i));
@@ -128,13 +165,22 @@ pub(super) fn fit_truth(
                 saved: saved.unwrap_or_default(),
                 checkpoint,
             });
+            let sampled = |round| events(i, TruthEvent::Sampled { round });
+            let exact = |done, total| events(i, TruthEvent::Exact { done, total });
+            let round = |r: &RefineRound| events(i, TruthEvent::Round(r));
+            let progress = RefineProgress {
+                sampled: &sampled,
+                exact: &exact,
+                round: &round,
+                ..RefineProgress::quiet()
+            };
             let r = refine_fit(
                 m,
                 &fs,
                 &p.check,
                 &p.refine,
                 &Default::default(),
-                RefineProgress::quiet(),
+                progress,
                 resume,
             )?;
             record.check = r.fit.summary.exact_check.as_ref().map(|c| TruthCheck {
