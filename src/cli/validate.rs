@@ -260,3 +260,38 @@ fn truth_event_line(i: usize, e: &TruthEvent) -> Option<String> {
         )),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_truth_prints_its_exact_curves_by_quarters_and_each_round() {
+        let exact = |done| truth_event_line(7, &TruthEvent::Exact { done, total: 104 });
+        let printed: Vec<usize> = (0..=104).filter(|&d| exact(d).is_some()).collect();
+        assert_eq!(printed, [26, 52, 78, 104]);
+        assert_eq!(exact(52).as_deref(), Some("truth 7: 52/104 exact curves"));
+        let r = hpge_inference::fit::RefineRound {
+            round: 1,
+            training_curves: 104,
+            pareto_k: 0.29,
+            max_abs_shift_sd: 0.081,
+            max_rel_diff_at_mode: 0.0019,
+            pass: true,
+            sampling_seconds: 74.7,
+            exact_seconds: 129.3,
+            error_model_seconds: 1.0,
+            resumed: true,
+            stopped: None,
+            local_mode_curves: 3,
+            better_basin: None,
+            variance_at: None,
+        };
+        assert_eq!(
+            truth_event_line(7, &TruthEvent::Round(&r)).as_deref(),
+            Some(
+                "truth 7: round 1 taken back: k-hat 0.29, largest shift 0.08 sd, pass (sampling 75 s, exact 129 s)"
+            )
+        );
+    }
+}
