@@ -386,11 +386,7 @@ fn summarise(truths: &[&TruthFit], prior: &Prior, l: usize) -> CoverageReport {
         seconds_split: checks
             .iter()
             .filter_map(|c| c.seconds_split)
-            .reduce(|a, b| SecondsSplit {
-                sampling: a.sampling + b.sampling,
-                exact: a.exact + b.exact,
-                error_model: a.error_model + b.error_model,
-            }),
+            .reduce(|a, b| a + b),
         split_truths: checks.iter().filter(|c| c.seconds_split.is_some()).count(),
     });
     CoverageReport {

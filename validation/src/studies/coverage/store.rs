@@ -64,6 +64,29 @@ pub struct SecondsSplit {
     pub error_model: f64,
 }
 
+impl SecondsSplit {
+    /// One refinement round's split.
+    pub fn of(r: &hpge_inference::fit::RefineRound) -> Self {
+        Self {
+            sampling: r.sampling_seconds,
+            exact: r.exact_seconds,
+            error_model: r.error_model_seconds,
+        }
+    }
+}
+
+impl std::ops::Add for SecondsSplit {
+    type Output = Self;
+
+    fn add(self, o: Self) -> Self {
+        Self {
+            sampling: self.sampling + o.sampling,
+            exact: self.exact + o.exact,
+            error_model: self.error_model + o.error_model,
+        }
+    }
+}
+
 /// One truth of a study as written.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct TruthFit {

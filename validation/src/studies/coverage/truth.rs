@@ -188,11 +188,7 @@ pub(super) fn fit_truth(
                 rounds: r.rounds.len(),
                 pareto_k: c.pareto_k,
                 max_abs_shift_sd: c.max_abs_shift_sd,
-                seconds_split: Some(SecondsSplit {
-                    sampling: r.rounds.iter().map(|k| k.sampling_seconds).sum(),
-                    exact: r.rounds.iter().map(|k| k.exact_seconds).sum(),
-                    error_model: r.rounds.iter().map(|k| k.error_model_seconds).sum(),
-                }),
+                seconds_split: r.rounds.iter().map(SecondsSplit::of).reduce(|a, b| a + b),
             });
             r.fit
         }
