@@ -11,12 +11,13 @@
 //! * axial edge (i, j)-(i, j+1), per adjacent cell half-annulus:
 //!   w = eps pi (r_outer^2 - r_inner^2) / (z_{j+1} - z_j);
 //!
-//! and the fixed space charge Q_n = q zeta(r_i, z_j) V_n, V_n the semiconductor part of the
-//! control volume (2 pi r carried exactly: quadrant volumes pi (r_b^2 - r_a^2) dz).
+//! and the fixed space charge Q_n = q int zeta dV over the semiconductor part V_n of the control
+//! volume (`field::space_charge`: a quadratic rule per cell quadrant, 2 pi r carried, exact
+//! volumes pi (r_b^2 - r_a^2) dz for a constant density).
 //! Reflecting world sides need nothing (no flux leaves through them); the axis is a reflecting
 //! line by symmetry.
 
-use crate::constants::{CM3_TO_M3, ELEMENTARY_CHARGE_C, VACUUM_PERMITTIVITY_F_PER_M};
+use crate::constants::VACUUM_PERMITTIVITY_F_PER_M;
 use crate::detector::{BoundaryKind, Detector, PassiveKind, Region, WorldSide};
 use crate::grid::Grid;
 
@@ -144,18 +145,7 @@ impl Mesh {
                 }
             }
         }
-        let model = det.impurity();
-        let charge_c = (0..nr * nz)
-            .map(|n| {
-                if vol[n] > 0.0 {
-                    let (i, j) = (n % nr, n / nr);
-                    let zeta = model.density_cm3(grid.r_mm()[i], grid.z_mm()[j]);
-                    ELEMENTARY_CHARGE_C * zeta * CM3_TO_M3 * vol[n]
-                } else {
-                    0.0
-                }
-            })
-            .collect();
+        let charge_c = super::space_charge::space_charge_c(&grid, &semi, det.impurity());
         Self {
             grid,
             kind,

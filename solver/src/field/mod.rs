@@ -21,6 +21,7 @@ mod report;
 mod round;
 mod settings;
 pub(crate) mod sor;
+mod space_charge;
 mod system;
 mod union_find;
 mod weighting;
