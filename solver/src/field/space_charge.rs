@@ -43,7 +43,7 @@ pub(crate) fn space_charge_c(grid: &Grid, semi: &[bool], model: &dyn ImpurityMod
     // The doubled grid: index 2i is tick i, 2i + 1 the middle of interval i.
     let (nr2, nz2) = (2 * nr - 1, 2 * nz - 1);
     let at = |t: &[f64], k: usize| {
-        if k % 2 == 0 {
+        if k.is_multiple_of(2) {
             t[k / 2]
         } else {
             0.5 * (t[k / 2] + t[k / 2 + 1])
