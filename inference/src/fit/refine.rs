@@ -426,7 +426,8 @@ impl FitJob {
 
     /// The fingerprint of a refined fit of this job with these settings
     /// ([`super::checkpoint::fingerprint`]): its inputs with their hashes, the sampler and
-    /// likelihood settings, the check's settings, the refinement's and the exact solver's.
+    /// likelihood settings, the check's settings, the refinement's and the exact solver's
+    /// (its settings and `hpge_solver::field::PHYSICS_REVISION`).
     pub fn fingerprint(
         &self,
         settings: &FitSettings,
@@ -440,6 +441,7 @@ impl FitJob {
             format!("{:?}", refine.hyper_evals),
             format!("{:?}", refine.variance),
             format!("{:?}", self.exact.settings),
+            hpge_solver::field::PHYSICS_REVISION.to_string(),
         ])
     }
 }

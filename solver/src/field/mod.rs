@@ -26,6 +26,13 @@ mod system;
 mod union_find;
 mod weighting;
 
+/// Names the solver's physics: changed whenever a change of the solver moves computed numbers
+/// (potentials, c12) beyond round-off, so that resumable runs built on exact solves (a fit's
+/// refinement rounds, the exact-data coverage study) never mix answers of two solvers. History:
+/// 2026-11-29, the space charge integrated over each control volume (`field::space_charge`;
+/// before it, zeta at the node times the node's volume: files of that solver carry no name).
+pub const PHYSICS_REVISION: &str = "2026-11-29 integrated space charge";
+
 pub use adaptive::Accuracy;
 pub use capacitance::CapacitanceMatrix;
 pub use charge::{contact_charge_c, quasi_static_c12_pf};

@@ -115,7 +115,8 @@ pub struct TruthFit {
 }
 
 /// The fingerprint of a study: its inputs (files with their hashes), where its data come from
-/// and its settings without the number of truths (so a study can be extended).
+/// (with `hpge_solver::field::PHYSICS_REVISION` for exact data) and its settings without the
+/// number of truths (so a study can be extended).
 pub fn study_fingerprint(
     inputs: &BTreeMap<String, String>,
     data_from: &str,
@@ -123,6 +124,10 @@ pub fn study_fingerprint(
 ) -> String {
     let mut parts: Vec<String> = inputs.iter().map(|(k, v)| format!("{k}={v}")).collect();
     parts.push(format!("data_from={data_from}"));
+    if data_from == "exact" {
+        // Exact data and exact checks: answers of two solvers never mix.
+        parts.push(format!("solver={}", hpge_solver::field::PHYSICS_REVISION));
+    }
     let mut s = serde_json::to_value(settings).unwrap_or_default();
     if let Some(o) = s.as_object_mut() {
         o.remove("n_truths");
