@@ -254,7 +254,14 @@ fn truth_event_line(i: usize, e: &TruthEvent) -> Option<String> {
             if r.resumed { "taken back" } else { "ended" },
             r.pareto_k,
             r.max_abs_shift_sd,
-            if r.pass { "pass" } else { "fail" },
+            match (r.pass, &r.better_basin) {
+                (true, _) => "pass".to_string(),
+                (false, Some(b)) => format!(
+                    "fail (an exact ascent found a better basin: ln p {:+.1})",
+                    b.ln_posterior_exact - b.ln_posterior_exact_at_mode
+                ),
+                (false, None) => "fail".to_string(),
+            },
             r.sampling_seconds,
             r.exact_seconds
         )),
@@ -291,6 +298,26 @@ mod tests {
             truth_event_line(7, &TruthEvent::Round(&r)).as_deref(),
             Some(
                 "truth 7: round 1 taken back: k-hat 0.29, largest shift 0.08 sd, pass (sampling 75 s, exact 129 s)"
+            )
+        );
+        // Inside both limits, failed by a better basin: the line says so.
+        let basin = hpge_inference::fit::RefineRound {
+            pass: false,
+            resumed: false,
+            better_basin: Some(hpge_inference::fit::BasinAscent {
+                start: vec![0.1],
+                theta: vec![0.2],
+                ln_posterior_exact: -10.0,
+                ln_posterior_exact_at_mode: -13.25,
+                evaluations: 40,
+                better: true,
+            }),
+            ..r
+        };
+        assert_eq!(
+            truth_event_line(7, &TruthEvent::Round(&basin)).as_deref(),
+            Some(
+                "truth 7: round 1 ended: k-hat 0.29, largest shift 0.08 sd, fail (an exact ascent found a better basin: ln p +3.2) (sampling 75 s, exact 129 s)"
             )
         );
     }
