@@ -113,7 +113,7 @@ pub fn coverage(o: &CoverageOptions, as_json: bool) -> Result<()> {
     )?;
     bar.finish_and_clear();
     let report = match outcome {
-        CoverageOutcome::Done(r) => r,
+        CoverageOutcome::Done(r) => *r,
         CoverageOutcome::Partial { done, total } => {
             println!(
                 "shard {}/{} done; {done} of {total} truths of the study in {}: the report is \
@@ -181,6 +181,7 @@ pub fn coverage(o: &CoverageOptions, as_json: bool) -> Result<()> {
             })).collect::<Vec<_>>(),
             "pass": report.pass,
             "unconverged": report.unconverged,
+            "unconverged_sampler": report.unconverged_sampler,
             "skipped": report.skipped,
             "seconds": report.seconds,
             "resumed": report.resumed,
@@ -199,6 +200,12 @@ pub fn coverage(o: &CoverageOptions, as_json: bool) -> Result<()> {
             report.truth_seconds,
             if report.pass { "PASS" } else { "FAIL" }
         );
+        if let Some(u) = &report.unconverged_sampler {
+            println!(
+                "unconverged fits recording their sampler: {} ({} at the draw cap, {} at the clock); smallest ESS {:.0}, largest R-hat {:.4}",
+                u.recorded, u.max_draws, u.max_seconds, u.ess_min, u.rhat_max
+            );
+        }
         if let Some(c) = &report.exact_check {
             println!(
                 "exact check of the fits: {} passed, {} failed after refinement; {:.2} rounds per fit on average, at most {}",

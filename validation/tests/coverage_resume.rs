@@ -149,7 +149,7 @@ fn run_telling(
 
 fn done(o: CoverageOutcome) -> CoverageReport {
     match o {
-        CoverageOutcome::Done(r) => r,
+        CoverageOutcome::Done(r) => *r,
         CoverageOutcome::Partial { done, total } => panic!("partial: {done} of {total}"),
     }
 }

@@ -19,8 +19,9 @@ mod settings;
 pub mod store;
 mod truth;
 
+use hpge_inference::sampler::SamplerStop;
 pub use settings::{COVERAGE_LEVELS, CoverageSettings, PipelineSettings};
-use store::{SecondsSplit, TruthCheck, TruthFit, TruthStore};
+use store::{SecondsSplit, TruthCheck, TruthFit, TruthSampler, TruthStore};
 pub use truth::{CoverageModels, TruthEvent, TruthEvents};
 use truth::{TruthIo, fit_truth};
 
@@ -95,6 +96,9 @@ pub struct CoverageReport {
     pub ranks: usize,
     /// Fits that did not reach their R-hat/ESS targets (kept in the study).
     pub unconverged: usize,
+    /// How far the unconverged fits that record their sampler got (absent when none does).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub unconverged_sampler: Option<UnconvergedTally>,
     /// Truths dropped because the data model failed there (exact solver: no c12).
     pub skipped: usize,
     /// Nominal levels of `coverage_curve`.
@@ -110,6 +114,41 @@ pub struct CoverageReport {
     /// With the full pipeline: how the fits' exact checks ended.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub exact_check: Option<CheckTally>,
+}
+
+/// How far a study's unconverged fits got (those whose records say how their sampler ended).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct UnconvergedTally {
+    /// Unconverged fits that record their sampler.
+    pub recorded: usize,
+    /// Of these, stopped by the draw cap.
+    pub max_draws: usize,
+    /// Of these, stopped by the clock.
+    pub max_seconds: usize,
+    /// The smallest ESS (bulk or tail, any parameter) among them.
+    pub ess_min: f64,
+    /// The largest R-hat among them.
+    pub rhat_max: f64,
+}
+
+impl UnconvergedTally {
+    /// The tally over `fits`' unconverged records with a sampler (None when there is none).
+    fn of<'a>(fits: impl Iterator<Item = &'a TruthFit>) -> Option<Self> {
+        let s: Vec<TruthSampler> = fits
+            .filter(|t| !t.converged)
+            .filter_map(|t| t.sampler)
+            .collect();
+        (!s.is_empty()).then(|| Self {
+            recorded: s.len(),
+            max_draws: s.iter().filter(|x| x.stop == SamplerStop::MaxDraws).count(),
+            max_seconds: s
+                .iter()
+                .filter(|x| x.stop == SamplerStop::MaxSeconds)
+                .count(),
+            ess_min: s.iter().map(|x| x.ess_min).fold(f64::INFINITY, f64::min),
+            rhat_max: s.iter().map(|x| x.rhat_max).fold(0.0, f64::max),
+        })
+    }
 }
 
 /// How the exact checks of a study's fits ended (studies with the full pipeline).
@@ -225,7 +264,7 @@ fn ln_gamma(x: f64) -> f64 {
 #[derive(Debug, Clone, PartialEq)]
 pub enum CoverageOutcome {
     /// Every truth is done: the study's result.
-    Done(CoverageReport),
+    Done(Box<CoverageReport>),
     /// This shard's truths are done, others' not yet.
     Partial {
         /// Truths done (by any shard).
@@ -330,7 +369,7 @@ pub fn coverage(
     let mut report = summarise(&truths, prior, settings.ranks);
     report.resumed = resumed;
     report.seconds = start.elapsed().as_secs_f64();
-    Ok(CoverageOutcome::Done(report))
+    Ok(CoverageOutcome::Done(Box::new(report)))
 }
 
 /// The study's statistics over its truths (skipped ones left out).
@@ -395,6 +434,7 @@ fn summarise(truths: &[&TruthFit], prior: &Prior, l: usize) -> CoverageReport {
         pass,
         ranks: l,
         unconverged: kept.iter().filter(|t| !t.converged).count(),
+        unconverged_sampler: UnconvergedTally::of(kept.iter().copied()),
         skipped: truths.len() - m,
         levels: COVERAGE_LEVELS.to_vec(),
         seconds: 0.0,
@@ -456,5 +496,43 @@ mod tests {
             "{lo} {hi}"
         );
         assert!((ln_gamma(10.0) - 362_880f64.ln()).abs() < 1e-12);
+    }
+
+    #[test]
+    fn unconverged_tally_counts_only_unconverged_fits_that_record_their_sampler() {
+        let fit = |converged: bool, sampler: Option<TruthSampler>| TruthFit {
+            fingerprint: String::new(),
+            index: 0,
+            truth: vec![],
+            skipped: None,
+            ranks: vec![],
+            jitter: vec![],
+            inside: vec![],
+            converged,
+            sampler,
+            check: None,
+            seconds: 0.0,
+        };
+        let s = |stop, ess_min, rhat_max| TruthSampler {
+            stop,
+            draws_per_chain: 20_000,
+            rhat_max,
+            ess_min,
+        };
+        let fits = [
+            fit(true, Some(s(SamplerStop::Converged, 900.0, 1.001))),
+            fit(false, None),
+            fit(false, Some(s(SamplerStop::MaxDraws, 240.0, 1.004))),
+            fit(false, Some(s(SamplerStop::MaxSeconds, 120.0, 1.02))),
+        ];
+        let t = UnconvergedTally::of(fits.iter()).expect("two records");
+        assert_eq!((t.recorded, t.max_draws, t.max_seconds), (2, 1, 1));
+        assert_eq!((t.ess_min, t.rhat_max), (120.0, 1.02));
+        assert!(UnconvergedTally::of(fits[..2].iter()).is_none());
+        // A record written before the field existed reads back without it.
+        let old = serde_json::to_string(&fits[1]).expect("serialise");
+        assert!(!old.contains("sampler"));
+        let back: TruthFit = serde_json::from_str(&old).expect("read back");
+        assert_eq!(back, fits[1]);
     }
 }

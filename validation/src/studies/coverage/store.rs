@@ -18,6 +18,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use hpge_inference::fit::{fingerprint, folder_files, remove_stale, write_whole};
+use hpge_inference::sampler::SamplerStop;
 use hpge_surrogate::Shard;
 use hpge_surrogate::generate::FolderLock;
 use serde::{Deserialize, Serialize};
@@ -51,6 +52,22 @@ pub struct TruthCheck {
     /// written before 2026-11-29.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub seconds_split: Option<SecondsSplit>,
+}
+
+/// How one truth's sampler ended: why it stopped and how far its least-mixed parameter got
+/// (with the targets, what "unconverged" means for this truth).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct TruthSampler {
+    /// Why sampling stopped (targets reached, the draw cap or the clock).
+    pub stop: SamplerStop,
+    /// Kept draws per chain.
+    pub draws_per_chain: usize,
+    /// The largest rank-normalised split R-hat over the parameters.
+    #[serde(deserialize_with = "hpge_inference::fit::f64_or_nan")]
+    pub rhat_max: f64,
+    /// The smallest of every parameter's bulk and tail ESS.
+    #[serde(deserialize_with = "hpge_inference::fit::f64_or_nan")]
+    pub ess_min: f64,
 }
 
 /// A pipeline fit's wall time by part, s (sums of [`hpge_inference::fit::RefineRound`]'s).
@@ -107,6 +124,9 @@ pub struct TruthFit {
     pub inside: Vec<Vec<bool>>,
     /// Whether the fit reached its R-hat and ESS targets.
     pub converged: bool,
+    /// How its sampler ended. Absent in records written before 2026-11-29 (afternoon).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sampler: Option<TruthSampler>,
     /// The exact check of a study with refinement.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub check: Option<TruthCheck>,

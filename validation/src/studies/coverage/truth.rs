@@ -16,7 +16,7 @@ use rand::SeedableRng;
 use rand::rngs::StdRng;
 
 use super::settings::{COVERAGE_LEVELS, CoverageSettings};
-use super::store::{SecondsSplit, TruthCheck, TruthFit};
+use super::store::{SecondsSplit, TruthCheck, TruthFit, TruthSampler};
 use crate::error::Result;
 
 /// The models of a study.
@@ -105,6 +105,7 @@ pub(super) fn fit_truth(
         jitter: Vec::new(),
         inside: Vec::new(),
         converged: false,
+        sampler: None,
         check: None,
         seconds: 0.0,
     };
@@ -214,6 +215,16 @@ pub(super) fn fit_truth(
         );
     }
     record.converged = f.summary.converged;
+    let dg = &f.samples.diagnostics;
+    record.sampler = Some(TruthSampler {
+        stop: f.samples.stop,
+        draws_per_chain: f.samples.chains.first().map_or(0, |c| c.theta.len()),
+        rhat_max: dg.iter().map(|x| x.rhat).fold(f64::NAN, f64::max),
+        ess_min: dg
+            .iter()
+            .map(|x| x.ess_bulk.min(x.ess_tail))
+            .fold(f64::NAN, f64::min),
+    });
     record.seconds = start.elapsed().as_secs_f64();
     Ok(record)
 }
