@@ -25,9 +25,10 @@ $B fit --prior priors/b-z.toml --sampler nuts --no-exact-check --out reports/fit
 $B fit --prior priors/b-rz.toml --truth $T --sampler nuts --no-exact-check --max-seconds 120 \
   --out reports/fits/b-rz-nuts || true
 # The coverage studies (reports/coverage/), each resuming per truth when started again:
-# about 40 min (B_RZ, surrogate data, 200 truths) and 8-60 min per truth with exact data on
-# 2 cores (the full pipeline of `fit`, refinement included, almost all of it exact solves; 100
-# truths, 20-60 h: run it across sessions or machines with --shard K/M; it resumes inside a truth):
+# about 40 min (B_RZ, surrogate data, 200 truths) and, with exact data, about 6-7 min of one
+# core per truth on the solver of 2026-11-29 (the full pipeline of `fit`, refinement included,
+# most of it exact solves; two truths run side by side on 2 cores, so 100 truths take about
+# 5.5 h; run it across sessions or machines with --shard K/M; it resumes inside a truth):
 #   $B validate coverage --truths 200 --prior priors/b-rz.toml --out reports/coverage/b-rz
 #   $B validate coverage --truths 100 --prior priors/b-rz.toml --exact --out reports/coverage/b-rz-exact
 #   $B validate coverage --truths 200 --prior priors/b-z.toml --out reports/coverage/b-z
