@@ -5,7 +5,7 @@
 use std::path::{Path, PathBuf};
 
 use hpge_inference::fit::{ExactCheckSettings, ExactGrids, FitSettings, RefineSettings};
-use hpge_inference::sampler::{SampleSettings, SamplerKind};
+use hpge_inference::sampler::{SampleSettings, SamplerKind, SamplerStop};
 use hpge_inference::{CvData, CvModel, Likelihood, NoiseSettings, Prior, PriorSpec, Result};
 use hpge_surrogate::Shard;
 use hpge_validation::studies::coverage::store::TruthStore;
@@ -174,8 +174,18 @@ fn a_study_resumes_extends_shards_and_never_mixes_runs() {
     assert_eq!((first.n_truths, first.resumed), (5, 0));
     let files = std::fs::read_dir(out.join("truths")).unwrap().count();
     assert_eq!(files, 5);
+    // Each truth's file says how its sampler ended, in agreement with its converged flag.
+    for t in store.load().unwrap().values() {
+        let s = t.sampler.expect("every new truth records its sampler");
+        assert_eq!(t.converged, s.stop == SamplerStop::Converged, "{s:?}");
+        assert!(s.draws_per_chain > 0 && s.ess_min > 0.0 && s.rhat_max.is_finite());
+    }
     let extended = done(run(models, &settings(8, None), Some(&store), Shard::WHOLE));
     assert_eq!((extended.n_truths, extended.resumed), (8, 5));
+    assert_eq!(
+        extended.unconverged_sampler.map_or(0, |u| u.recorded),
+        extended.unconverged
+    );
     assert_eq!(extended.parameters, whole.parameters);
     // A second process on the same shard of the folder is refused while the first holds it.
     assert!(TruthStore::open(&out, "run-a".into(), Shard::WHOLE).is_err());
