@@ -40,6 +40,11 @@ impl Diagnostics {
         }
     }
 
+    /// The smaller of the bulk and tail ESS.
+    pub fn ess_min(&self) -> f64 {
+        self.ess_bulk.min(self.ess_tail)
+    }
+
     /// R-hat <= `rhat_max` and both ESS >= `ess_min`.
     pub fn converged(&self, rhat_max: f64, ess_min: f64) -> bool {
         self.rhat <= rhat_max && self.ess_bulk >= ess_min && self.ess_tail >= ess_min

@@ -137,7 +137,7 @@ pub fn fit(
         let range = draw_range(&all, p.support);
         let dg = samples.diagnostics[j];
         // The histogram's counting noise is that of the chains' effective draws.
-        let ess = dg.ess_bulk.min(dg.ess_tail);
+        let ess = dg.ess_min();
         let si = smallest_intervals(&all, None, Some(ess), range, settings.bins, &LEVELS);
         let width = (range[1] - range[0]) / settings.bins as f64;
         let si: Vec<Vec<[f64; 2]>> = si.into_iter().map(|v| close_gaps(v, 2.0 * width)).collect();

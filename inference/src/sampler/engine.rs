@@ -101,7 +101,7 @@ pub(super) fn finish(
         let rhat = diagnostics.iter().map(|x| x.rhat).fold(0.0, f64::max);
         let ess = diagnostics
             .iter()
-            .map(|x| x.ess_bulk.min(x.ess_tail))
+            .map(|x| x.ess_min())
             .fold(f64::INFINITY, f64::min);
         let seconds = start.elapsed().as_secs_f64();
         let draws = chains[0].theta.len();

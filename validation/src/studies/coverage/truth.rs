@@ -206,7 +206,7 @@ pub(super) fn fit_truth(
         let range = draw_range(&draws, p.support);
         // As the fit's summary: the histogram's noise is that of the chains' effective draws.
         let dg = f.samples.diagnostics[j];
-        let ess = dg.ess_bulk.min(dg.ess_tail);
+        let ess = dg.ess_min();
         let si = smallest_intervals(&draws, None, Some(ess), range, fs.bins, &COVERAGE_LEVELS);
         record.inside.push(
             si.iter()
@@ -220,10 +220,7 @@ pub(super) fn fit_truth(
         stop: f.samples.stop,
         draws_per_chain: f.samples.chains.first().map_or(0, |c| c.theta.len()),
         rhat_max: dg.iter().map(|x| x.rhat).fold(f64::NAN, f64::max),
-        ess_min: dg
-            .iter()
-            .map(|x| x.ess_bulk.min(x.ess_tail))
-            .fold(f64::NAN, f64::min),
+        ess_min: dg.iter().map(|x| x.ess_min()).fold(f64::NAN, f64::min),
     });
     record.seconds = start.elapsed().as_secs_f64();
     Ok(record)
