@@ -45,6 +45,14 @@ impl Diagnostics {
         self.ess_bulk.min(self.ess_tail)
     }
 
+    /// The least-mixed figures over parameters: (largest R-hat, smallest bulk or tail ESS);
+    /// (0, infinity) for none. NaN entries are passed over (`f64::max`/`f64::min`).
+    pub fn worst(all: &[Diagnostics]) -> (f64, f64) {
+        all.iter().fold((0.0, f64::INFINITY), |(r, e), d| {
+            (r.max(d.rhat), e.min(d.ess_min()))
+        })
+    }
+
     /// R-hat <= `rhat_max` and both ESS >= `ess_min`.
     pub fn converged(&self, rhat_max: f64, ess_min: f64) -> bool {
         self.rhat <= rhat_max && self.ess_bulk >= ess_min && self.ess_tail >= ess_min

@@ -154,3 +154,19 @@ fn diagnostics_of_equal_the_three_functions_apart() {
     assert_eq!(d.ess_bulk, ess_bulk(&c));
     assert_eq!(d.ess_tail, ess_tail(&c));
 }
+
+#[test]
+fn worst_takes_the_largest_rhat_and_the_smallest_of_either_ess() {
+    let d = |rhat, ess_bulk, ess_tail| Diagnostics {
+        rhat,
+        ess_bulk,
+        ess_tail,
+    };
+    let all = [
+        d(1.002, 900.0, 1200.0),
+        d(1.03, 1500.0, 310.0),
+        d(f64::NAN, 700.0, 800.0),
+    ];
+    assert_eq!(Diagnostics::worst(&all), (1.03, 310.0));
+    assert_eq!(Diagnostics::worst(&[]), (0.0, f64::INFINITY));
+}

@@ -98,11 +98,7 @@ pub(super) fn finish(
             }
         }
         let diagnostics = diagnose(&chains, d);
-        let rhat = diagnostics.iter().map(|x| x.rhat).fold(0.0, f64::max);
-        let ess = diagnostics
-            .iter()
-            .map(|x| x.ess_min())
-            .fold(f64::INFINITY, f64::min);
+        let (rhat, ess) = Diagnostics::worst(&diagnostics);
         let seconds = start.elapsed().as_secs_f64();
         let draws = chains[0].theta.len();
         progress(&Status {

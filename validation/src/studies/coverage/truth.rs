@@ -5,6 +5,7 @@
 use std::path::Path;
 use std::time::Instant;
 
+use hpge_inference::diagnostics::Diagnostics;
 use hpge_inference::fit::{
     Checkpoint, RefineInputs, RefineProgress, RefineRound, Resume, draw_range,
     fingerprint as checkpoint_fingerprint, refine_fit,
@@ -215,12 +216,12 @@ pub(super) fn fit_truth(
         );
     }
     record.converged = f.summary.converged;
-    let dg = &f.samples.diagnostics;
+    let (rhat_max, ess_min) = Diagnostics::worst(&f.samples.diagnostics);
     record.sampler = Some(TruthSampler {
         stop: f.samples.stop,
         draws_per_chain: f.samples.chains.first().map_or(0, |c| c.theta.len()),
-        rhat_max: dg.iter().map(|x| x.rhat).fold(f64::NAN, f64::max),
-        ess_min: dg.iter().map(|x| x.ess_min()).fold(f64::NAN, f64::min),
+        rhat_max,
+        ess_min,
     });
     record.seconds = start.elapsed().as_secs_f64();
     Ok(record)
