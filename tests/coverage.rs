@@ -78,7 +78,37 @@ fn a_killed_study_resumes_and_shards_share_a_folder() {
     let first = args(p, s, &["--shard", "1/2"]);
     let out = ok(&run(&first.iter().map(String::as_str).collect::<Vec<_>>()));
     assert!(out.contains("2 of 4 truths"), "{out}");
+    // A look at the half-done study (--progress) runs nothing and changes nothing.
+    let files = || {
+        let mut f: Vec<_> = std::fs::read_dir(shards.join("truths"))
+            .unwrap()
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .collect();
+        f.sort();
+        f
+    };
+    let before = files();
+    let peek = json(&args(p, s, &["--progress"]));
+    assert_eq!(
+        (
+            &peek["partial"],
+            &peek["done"],
+            &peek["total"],
+            &peek["n_truths"]
+        ),
+        (&true.into(), &2.into(), &4.into(), &2.into()),
+        "{peek}"
+    );
+    assert_eq!(files(), before);
     let joined = json(&args(p, s, &["--shard", "0/2"]));
     assert_eq!(joined["parameters"], reference["parameters"]);
+    // Once every truth is done, the look gives the study's own statistics.
+    let peek = json(&args(p, s, &["--progress"]));
+    assert_eq!((&peek["done"], &peek["pass"]), (&4.into(), &joined["pass"]));
+    assert_eq!(peek["parameters"], reference["parameters"]);
+    // A folder without a study has none done, and is not made.
+    let none = json(&args(p, d.join("none").to_str().unwrap(), &["--progress"]));
+    assert_eq!((&none["done"], &none["partial"]), (&0.into(), &true.into()));
+    assert!(!d.join("none").exists());
     let _ = std::fs::remove_dir_all(&d);
 }

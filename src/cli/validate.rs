@@ -4,10 +4,11 @@ use std::io::Write as _;
 
 use anyhow::{Context, Result};
 use hpge_inference::{CvModel, ExactModel};
-use hpge_validation::studies::coverage::TruthEvent;
 use hpge_validation::studies::coverage::store::{TruthStore, study_fingerprint};
+use hpge_validation::studies::coverage::{TruthEvent, progress};
 use hpge_validation::{
-    CoverageModels, CoverageOptions, CoverageOutcome, CoverageRun, coverage as run_coverage,
+    CoverageModels, CoverageOptions, CoverageOutcome, CoverageReport, CoverageRun,
+    coverage as run_coverage,
 };
 use indicatif::{ProgressBar, ProgressStyle};
 
@@ -27,6 +28,10 @@ pub fn coverage(o: &CoverageOptions, as_json: bool) -> Result<()> {
     )?;
     let out = o.out_dir();
     let out = out.as_path();
+    let fingerprint = study_fingerprint(&s.inputs, o.data_from(), &settings);
+    if o.progress {
+        return coverage_progress(o, out, &fingerprint, &s.prior, &settings, as_json);
+    }
     std::fs::create_dir_all(out)
         .with_context(|| format!("--out {}: cannot create the folder", out.display()))?;
     let exact;
@@ -37,11 +42,7 @@ pub fn coverage(o: &CoverageOptions, as_json: bool) -> Result<()> {
         (&s.surrogate, s.surrogate.sigma_rel())
     };
     let shard = o.shard()?;
-    let store = TruthStore::open(
-        out,
-        study_fingerprint(&s.inputs, o.data_from(), &settings),
-        shard,
-    )?;
+    let store = TruthStore::open(out, fingerprint, shard)?;
     eprintln!(
         "coverage: {} truths from {}, data from {}, fitted with {} ({} sampler, ESS >= {}{}), seed {}{}",
         o.truths,
@@ -171,76 +172,126 @@ pub fn coverage(o: &CoverageOptions, as_json: bool) -> Result<()> {
         &hpge_reports::plot::coverage_title(&o.prior.display().to_string(), o.data_from()),
     )?;
     if as_json {
-        // The issue's fields first: n_truths, parameters (name, ks_p, coverage_683,
-        // coverage_955), pass; the full record is in coverage.json.
-        let brief = serde_json::json!({
-            "n_truths": report.n_truths,
-            "parameters": report.parameters.iter().map(|p| serde_json::json!({
-                "name": p.name, "ks_p": p.ks_p, "coverage_683": p.coverage_683, "coverage_955": p.coverage_955,
-                "expected_683": p.expected_683, "expected_955": p.expected_955,
-            })).collect::<Vec<_>>(),
-            "pass": report.pass,
-            "unconverged": report.unconverged,
-            "unconverged_sampler": report.unconverged_sampler,
-            "skipped": report.skipped,
-            "seconds": report.seconds,
-            "resumed": report.resumed,
-            "truth_seconds": report.truth_seconds,
-            "exact_check": report.exact_check,
-        });
-        println!("{brief}");
+        println!("{}", brief_json(&report));
     } else {
-        println!(
-            "{} truths ({} skipped, {} fits unconverged, {} taken back from an earlier run) in {:.0} s ({:.0} s of truths' work): {}",
-            report.n_truths,
-            report.skipped,
-            report.unconverged,
-            report.resumed,
-            report.seconds,
-            report.truth_seconds,
-            if report.pass { "PASS" } else { "FAIL" }
-        );
-        if let Some(u) = &report.unconverged_sampler {
-            println!(
-                "unconverged fits recording their sampler: {} ({} at the draw cap, {} at the clock); smallest ESS {:.0}, largest R-hat {:.4}",
-                u.recorded, u.max_draws, u.max_seconds, u.ess_min, u.rhat_max
-            );
-        }
-        if let Some(c) = &report.exact_check {
-            println!(
-                "exact check of the fits: {} passed, {} failed after refinement; {:.2} rounds per fit on average, at most {}",
-                c.passed, c.failed, c.rounds_mean, c.rounds_max
-            );
-            if let Some(t) = c.seconds_split {
-                println!(
-                    "their wall time over the {} fits that record it: {:.0} s sampling, {:.0} s exact solves, {:.0} s error models",
-                    c.split_truths, t.sampling, t.exact, t.error_model
-                );
-            }
-        }
-        println!(
-            "{:<10} {:>8} {:>10} {:>17} {:>10} {:>17}",
-            "parameter", "KS p", "cov 68.3%", "99% expected", "cov 95.5%", "99% expected"
-        );
-        for p in &report.parameters {
-            println!(
-                "{:<10} {:>8.3} {:>10.3} [{:.3}, {:.3}] {:>10.3} [{:.3}, {:.3}]",
-                p.name,
-                p.ks_p,
-                p.coverage_683,
-                p.expected_683[0],
-                p.expected_683[1],
-                p.coverage_955,
-                p.expected_955[0],
-                p.expected_955[1]
-            );
-        }
+        print_report(&report, true);
         println!("outputs in {}", out.display());
     }
     if !report.pass {
         std::process::exit(1);
     }
     Ok(())
+}
+
+/// `validate coverage --progress`: the statistics over the truths written so far, nothing run.
+fn coverage_progress(
+    o: &CoverageOptions,
+    out: &std::path::Path,
+    fingerprint: &str,
+    prior: &hpge_inference::Prior,
+    settings: &hpge_validation::CoverageSettings,
+    as_json: bool,
+) -> Result<()> {
+    let report = progress(out, fingerprint, prior, settings)?;
+    let done = report.as_ref().map_or(0, |r| r.n_truths + r.skipped);
+    if as_json {
+        let mut j = report.as_ref().map_or(serde_json::json!({}), brief_json);
+        if let Some(obj) = j.as_object_mut() {
+            obj.insert("partial".into(), true.into());
+            obj.insert("done".into(), done.into());
+            obj.insert("total".into(), o.truths.into());
+        }
+        println!("{j}");
+        return Ok(());
+    }
+    println!(
+        "progress of the study in {}: {done} of {} truths done (nothing run here; the bands \
+         below are those of the truths done, and the study's verdict is the one at {})",
+        out.display(),
+        o.truths,
+        o.truths
+    );
+    if let Some(r) = &report {
+        print_report(r, false);
+    }
+    Ok(())
+}
+
+/// The issue's fields first: n_truths, parameters (name, ks_p, coverage_683, coverage_955),
+/// pass; the full record is in coverage.json.
+fn brief_json(report: &CoverageReport) -> serde_json::Value {
+    serde_json::json!({
+        "n_truths": report.n_truths,
+        "parameters": report.parameters.iter().map(|p| serde_json::json!({
+            "name": p.name, "ks_p": p.ks_p, "coverage_683": p.coverage_683, "coverage_955": p.coverage_955,
+            "expected_683": p.expected_683, "expected_955": p.expected_955,
+        })).collect::<Vec<_>>(),
+        "pass": report.pass,
+        "unconverged": report.unconverged,
+        "unconverged_sampler": report.unconverged_sampler,
+        "skipped": report.skipped,
+        "seconds": report.seconds,
+        "resumed": report.resumed,
+        "truth_seconds": report.truth_seconds,
+        "exact_check": report.exact_check,
+    })
+}
+
+/// The report as text: the counts, the exact checks and a table of the parameters; `ran`: this
+/// process ran the study (else the truths done so far were only read).
+fn print_report(report: &CoverageReport, ran: bool) {
+    let verdict = if report.pass { "PASS" } else { "FAIL" };
+    if ran {
+        println!(
+            "{} truths ({} skipped, {} fits unconverged, {} taken back from an earlier run) in {:.0} s ({:.0} s of truths' work): {verdict}",
+            report.n_truths,
+            report.skipped,
+            report.unconverged,
+            report.resumed,
+            report.seconds,
+            report.truth_seconds,
+        );
+    } else {
+        println!(
+            "{} truths ({} skipped, {} fits unconverged; {:.0} s of truths' work): so far {verdict}",
+            report.n_truths, report.skipped, report.unconverged, report.truth_seconds,
+        );
+    }
+    if let Some(u) = &report.unconverged_sampler {
+        println!(
+            "unconverged fits recording their sampler: {} ({} at the draw cap, {} at the clock); smallest ESS {:.0}, largest R-hat {:.4}",
+            u.recorded, u.max_draws, u.max_seconds, u.ess_min, u.rhat_max
+        );
+    }
+    if let Some(c) = &report.exact_check {
+        println!(
+            "exact check of the fits: {} passed, {} failed after refinement; {:.2} rounds per fit on average, at most {}",
+            c.passed, c.failed, c.rounds_mean, c.rounds_max
+        );
+        if let Some(t) = c.seconds_split {
+            println!(
+                "their wall time over the {} fits that record it: {:.0} s sampling, {:.0} s exact solves, {:.0} s error models",
+                c.split_truths, t.sampling, t.exact, t.error_model
+            );
+        }
+    }
+    println!(
+        "{:<10} {:>8} {:>10} {:>17} {:>10} {:>17}",
+        "parameter", "KS p", "cov 68.3%", "99% expected", "cov 95.5%", "99% expected"
+    );
+    for p in &report.parameters {
+        println!(
+            "{:<10} {:>8.3} {:>10.3} [{:.3}, {:.3}] {:>10.3} [{:.3}, {:.3}]",
+            p.name,
+            p.ks_p,
+            p.coverage_683,
+            p.expected_683[0],
+            p.expected_683[1],
+            p.coverage_955,
+            p.expected_955[0],
+            p.expected_955[1]
+        );
+    }
 }
 
 /// The line a truth's event prints, if any: each round's start of the exact check and its end,

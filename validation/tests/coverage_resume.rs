@@ -9,7 +9,7 @@ use hpge_inference::sampler::{SampleSettings, SamplerKind, SamplerStop};
 use hpge_inference::{CvData, CvModel, Likelihood, NoiseSettings, Prior, PriorSpec, Result};
 use hpge_surrogate::Shard;
 use hpge_validation::studies::coverage::store::TruthStore;
-use hpge_validation::studies::coverage::{PipelineSettings, TruthEvent, TruthEvents};
+use hpge_validation::studies::coverage::{PipelineSettings, TruthEvent, TruthEvents, progress};
 use hpge_validation::{
     CoverageModels, CoverageOutcome, CoverageReport, CoverageRun, CoverageSettings, coverage,
 };
@@ -180,6 +180,18 @@ fn a_study_resumes_extends_shards_and_never_mixes_runs() {
         assert_eq!(t.converged, s.stop == SamplerStop::Converged, "{s:?}");
         assert!(s.draws_per_chain > 0 && s.ess_min > 0.0 && s.rhat_max.is_finite());
     }
+    // A look while the store is held (the study running) sees the 5 truths of run-a, with the
+    // statistics the run gave, and nothing of another run.
+    let peek = progress(&out, "run-a", &prior(&sur), &settings(8, None))
+        .unwrap()
+        .expect("5 truths done");
+    assert_eq!(peek.n_truths, 5);
+    assert_eq!(peek.parameters, first.parameters);
+    assert!(
+        progress(&out, "run-b", &prior(&sur), &settings(8, None))
+            .unwrap()
+            .is_none()
+    );
     let extended = done(run(models, &settings(8, None), Some(&store), Shard::WHOLE));
     assert_eq!((extended.n_truths, extended.resumed), (8, 5));
     assert_eq!(

@@ -94,6 +94,11 @@ pub struct CoverageOptions {
     /// --out; whichever finds every truth done writes the report).
     #[cfg_attr(feature = "clap", arg(long, value_name = "K/M", default_value = "0/1"))]
     pub shard: String,
+    /// Run nothing: print the study's statistics over the truths written so far in --out (of
+    /// this study: the same arguments) and exit 0. Safe beside the running study: it takes no
+    /// lock and removes nothing. The bands are those of the truths done, not of --truths.
+    #[cfg_attr(feature = "clap", arg(long))]
+    pub progress: bool,
 }
 
 impl CoverageOptions {
@@ -116,6 +121,7 @@ impl CoverageOptions {
             no_exact_check: false,
             refine_rounds: DEFAULT_REFINE_ROUNDS,
             shard: "0/1".into(),
+            progress: false,
         }
     }
 

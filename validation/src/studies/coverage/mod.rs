@@ -372,6 +372,27 @@ pub fn coverage(
     Ok(CoverageOutcome::Done(Box::new(report)))
 }
 
+/// The study's statistics over the truths of index < `n_truths` written so far in `out` by the
+/// study `fingerprint` ([`store::peek`]: no lock taken, nothing removed), with the 99% bands of
+/// the number done; None when none is done. For a look at a study that is still running.
+///
+/// # Errors
+/// The truths folder exists and cannot be read.
+pub fn progress(
+    out: &std::path::Path,
+    fingerprint: &str,
+    prior: &Prior,
+    settings: &CoverageSettings,
+) -> Result<Option<CoverageReport>> {
+    let mut done = store::peek(out, fingerprint)?;
+    done.retain(|i, _| *i < settings.n_truths);
+    if done.is_empty() {
+        return Ok(None);
+    }
+    let truths: Vec<&TruthFit> = done.values().collect();
+    Ok(Some(summarise(&truths, prior, settings.ranks)))
+}
+
 /// The study's statistics over its truths (skipped ones left out).
 fn summarise(truths: &[&TruthFit], prior: &Prior, l: usize) -> CoverageReport {
     let d = prior.dim();

@@ -156,6 +156,46 @@ pub fn study_fingerprint(
     fingerprint(&parts)
 }
 
+/// The truths of the study `fingerprint` written so far in `out` (by any shard), by index, read
+/// without the lock and without removing anything: safe beside the running study (a truth is
+/// written whole, so a file is either there or not). Unreadable files and those of another run
+/// are left out; a folder without `truths/` has none.
+///
+/// # Errors
+/// The truths folder exists and cannot be read.
+pub fn peek(out: &Path, fingerprint: &str) -> Result<BTreeMap<usize, TruthFit>> {
+    let dir = out.join(TRUTHS_DIR);
+    if !dir.is_dir() {
+        return Ok(BTreeMap::new());
+    }
+    read_truths(&dir, fingerprint)
+}
+
+/// The truth files of `dir` that belong to `fingerprint` and lie under their own index's name.
+fn read_truths(dir: &Path, fingerprint: &str) -> Result<BTreeMap<usize, TruthFit>> {
+    let mut done = BTreeMap::new();
+    for f in folder_files(dir)? {
+        if f.extension().is_none_or(|e| e != "json") {
+            continue;
+        }
+        let Some(t) = std::fs::read_to_string(&f)
+            .ok()
+            .and_then(|t| serde_json::from_str::<TruthFit>(&t).ok())
+        else {
+            continue;
+        };
+        if t.fingerprint == fingerprint && f == truth_path(dir, t.index) {
+            done.insert(t.index, t);
+        }
+    }
+    Ok(done)
+}
+
+/// Truth `index`'s file in the truths folder `dir`.
+fn truth_path(dir: &Path, index: usize) -> PathBuf {
+    dir.join(format!("truth-{index:05}.json"))
+}
+
 /// The truths folder of one study, locked for one shard.
 pub struct TruthStore {
     dir: PathBuf,
@@ -219,7 +259,7 @@ impl TruthStore {
     }
 
     fn path(&self, index: usize) -> PathBuf {
-        self.dir.join(format!("truth-{index:05}.json"))
+        truth_path(&self.dir, index)
     }
 
     /// The truths of this run written so far (by any shard), by index; unreadable files and
@@ -228,22 +268,7 @@ impl TruthStore {
     /// # Errors
     /// The folder cannot be read.
     pub fn load(&self) -> Result<BTreeMap<usize, TruthFit>> {
-        let mut done = BTreeMap::new();
-        for f in folder_files(&self.dir)? {
-            if f.extension().is_none_or(|e| e != "json") {
-                continue;
-            }
-            let Some(t) = std::fs::read_to_string(&f)
-                .ok()
-                .and_then(|t| serde_json::from_str::<TruthFit>(&t).ok())
-            else {
-                continue;
-            };
-            if t.fingerprint == self.fingerprint && f == self.path(t.index) {
-                done.insert(t.index, t);
-            }
-        }
-        Ok(done)
+        read_truths(&self.dir, &self.fingerprint)
     }
 
     /// Writes a finished truth whole (temporary name, then renamed).
