@@ -9,7 +9,8 @@
 #     suffixes -tW-W-W, -hdW, -mN, -wdWD.
 # Needs data/training/{train,test}.csv (bash data/training/make.sh, ~40 min) and the committed
 # data/training/{heldout,calibration}.csv. Writes models/super-siegfried-rz-RECIPE.safetensors, its learning
-# curves (.curves.csv), the held-out figures (.heldout.json) and models/figures/RECIPE/.
+# curves (.curves.csv), the held-out figures (.heldout.json, and as text with the worst samples,
+# .heldout.txt) and models/figures/RECIPE/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 RECIPE=${1:-split}
@@ -34,4 +35,4 @@ $B train --data data/training/train.csv --test data/training/test.csv --space sp
 # The per-point uncertainty sigma_s(p, U_B), fitted on rows neither training nor held out.
 $B calibrate --model "$NAME.safetensors" --data data/training/calibration.csv
 $B evaluate --model "$NAME.safetensors" --data data/training/heldout.csv --json > "$NAME.heldout.json"
-$B evaluate --model "$NAME.safetensors" --data data/training/heldout.csv --plot "$FIGS"
+$B evaluate --model "$NAME.safetensors" --data data/training/heldout.csv --plot "$FIGS" > "$NAME.heldout.txt"

@@ -154,3 +154,46 @@ fn evaluate_reports_the_accuracy_at_the_edges_of_every_input() {
         );
     }
 }
+
+#[test]
+fn evaluate_reports_the_accuracy_by_band_of_the_bias() {
+    let data = "data/training/heldout.csv";
+    let o = run(&[
+        "evaluate", "--model", MODEL, "--data", data, "--json", "--worst", "0",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let bands = j["bias_bands"].as_array().expect("bias_bands");
+    let f = |b: &serde_json::Value, k: &str| b[k].as_f64().unwrap();
+    // The bands tile the bias range 10-3000 V, finer at the low end, and hold every row once.
+    let lo: Vec<f64> = bands
+        .iter()
+        .map(|b| b["range_v"][0].as_f64().unwrap())
+        .collect();
+    let hi: Vec<f64> = bands
+        .iter()
+        .map(|b| b["range_v"][1].as_f64().unwrap())
+        .collect();
+    assert_eq!((lo[0], *hi.last().unwrap()), (10.0, 3000.0));
+    assert!(
+        (hi[0] - 39.9).abs() < 1e-9 && (hi[2] - 309.0).abs() < 1e-9,
+        "{hi:?}"
+    );
+    assert!(lo[1..].iter().zip(&hi).all(|(a, b)| a == b));
+    let n: u64 = bands.iter().map(|b| b["n"].as_u64().unwrap()).sum();
+    assert_eq!(n, j["n"].as_u64().unwrap());
+    // The lowest band is the least accurate, and its error model widens with it: the fraction
+    // within 2 predicted sigma stays near the whole set's there.
+    let (first, last) = (&bands[0], &bands[bands.len() - 1]);
+    assert!(
+        f(first, "rel_sigma") > 3.0 * f(last, "rel_sigma"),
+        "{first} {last}"
+    );
+    for b in bands {
+        assert!(f(b, "abs_rel_q50") <= f(b, "abs_rel_q90"), "{b}");
+        assert!((0.85..=1.0).contains(&f(b, "coverage_2sigma")), "{b}");
+    }
+    let o = run(&["evaluate", "--model", MODEL, "--data", data, "--worst", "0"]);
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(text.contains("by bias:"), "{text}");
+}

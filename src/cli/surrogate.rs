@@ -291,6 +291,29 @@ pub fn evaluate(o: &EvaluateOptions, json: bool, plot: Option<&Path>) -> Result<
             e.support[1]
         );
     }
+    if !ev.bias_bands.is_empty() {
+        println!(
+            "by bias: the rows in each band of U_B (Gaussian sigma, |relative error| quantiles, \
+             fraction within 2 predicted sigma)"
+        );
+        println!(
+            "  {:>15} {:>6} {:>9} {:>9} {:>9} {:>9} {:>9}",
+            "U_B (V)", "n", "sigma", "median", "q90", "q99", "in 2 sig"
+        );
+        for b in &ev.bias_bands {
+            println!(
+                "  {:>7.0}-{:<7.0} {:>6} {:>8.3}% {:>8.3}% {:>8.3}% {:>8.3}% {:>8.1}%",
+                b.range_v[0],
+                b.range_v[1],
+                b.n,
+                100.0 * b.rel_sigma,
+                100.0 * b.abs_rel_q50,
+                100.0 * b.abs_rel_q90,
+                100.0 * b.abs_rel_q99,
+                100.0 * b.coverage_2sigma
+            );
+        }
+    }
     println!("worst samples:");
     for w in &ev.worst {
         let inputs: Vec<String> = w

@@ -6,6 +6,7 @@ use std::path::Path;
 
 use serde::Serialize;
 
+use super::bands::{BiasBand, bias_bands};
 use crate::model::{DataSet, Figures, Surrogate, dimension_from_unit, quantile};
 use crate::{Error, Result};
 
@@ -135,6 +136,8 @@ pub struct Evaluation {
     pub coverage: (f64, f64),
     /// `per-point` (a calibrated error model) or `constant` (sigma_p).
     pub sigma_kind: &'static str,
+    /// The accuracy by band of the bias ([`super::bias_bands`]).
+    pub bias_bands: Vec<BiasBand>,
 }
 
 /// `evaluate --json`: the issue's fields first, then the rest (the field order is the JSON's).
@@ -189,6 +192,9 @@ pub struct EvaluationJson<'a> {
     /// The accuracy at the edges of every input (issue 24): rows in the lowest and highest 5%
     /// of its u.
     pub edges: &'a [EdgeFigures],
+    /// The accuracy by band of the bias voltage, finer at low bias (empty for a space without
+    /// one).
+    pub bias_bands: &'a [BiasBand],
 }
 
 /// Reads a data set against the space of `model` (loaded from `model_file`); a refusal names the
@@ -228,7 +234,9 @@ impl Evaluation {
             .collect();
         let edges = edge_figures(model, data, &pred);
         let rels: Vec<f64> = (0..data.len()).map(rel).collect();
-        let coverage = crate::model::coverage_of(&rels, model.sigma_set(data).into_iter());
+        let sigma = model.sigma_set(data);
+        let coverage = crate::model::coverage_of(&rels, sigma.iter().copied());
+        let bias_bands = bias_bands(model, data, &rels, &sigma);
         Evaluation {
             figures,
             excluded: data.excluded,
@@ -240,6 +248,7 @@ impl Evaluation {
             edges,
             coverage,
             sigma_kind: model.sigma_kind(),
+            bias_bands,
         }
     }
 
@@ -270,6 +279,7 @@ impl Evaluation {
             worst: &self.worst,
             program_version: env!("CARGO_PKG_VERSION"),
             edges: &self.edges,
+            bias_bands: &self.bias_bands,
         }
     }
 }

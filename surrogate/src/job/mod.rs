@@ -5,6 +5,7 @@
 //! options are declared here once ([`GenerateOptions`], [`TrainJob`], [`EvaluateOptions`],
 //! [`PredictOptions`]).
 
+mod bands;
 mod calibrate;
 mod checkpoint;
 mod evaluate;
@@ -15,6 +16,7 @@ mod train;
 #[cfg(test)]
 mod tests;
 
+pub use bands::{BIAS_BAND_EDGES_U, BiasBand, bias_bands};
 pub use calibrate::CalibrateOptions;
 pub use checkpoint::{curves_path, partial_dir, resume_members, save_member, write_curves};
 pub use evaluate::{
