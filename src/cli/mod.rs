@@ -4,6 +4,8 @@ mod args;
 mod convergence;
 mod detector;
 mod discover;
+#[cfg(test)]
+mod docs;
 pub(crate) mod field;
 pub(crate) mod fit;
 mod generate;
