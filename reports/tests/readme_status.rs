@@ -17,6 +17,14 @@ fn readme_status_table_agrees_with_the_results_files() {
         want.trim(),
         "README.md's status table is out of date: cargo run --release -- report status --write README.md"
     );
+    // Both fits of the main job's acceptance (issue 21) show their wall time against its target.
+    for fit in ["main job (B_RZ fit)", "B_Z fit"] {
+        assert!(
+            rows.iter()
+                .any(|r| r.what == format!("{fit}: wall time on 2 cores")),
+            "no wall-time row for {fit}"
+        );
+    }
     // Every row's source exists.
     for r in &rows {
         assert!(root.join(&r.source).exists(), "{} is missing", r.source);
