@@ -30,7 +30,7 @@ pub fn coverage(o: &CoverageOptions, as_json: bool) -> Result<()> {
     let out = out.as_path();
     let fingerprint = study_fingerprint(&s.inputs, o.data_from(), &settings);
     if o.progress {
-        return coverage_progress(o, out, &fingerprint, &s.prior, &settings, as_json);
+        return coverage_progress(out, &fingerprint, &s.prior, &settings, as_json);
     }
     std::fs::create_dir_all(out)
         .with_context(|| format!("--out {}: cannot create the folder", out.display()))?;
@@ -185,7 +185,6 @@ pub fn coverage(o: &CoverageOptions, as_json: bool) -> Result<()> {
 
 /// `validate coverage --progress`: the statistics over the truths written so far, nothing run.
 fn coverage_progress(
-    o: &CoverageOptions,
     out: &std::path::Path,
     fingerprint: &str,
     prior: &hpge_inference::Prior,
@@ -199,7 +198,7 @@ fn coverage_progress(
         if let Some(obj) = j.as_object_mut() {
             obj.insert("partial".into(), true.into());
             obj.insert("done".into(), done.into());
-            obj.insert("total".into(), o.truths.into());
+            obj.insert("total".into(), settings.n_truths.into());
         }
         println!("{j}");
         return Ok(());
@@ -208,8 +207,8 @@ fn coverage_progress(
         "progress of the study in {}: {done} of {} truths done (nothing run here; the bands \
          below are those of the truths done, and the study's verdict is the one at {})",
         out.display(),
-        o.truths,
-        o.truths
+        settings.n_truths,
+        settings.n_truths
     );
     if let Some(r) = &report {
         print_report(r, false);
