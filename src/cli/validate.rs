@@ -131,7 +131,7 @@ pub fn coverage(o: &CoverageOptions, as_json: bool) -> Result<()> {
     if let Some(obj) = json.as_object_mut() {
         obj.insert("program_version".into(), env!("CARGO_PKG_VERSION").into());
         obj.insert("inputs".into(), serde_json::to_value(&s.inputs)?);
-        obj.insert("data_from".into(), o.data_from().into());
+        obj.insert("data_from".into(), o.data_from().as_str().into());
         obj.insert("shard".into(), o.shard.clone().into());
         obj.insert("settings".into(), serde_json::to_value(settings)?);
         // ranks.csv's provenance (it is a plain table: one header row, no comment lines).
@@ -169,7 +169,7 @@ pub fn coverage(o: &CoverageOptions, as_json: bool) -> Result<()> {
     hpge_reports::plot::coverage_figures(
         &out.join("figures"),
         &report,
-        &hpge_reports::plot::coverage_title(&o.prior.display().to_string(), o.data_from()),
+        &hpge_reports::plot::coverage_title(&o.prior.display().to_string(), o.data_from().as_str()),
     )?;
     if as_json {
         println!("{}", brief_json(&report));

@@ -8,7 +8,7 @@
 
 use serde::Serialize;
 
-use crate::model::{DataSet, Surrogate, dimension_from_unit, gaussian_fit, quantile};
+use crate::model::{DataSet, Surrogate, coverage_of, dimension_from_unit, gaussian_fit, quantile};
 use crate::space::Target;
 
 /// Band edges in the bias input's unit coordinate u: 1%, 3%, 10%, 20%, ... of its range (for
@@ -72,11 +72,6 @@ fn band(range_v: [f64; 2], rel: &[f64], sigma: &[f64]) -> BiasBand {
     let n = rel.len();
     let mut abs: Vec<f64> = rel.iter().map(|r| r.abs()).collect();
     abs.sort_by(f64::total_cmp);
-    let within = rel
-        .iter()
-        .zip(sigma)
-        .filter(|(r, s)| r.abs() <= 2.0 * **s)
-        .count();
     BiasBand {
         range_v,
         n,
@@ -88,11 +83,7 @@ fn band(range_v: [f64; 2], rel: &[f64], sigma: &[f64]) -> BiasBand {
         abs_rel_q50: quantile(&abs, 0.5),
         abs_rel_q90: quantile(&abs, 0.9),
         abs_rel_q99: quantile(&abs, 0.99),
-        coverage_2sigma: if n == 0 {
-            f64::NAN
-        } else {
-            within as f64 / n as f64
-        },
+        coverage_2sigma: coverage_of(rel, sigma.iter().copied()).1,
     }
 }
 

@@ -15,7 +15,7 @@ use hpge_inference::sampler::{DEFAULT_MODE_STARTS, DEFAULT_SEED};
 use hpge_inference::{DiscoverSettings, FitSettings, SampleSettings, SamplerKind};
 use hpge_surrogate::Shard;
 
-use super::coverage::{CoverageSettings, PipelineSettings};
+use super::coverage::{CoverageSettings, DataFrom, PipelineSettings};
 use crate::error::Result;
 
 /// Target bulk and tail ESS of each fit of a coverage study: ranks among L draws need about L
@@ -190,9 +190,13 @@ impl CoverageOptions {
         })
     }
 
-    /// Where the data come from, as coverage.json says it: `exact` or `surrogate`.
-    pub fn data_from(&self) -> &'static str {
-        if self.exact { "exact" } else { "surrogate" }
+    /// Where the data come from (`--exact`); coverage.json names it.
+    pub fn data_from(&self) -> DataFrom {
+        if self.exact {
+            DataFrom::Exact
+        } else {
+            DataFrom::Surrogate
+        }
     }
 
     /// The noise model named by `likelihood`.

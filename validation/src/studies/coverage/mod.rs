@@ -20,7 +20,7 @@ pub mod store;
 mod truth;
 
 use hpge_inference::sampler::SamplerStop;
-pub use settings::{COVERAGE_LEVELS, CoverageSettings, PipelineSettings};
+pub use settings::{COVERAGE_LEVELS, CoverageSettings, DataFrom, PipelineSettings};
 use store::{SecondsSplit, TruthCheck, TruthFit, TruthSampler, TruthStore};
 pub use truth::{CoverageModels, TruthEvent, TruthEvents};
 use truth::{TruthIo, fit_truth};

@@ -23,7 +23,7 @@ use hpge_surrogate::Shard;
 use hpge_surrogate::generate::FolderLock;
 use serde::{Deserialize, Serialize};
 
-use super::settings::CoverageSettings;
+use super::settings::{CoverageSettings, DataFrom};
 use crate::error::Result;
 
 /// The folder inside a study's output folder that holds its truths.
@@ -139,12 +139,12 @@ pub struct TruthFit {
 /// number of truths (so a study can be extended).
 pub fn study_fingerprint(
     inputs: &BTreeMap<String, String>,
-    data_from: &str,
+    data_from: DataFrom,
     settings: &CoverageSettings,
 ) -> String {
     let mut parts: Vec<String> = inputs.iter().map(|(k, v)| format!("{k}={v}")).collect();
-    parts.push(format!("data_from={data_from}"));
-    if data_from == "exact" {
+    parts.push(format!("data_from={}", data_from.as_str()));
+    if data_from == DataFrom::Exact {
         // Exact data and exact checks: answers of two solvers never mix.
         parts.push(format!("solver={}", hpge_solver::field::PHYSICS_REVISION));
     }
