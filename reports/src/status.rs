@@ -214,26 +214,82 @@ fn stand_in_row(root: &Path) -> Result<StatusRow> {
     })
 }
 
-/// What makes a coverage study's record stale: its model is not the default surrogate `model`,
-/// or its model or data file has changed since (their FNV-1a hashes against the recorded ones).
-/// None when the record describes the files as they are.
+/// What makes a coverage study's record stale: its model is not the default surrogate `model`;
+/// one of its input files (model, data, prior) has changed since (their FNV-1a hashes against
+/// the recorded ones; the recorded `detector_hash` is the resolved detector's,
+/// `ExactSolver::detector_hash`, not the file's); or its settings are not those the command line gives a study of
+/// its prior and data today ([`settings_differ`]: a change of the sampler's targets, the exact
+/// check or the refinement is a different pipeline). None when the record describes the shipped
+/// pipeline as it is.
 fn coverage_stale(root: &Path, s: &Value, model: &str) -> Option<String> {
     let input = |key: &str| s.pointer(&format!("/inputs/{key}")).and_then(Value::as_str);
-    let (Some(used), Some(used_hash)) = (input("model"), input("model_hash")) else {
+    let (Some(used), Some(_)) = (input("model"), input("model_hash")) else {
         return Some("its record names no model".into());
     };
     if used != model {
         return Some(format!("made with {used}, not the default surrogate"));
     }
-    if hpge_inference::fit::file_hash(&root.join(used)) != used_hash {
-        return Some(format!("{used} has changed since"));
+    for key in ["model", "data", "prior"] {
+        if let (Some(file), Some(hash)) = (input(key), input(&format!("{key}_hash")))
+            && hpge_inference::fit::file_hash(&root.join(file)) != hash
+        {
+            return Some(format!("{file} has changed since"));
+        }
     }
-    if let (Some(data), Some(data_hash)) = (input("data"), input("data_hash"))
-        && hpge_inference::fit::file_hash(&root.join(data)) != data_hash
-    {
-        return Some(format!("{data} has changed since"));
+    settings_differ(s)
+}
+
+/// Where a coverage record's `settings` differ from the defaults of a study of its prior and
+/// data source (`CoverageOptions::new(n_truths)` with `--prior` and `--exact` as recorded; the
+/// number of truths left out, as in the study's fingerprint): None when they are the same.
+fn settings_differ(s: &Value) -> Option<String> {
+    let Some(recorded) = s.get("settings") else {
+        return Some("its record has no settings".into());
+    };
+    let mut o = hpge_validation::CoverageOptions::new(
+        s.get("n_truths")
+            .and_then(Value::as_u64)
+            .unwrap_or(2)
+            .max(2) as usize,
+    );
+    if let Some(prior) = s.pointer("/inputs/prior").and_then(Value::as_str) {
+        o.prior = prior.into();
     }
-    None
+    o.exact = s.get("data_from").and_then(Value::as_str) == Some("exact");
+    let current = match o.settings() {
+        Ok(c) => serde_json::to_value(c).unwrap_or_default(),
+        Err(e) => return Some(format!("the defaults' settings cannot be made: {e}")),
+    };
+    let mut paths = Vec::new();
+    differing_paths("", recorded, &current, &mut paths);
+    paths.retain(|p| p != "/n_truths");
+    if paths.is_empty() {
+        None
+    } else {
+        Some(format!(
+            "its settings are not today's defaults ({})",
+            paths.join(", ")
+        ))
+    }
+}
+
+/// The JSON pointers under `path` where `a` and `b` differ (objects compared key by key, any
+/// other value whole).
+fn differing_paths(path: &str, a: &Value, b: &Value, out: &mut Vec<String>) {
+    match (a, b) {
+        (Value::Object(x), Value::Object(y)) => {
+            let keys: std::collections::BTreeSet<&String> = x.keys().chain(y.keys()).collect();
+            for k in keys {
+                let (va, vb) = (
+                    x.get(k.as_str()).unwrap_or(&Value::Null),
+                    y.get(k.as_str()).unwrap_or(&Value::Null),
+                );
+                differing_paths(&format!("{path}/{k}"), va, vb, out);
+            }
+        }
+        _ if a != b => out.push(path.to_string()),
+        _ => {}
+    }
 }
 
 /// A coverage study (`reports/coverage/NAME/coverage.json`) against the truths it needs, made
@@ -469,9 +525,17 @@ mod tests {
         std::fs::write(root.join("m/a.safetensors"), b"model a").unwrap();
         std::fs::write(root.join("cv.csv"), b"U_V,c_pF\n").unwrap();
         let hash = |p: &str| hpge_inference::fit::file_hash(&root.join(p));
+        // A surrogate-data study of the default prior with today's default settings.
+        let settings = serde_json::to_value(
+            hpge_validation::CoverageOptions::new(20)
+                .settings()
+                .unwrap(),
+        )
+        .unwrap();
         let record = |model: &str| {
             serde_json::json!({"inputs": {"model": model, "model_hash": hash("m/a.safetensors"),
-                "data": "cv.csv", "data_hash": hash("cv.csv")}})
+                "data": "cv.csv", "data_hash": hash("cv.csv")}, "data_from": "surrogate",
+                "n_truths": 20, "settings": settings})
         };
         assert_eq!(
             coverage_stale(&root, &record("m/a.safetensors"), "m/a.safetensors"),
@@ -488,6 +552,30 @@ mod tests {
         assert!(model.contains("a.safetensors has changed"), "{model}");
         assert!(coverage_stale(&root, &serde_json::json!({}), "m/a.safetensors").is_some());
         std::fs::remove_dir_all(&root).unwrap();
+    }
+
+    #[test]
+    fn a_coverage_study_with_other_settings_than_the_defaults_is_stale() {
+        let settings = serde_json::to_value(
+            hpge_validation::CoverageOptions::new(200)
+                .settings()
+                .unwrap(),
+        )
+        .unwrap();
+        let record = |settings: &Value, data_from: &str| serde_json::json!({"n_truths": 200, "data_from": data_from, "settings": settings});
+        assert_eq!(settings_differ(&record(&settings, "surrogate")), None);
+        // More truths than recorded extend a study; they do not make it another.
+        let mut more = settings.clone();
+        more["n_truths"] = 400.into();
+        assert_eq!(settings_differ(&record(&more, "surrogate")), None);
+        let mut lower = settings.clone();
+        lower["fit"]["sample"]["ess_min"] = 200.0.into();
+        let why = settings_differ(&record(&lower, "surrogate")).unwrap();
+        assert!(why.contains("/fit/sample/ess_min"), "{why}");
+        // The same settings as a study with exact data lack its pipeline (exact check, refinement).
+        let why = settings_differ(&record(&settings, "exact")).unwrap();
+        assert!(why.contains("/pipeline"), "{why}");
+        assert!(settings_differ(&serde_json::json!({"n_truths": 200})).is_some());
     }
 
     #[test]
