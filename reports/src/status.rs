@@ -9,7 +9,7 @@
 
 use std::path::{Path, PathBuf};
 
-use hpge_validation::studies::coverage::ParameterCoverage;
+use hpge_validation::studies::coverage::{ParameterCoverage, SubsetCoverage};
 use hpge_validation::studies::stand_in::{chi2_band, stand_in_noise};
 use serde_json::Value;
 
@@ -324,6 +324,7 @@ fn coverage_row(
     if let Some(why) = &stale {
         detail = format!("{detail}; stale: {why}");
     }
+    detail.push_str(&subsets_note(&s));
     Ok(StatusRow {
         what: what.into(),
         result: format!(
@@ -338,6 +339,36 @@ fn coverage_row(
         verdict: Verdict::of(pass && failing.is_empty() && n >= needed && stale.is_none()),
         source: rel,
     })
+}
+
+/// The study's subsets in a few words ("; over the 45 converged fits alone: passes"), where its
+/// `coverage.json` has them (a diagnostic beside the verdict: `SubsetCoverage`); empty without.
+fn subsets_note(s: &Value) -> String {
+    let subsets: Vec<SubsetCoverage> = s
+        .get("subsets")
+        .and_then(|v| serde_json::from_value(v.clone()).ok())
+        .unwrap_or_default();
+    subsets
+        .iter()
+        .map(|x| {
+            let failing: Vec<&str> = x
+                .parameters
+                .iter()
+                .filter(|p| !p.failures_at(0.01).is_empty())
+                .map(|p| p.name.as_str())
+                .collect();
+            let verdict = if failing.is_empty() {
+                "passes".to_string()
+            } else {
+                format!("outside: {}", failing.join(", "))
+            };
+            format!(
+                "; over the {} {} alone: {verdict}",
+                x.n_truths,
+                x.subset.describe()
+            )
+        })
+        .collect()
 }
 
 /// Whether one parameter of a coverage study passes: KS p > 0.01 and both coverages inside their
@@ -596,5 +627,26 @@ mod tests {
         let q = serde_json::json!({"ks_p": 0.5, "coverage_683": 0.7, "expected_683": [0.62, 0.74],
             "coverage_955": 0.95, "expected_955": [0.92, 0.98]});
         assert!(parameter_passes(&q));
+    }
+
+    #[test]
+    fn a_coverage_study_names_its_subsets_verdicts() {
+        let param = |name: &str, c683: f64| {
+            serde_json::json!({"name": name, "ks_p": 0.5, "coverage_683": c683,
+                "expected_683": [0.62, 0.74], "coverage_955": 0.95, "expected_955": [0.92, 0.98]})
+        };
+        let s = serde_json::json!({"subsets": [
+            {"subset": "converged", "n_truths": 45, "pass": true, "failures": [],
+             "parameters": [param("a", 0.7), param("b", 0.7)]},
+            {"subset": "check_passed", "n_truths": 92, "pass": false,
+             "failures": ["b: 68.3% coverage 0.60 outside [0.62, 0.74]"],
+             "parameters": [param("a", 0.7), param("b", 0.6)]}]});
+        assert_eq!(
+            subsets_note(&s),
+            "; over the 45 converged fits alone: passes; over the 92 fits whose exact check \
+             passed alone: outside: b"
+        );
+        // A record written before subsets existed, or of a study without any, adds nothing.
+        assert_eq!(subsets_note(&serde_json::json!({"n_truths": 20})), "");
     }
 }

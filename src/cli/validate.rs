@@ -5,7 +5,7 @@ use std::io::Write as _;
 use anyhow::{Context, Result};
 use hpge_inference::{CvModel, ExactModel};
 use hpge_validation::studies::coverage::store::{TruthStore, study_fingerprint};
-use hpge_validation::studies::coverage::{TruthEvent, progress};
+use hpge_validation::studies::coverage::{ParameterCoverage, SubsetCoverage, TruthEvent, progress};
 use hpge_validation::{
     CoverageModels, CoverageOptions, CoverageOutcome, CoverageReport, CoverageRun,
     coverage as run_coverage,
@@ -233,6 +233,9 @@ fn brief_json(report: &CoverageReport) -> serde_json::Value {
         "resumed": report.resumed,
         "truth_seconds": report.truth_seconds,
         "exact_check": report.exact_check,
+        "subsets": report.subsets.iter().map(|s| serde_json::json!({
+            "subset": s.subset, "n_truths": s.n_truths, "pass": s.pass, "failures": s.failures,
+        })).collect::<Vec<_>>(),
     })
 }
 
@@ -291,6 +294,40 @@ fn print_report(report: &CoverageReport, ran: bool) {
             p.expected_955[1]
         );
     }
+    for s in &report.subsets {
+        println!("{}", subset_line(s));
+    }
+}
+
+/// One line on a subset of the truths: its size, its verdict with its own bands and, where it
+/// fails, what; where it passes, its smallest KS p and its coverages' ranges.
+fn subset_line(s: &SubsetCoverage) -> String {
+    let head = format!(
+        "over the {} {} only (a diagnostic; the verdict is the whole set's):",
+        s.n_truths,
+        s.subset.describe()
+    );
+    if !s.pass {
+        return format!("{head} FAIL ({})", s.failures.join("; "));
+    }
+    let range = |f: fn(&ParameterCoverage) -> f64| {
+        let v = s.parameters.iter().map(f);
+        let lo = v.clone().fold(f64::INFINITY, f64::min);
+        (lo, v.fold(f64::NEG_INFINITY, f64::max))
+    };
+    let (ks, _) = range(|p| p.ks_p);
+    let (a, b) = range(|p| p.coverage_683);
+    let (c, e) = range(|p| p.coverage_955);
+    let band = |x: [f64; 2]| format!("[{:.3}, {:.3}]", x[0], x[1]);
+    let (e683, e955) = s
+        .parameters
+        .first()
+        .map_or((String::new(), String::new()), |p| {
+            (band(p.expected_683), band(p.expected_955))
+        });
+    format!(
+        "{head} PASS (smallest KS p {ks:.3}; 68.3% coverage {a:.3}-{b:.3} in {e683}, 95.5% coverage {c:.3}-{e:.3} in {e955})"
+    )
 }
 
 /// The line a truth's event prints, if any: each round's start of the exact check and its end,

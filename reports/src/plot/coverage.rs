@@ -521,6 +521,7 @@ mod tests {
             resumed: 0,
             truth_seconds: 2.0,
             exact_check: None,
+            subsets: vec![],
         }
     }
 

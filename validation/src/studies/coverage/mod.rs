@@ -17,11 +17,13 @@ use serde::{Deserialize, Serialize};
 
 mod settings;
 pub mod store;
+pub mod subsets;
 mod truth;
 
 use hpge_inference::sampler::SamplerStop;
 pub use settings::{COVERAGE_LEVELS, CoverageSettings, DataFrom, PipelineSettings};
 use store::{SecondsSplit, TruthCheck, TruthFit, TruthSampler, TruthStore};
+pub use subsets::{Subset, SubsetCoverage};
 pub use truth::{CoverageModels, TruthEvent, TruthEvents};
 use truth::{TruthIo, fit_truth};
 
@@ -114,6 +116,10 @@ pub struct CoverageReport {
     /// With the full pipeline: how the fits' exact checks ended.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub exact_check: Option<CheckTally>,
+    /// The same statistics over the fits that converged, passed their exact check, or both,
+    /// where such a subset is neither empty nor the whole set (a diagnostic: [`subsets`]).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub subsets: Vec<SubsetCoverage>,
 }
 
 /// How far a study's unconverged fits got (those whose records say how their sampler ended).
@@ -396,47 +402,15 @@ pub fn progress(
 /// The study's statistics over its truths (skipped ones left out).
 fn summarise(truths: &[&TruthFit], prior: &Prior, l: usize) -> CoverageReport {
     let d = prior.dim();
+    let names: Vec<&str> = prior.parameters.iter().map(|p| p.name.as_str()).collect();
     let kept: Vec<&TruthFit> = truths
         .iter()
         .copied()
         .filter(|t| t.skipped.is_none())
         .collect();
     let m = kept.len();
-    let k683 = COVERAGE_LEVELS
-        .iter()
-        .position(|&x| x == 0.683)
-        .expect("0.683 is a level");
-    let k955 = COVERAGE_LEVELS
-        .iter()
-        .position(|&x| x == 0.955)
-        .expect("0.955 is a level");
-    let e683 = binomial_interval(m, 0.683, 0.99);
-    let e955 = binomial_interval(m, 0.955, 0.99);
-    let mut parameters = Vec::with_capacity(d);
-    let mut pass = m > 0;
-    for (j, p) in prior.parameters.iter().enumerate() {
-        let u: Vec<f64> = kept
-            .iter()
-            .map(|t| (t.ranks[j] as f64 + t.jitter[j]) / (l + 1) as f64)
-            .collect();
-        let ks_p = ks_uniform(&u);
-        let curve: Vec<f64> = (0..COVERAGE_LEVELS.len())
-            .map(|k| kept.iter().filter(|t| t.inside[j][k]).count() as f64 / m.max(1) as f64)
-            .collect();
-        let (c683, c955) = (curve[k683], curve[k955]);
-        let pc = ParameterCoverage {
-            name: p.name.clone(),
-            ks_p,
-            coverage_683: c683,
-            coverage_955: c955,
-            expected_683: e683,
-            expected_955: e955,
-            coverage_curve: curve,
-            ranks: kept.iter().map(|t| t.ranks[j]).collect(),
-        };
-        pass &= pc.failures(d).is_empty();
-        parameters.push(pc);
-    }
+    let parameters = parameter_coverage(&kept, &names, l);
+    let pass = m > 0 && parameters.iter().all(|p| p.failures(d).is_empty());
     let checks: Vec<&TruthCheck> = kept.iter().filter_map(|t| t.check.as_ref()).collect();
     let exact_check = (!checks.is_empty()).then(|| CheckTally {
         passed: checks.iter().filter(|c| c.pass).count(),
@@ -462,7 +436,48 @@ fn summarise(truths: &[&TruthFit], prior: &Prior, l: usize) -> CoverageReport {
         resumed: 0,
         truth_seconds: truths.iter().map(|t| t.seconds).sum(),
         exact_check,
+        subsets: subsets::subsets(&kept, &names, l),
     }
+}
+
+/// Each parameter's (named by `names`, in the truths' order) rank KS p and interval coverage
+/// over `kept`, with the 99% binomial bands of their number, from `l` ranks: the uniform
+/// u = (rank + jitter) / (L + 1) of simulation-based calibration.
+fn parameter_coverage(kept: &[&TruthFit], names: &[&str], l: usize) -> Vec<ParameterCoverage> {
+    let m = kept.len();
+    let k683 = COVERAGE_LEVELS
+        .iter()
+        .position(|&x| x == 0.683)
+        .expect("0.683 is a level");
+    let k955 = COVERAGE_LEVELS
+        .iter()
+        .position(|&x| x == 0.955)
+        .expect("0.955 is a level");
+    let e683 = binomial_interval(m, 0.683, 0.99);
+    let e955 = binomial_interval(m, 0.955, 0.99);
+    names
+        .iter()
+        .enumerate()
+        .map(|(j, name)| {
+            let u: Vec<f64> = kept
+                .iter()
+                .map(|t| (t.ranks[j] as f64 + t.jitter[j]) / (l + 1) as f64)
+                .collect();
+            let curve: Vec<f64> = (0..COVERAGE_LEVELS.len())
+                .map(|k| kept.iter().filter(|t| t.inside[j][k]).count() as f64 / m.max(1) as f64)
+                .collect();
+            ParameterCoverage {
+                name: (*name).to_string(),
+                ks_p: ks_uniform(&u),
+                coverage_683: curve[k683],
+                coverage_955: curve[k955],
+                expected_683: e683,
+                expected_955: e955,
+                coverage_curve: curve,
+                ranks: kept.iter().map(|t| t.ranks[j]).collect(),
+            }
+        })
+        .collect()
 }
 
 #[cfg(test)]
