@@ -100,7 +100,21 @@ fn shards_merge_to_the_single_run_and_runs_are_deterministic() {
     let o = run(&args);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert_eq!(rows(&merged), rows(&whole.join("rows.csv")));
-    assert!(d.join("merged.json").is_file());
+    // Every solve succeeded, and the merge counts none failed (it once read the status from
+    // the wrong column and counted every row).
+    let ok_rows = std::fs::read_to_string(whole.join("rows.csv"))
+        .unwrap()
+        .matches(",ok,")
+        .count();
+    assert_eq!(ok_rows, 9, "every solve of the test's run succeeds");
+    assert!(
+        String::from_utf8_lossy(&o.stdout).contains("(0 failed solves)"),
+        "{}",
+        String::from_utf8_lossy(&o.stdout)
+    );
+    let side: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d.join("merged.json")).unwrap()).unwrap();
+    assert_eq!(side["failed"], 0);
     // Incomplete or inconsistent sets are refused.
     let o = run(&[
         "merge",

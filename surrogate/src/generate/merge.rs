@@ -4,7 +4,7 @@ use std::collections::BTreeMap;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use super::run::{RunInfo, read_folder};
+use super::run::{RunInfo, read_folder, solve_failed, status_column};
 use crate::error::{Error, Result};
 
 /// What a merge wrote.
@@ -109,8 +109,9 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<MergeReport> {
         let mut f = std::io::BufWriter::new(std::fs::File::create(&tmp)?);
         writeln!(f, "{}", info.header)?;
         let mut failed = 0;
+        let status = status_column(&info.header);
         for line in rows.values() {
-            if line.rsplit(',').nth(1) != Some("ok") {
+            if solve_failed(status, line) {
                 failed += 1;
             }
             writeln!(f, "{line}")?;

@@ -209,11 +209,11 @@ pub fn run(
     };
     let mut done: HashSet<u64> = existing.iter().map(|r| r.0).collect();
     // With `retry_failed`, the rows whose solve failed (status other than `ok`).
-    let status_column = info.header.split(',').position(|h| h == "status");
+    let status = status_column(&info.header);
     let failed_before: HashSet<u64> = existing
         .iter()
         .filter(|_| g.retry_failed)
-        .filter(|(_, line)| status_column.and_then(|c| line.split(',').nth(c)) != Some("ok"))
+        .filter(|(_, line)| solve_failed(status, line))
         .map(|r| r.0)
         .collect();
     // Curve mode writes a point's rows in one write, so only a cut-off last write leaves a
@@ -356,4 +356,16 @@ pub fn read_folder(dir: &Path) -> Result<(RunInfo, Vec<(u64, String)>)> {
     let rows_path: PathBuf = dir.join("rows.csv");
     let (rows, _) = read_rows(&rows_path, &info.header, false)?;
     Ok((info, rows))
+}
+
+/// The position of the `status` column in a rows file's `header` (None: the header has none).
+pub(super) fn status_column(header: &str) -> Option<usize> {
+    header.split(',').position(|h| h == "status")
+}
+
+/// Whether a row `line` records a failed solve: its `status` (at `status`, from
+/// [`status_column`]) is not `ok`. The column is found by name: the columns after it have
+/// changed (`c12_err_pF` came after it), so its place from the end is not fixed.
+pub(super) fn solve_failed(status: Option<usize>, line: &str) -> bool {
+    status.and_then(|c| line.split(',').nth(c)) != Some("ok")
 }
