@@ -311,9 +311,12 @@ fn subset_line(s: &SubsetCoverage) -> String {
         return format!("{head} FAIL ({})", s.failures.join("; "));
     }
     let range = |f: fn(&ParameterCoverage) -> f64| {
-        let v = s.parameters.iter().map(f);
-        let lo = v.clone().fold(f64::INFINITY, f64::min);
-        (lo, v.fold(f64::NEG_INFINITY, f64::max))
+        s.parameters
+            .iter()
+            .map(f)
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
+                (lo.min(x), hi.max(x))
+            })
     };
     let (ks, _) = range(|p| p.ks_p);
     let (a, b) = range(|p| p.coverage_683);
