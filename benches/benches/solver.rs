@@ -4,13 +4,19 @@
 //! curve in <= 3 s on the 2-core machine (issue 18). The curve with one forward-difference step
 //! on its grids (`field::cv_curves_near`) against two adaptive curves. Then every shipped
 //! detector type at its three biases of the accuracy table (undepleted, pinch-off window,
-//! depleted; `hpge_validation::accuracy_cases`) at the default tolerance.
+//! depleted; `hpge_validation::accuracy_cases`) at the default tolerance. Last, the exact-solver
+//! check's solves: draws of a two-mode posterior on the mode's grids (20 voltages, 4 draws
+//! around the stand-in's truth and 4 around its mirror, bottom and top swapped), each seeded
+//! from the mode's potential against along a nearest-neighbour chain (`field::SeedChain`;
+//! the same c12 bit for bit, `validation/tests/near_chain.rs`).
 
 use std::hint::black_box;
 use std::time::Duration;
 
 use criterion::Criterion;
-use hpge_solver::field::{Continuation, cv_curves_near};
+use hpge_solver::field::{
+    Continuation, NearSeeding, SeedChain, cv_curves_near, cv_curves_near_each,
+};
 use hpge_solver::{Detector, FieldSettings, Method, Parameters, cv_curve, solve_point};
 use hpge_validation::{accuracy_cases, repo_path};
 
@@ -78,6 +84,62 @@ pub fn bench(c: &mut Criterion) {
         let volts: Vec<f64> = case.biases.iter().map(|(v, _)| *v).collect();
         g.bench_function(format!("curve_3/{name}"), |b| {
             b.iter(|| cv_curve(&det, black_box(&volts), &s, |_, _| {}).expect("solves"))
+        });
+    }
+    g.finish();
+    check_draws(c);
+}
+
+/// The exact check's draws of a two-mode posterior, seeded from the mode or along a chain.
+fn check_draws(c: &mut Criterion) {
+    use hpge_surrogate::{ExactSolver, ParameterSpace};
+    let space = ParameterSpace::from_file(&repo_path("spaces/super-siegfried-rz.toml"))
+        .expect("shipped space loads");
+    let widths: Vec<f64> = space.dimensions[..9]
+        .iter()
+        .map(|d| d.range[1] - d.range[0])
+        .collect();
+    let ex = ExactSolver::new(
+        space,
+        &repo_path("detectors/super-siegfried-k1.toml"),
+        FieldSettings::default(),
+    )
+    .expect("exact solver sets up");
+    let mode = [3.0, 0.66, 0.66, 0.58, -0.38, 0.55, 0.54, 0.48, -0.32];
+    let mirror = [3.0, 0.55, 0.54, 0.48, -0.32, 0.66, 0.66, 0.58, -0.38];
+    let mut xs = Vec::new();
+    for k in 0..4 {
+        let e = 0.004 * f64::from(k + 1);
+        for m in [mode, mirror] {
+            let mut x = m;
+            x[0] += 20.0 * e;
+            x[1] -= e;
+            x[5] += e;
+            xs.push(x.to_vec());
+        }
+    }
+    let det = ex.detector(&mode).expect("detector");
+    let near: Vec<_> = xs
+        .iter()
+        .map(|x| ex.detector(x).expect("detector"))
+        .collect();
+    let chain = SeedChain::nearest_neighbour(&mode, &xs, &widths);
+    let volts: Vec<f64> = (0..20).map(|k| 25.0 + 150.0 * k as f64).collect();
+    let mut g = c.benchmark_group("exact_check_draws");
+    g.sample_size(10).measurement_time(Duration::from_secs(40));
+    for (name, seeding) in [("from_mode", NearSeeding::Base), ("chain", chain.seeding())] {
+        g.bench_function(format!("8_draws_20V/{name}"), |b| {
+            b.iter(|| {
+                cv_curves_near_each(
+                    &det,
+                    &near,
+                    black_box(&volts),
+                    &ex.settings,
+                    (Continuation::Seeded, seeding),
+                    |_, _| {},
+                )
+                .expect("solves")
+            })
         });
     }
     g.finish();

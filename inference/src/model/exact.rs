@@ -2,7 +2,7 @@
 //! cores; used to check a surrogate posterior, never to sample one).
 
 use hpge_solver::Detector;
-use hpge_solver::field::{Continuation, cv_curves_near_each};
+use hpge_solver::field::{Continuation, SeedChain, cv_curves_near_each};
 use hpge_surrogate::ExactSolver;
 
 use super::{CvModel, NearCurves};
@@ -121,7 +121,11 @@ impl CvModel for ExactModel {
 /// its grids (`hpge_solver::field::cv_curves_near_each`, seeded continuation as
 /// [`ExactSolver::curve`]); `detector` builds a detector from inputs, which must lie in
 /// `domain` (named `names`). A nearby point outside the domain, or whose detector cannot be
-/// built, is its own entry's error.
+/// built, is its own entry's error. The nearby points are solved along a nearest-neighbour
+/// chain from `x` where it is shorter than the star from `x` (distances in units of each
+/// input's domain width; `SeedChain::seeding`): the same curves, in fewer active-set steps
+/// where the points lie closer to each other than to `x` (posterior draws); forward-difference
+/// steps stay seeded by `x`.
 pub(crate) fn near_curves(
     model: &ExactModel,
     (names, domain): (&[String], &[[f64; 2]]),
@@ -134,12 +138,14 @@ pub(crate) fn near_curves(
     let det = detector(x)?;
     // The detectors to solve, and in each entry's place the error that stops it.
     let mut dets = Vec::with_capacity(near.len());
+    let mut placed = Vec::with_capacity(near.len());
     let slots: Vec<Option<Error>> = near
         .iter()
         .map(
             |xn| match check_domain(names, domain, xn).and_then(|()| detector(xn)) {
                 Ok(d) => {
                     dets.push(d);
+                    placed.push(xn.clone());
                     None
                 }
                 Err(e) => Some(e),
@@ -148,12 +154,14 @@ pub(crate) fn near_curves(
         .collect();
     let total = near.len() + 1;
     let skipped = near.len() - dets.len();
+    let widths: Vec<f64> = domain.iter().map(|r| r[1] - r[0]).collect();
+    let chain = SeedChain::nearest_neighbour(x, &placed, &widths);
     let nc = cv_curves_near_each(
         &det,
         &dets,
         &model.volts,
         &model.solver.settings,
-        Continuation::Seeded,
+        (Continuation::Seeded, chain.seeding()),
         |done, _| progress(done + skipped, total),
     )
     .map_err(|e| Error::Surrogate(e.into()))?;

@@ -41,7 +41,7 @@ pub use curve::{Continuation, CvCurve, CvPoint, cv_curve, cv_curve_with, normali
 pub use depletion::{MAX_POCKET_ROUNDS, PotentialSolution, solve_fast, solve_fast_with};
 pub use full_depletion::full_depletion_voltage;
 pub use mesh::{Mesh, NodeKind};
-pub use near::{NearCurves, NearEach, cv_curves_near, cv_curves_near_each};
+pub use near::{NearCurves, NearEach, NearSeeding, SeedChain, cv_curves_near, cv_curves_near_each};
 pub use pinch_off::{curve_pinch_off_voltage, pinch_off_voltage};
 pub use pockets::{Pocket, deepest_depression_v, deepest_empty_depression_v, find_pockets};
 pub use point::{
