@@ -92,38 +92,17 @@ pub fn bench(c: &mut Criterion) {
 
 /// The exact check's draws of a two-mode posterior, seeded from the mode or along a chain.
 fn check_draws(c: &mut Criterion) {
-    use hpge_surrogate::{ExactSolver, ParameterSpace};
-    let space = ParameterSpace::from_file(&repo_path("spaces/super-siegfried-rz.toml"))
-        .expect("shipped space loads");
-    let widths: Vec<f64> = space.dimensions[..9]
-        .iter()
-        .map(|d| d.range[1] - d.range[0])
-        .collect();
-    let ex = ExactSolver::new(
-        space,
-        &repo_path("detectors/super-siegfried-k1.toml"),
-        FieldSettings::default(),
-    )
-    .expect("exact solver sets up");
-    let mode = [3.0, 0.66, 0.66, 0.58, -0.38, 0.55, 0.54, 0.48, -0.32];
-    let mirror = [3.0, 0.55, 0.54, 0.48, -0.32, 0.66, 0.66, 0.58, -0.38];
-    let mut xs = Vec::new();
-    for k in 0..4 {
-        let e = 0.004 * f64::from(k + 1);
-        for m in [mode, mirror] {
-            let mut x = m;
-            x[0] += 20.0 * e;
-            x[1] -= e;
-            x[5] += e;
-            xs.push(x.to_vec());
-        }
-    }
-    let det = ex.detector(&mode).expect("detector");
+    use hpge_validation::problems::stand_in::{
+        STAND_IN_TRUTH, input_widths, stand_in_solver, two_mode_draws,
+    };
+    let ex = stand_in_solver().expect("the stand-in's exact solver sets up");
+    let xs = two_mode_draws(4);
+    let det = ex.detector(&STAND_IN_TRUTH).expect("detector");
     let near: Vec<_> = xs
         .iter()
         .map(|x| ex.detector(x).expect("detector"))
         .collect();
-    let chain = SeedChain::nearest_neighbour(&mode, &xs, &widths);
+    let chain = SeedChain::nearest_neighbour(&STAND_IN_TRUTH, &xs, &input_widths(&ex));
     let volts: Vec<f64> = (0..20).map(|k| 25.0 + 150.0 * k as f64).collect();
     let mut g = c.benchmark_group("exact_check_draws");
     g.sample_size(10).measurement_time(Duration::from_secs(40));

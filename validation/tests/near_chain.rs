@@ -4,42 +4,18 @@
 //! solver reaches from either seed), in fewer active-set steps along the chain. The work counter
 //! pins the algorithm: a chain that seeded from the mode again would not save the steps.
 
-use hpge_solver::FieldSettings;
 use hpge_solver::field::{Continuation, NearSeeding, SeedChain, cv_curves_near_each};
-use hpge_surrogate::{ExactSolver, ParameterSpace};
-use hpge_validation::repo_path;
+use hpge_validation::problems::stand_in::{
+    STAND_IN_TRUTH, input_widths, stand_in_solver, two_mode_draws,
+};
 
 #[test]
 fn a_chain_through_two_modes_gives_the_same_curves_in_fewer_steps() {
-    let space = ParameterSpace::from_file(&repo_path("spaces/super-siegfried-rz.toml")).unwrap();
-    let ex = ExactSolver::new(
-        space,
-        &repo_path("detectors/super-siegfried-k1.toml"),
-        FieldSettings::default(),
-    )
-    .unwrap();
-    // The stand-in's truth (d_Li, four bottom knots, four top knots), and B_Z-like draws
-    // around it and around its mirror (bottom and top levels swapped), as in the B_Z fit.
-    let mode = [3.0, 0.66, 0.66, 0.58, -0.38, 0.55, 0.54, 0.48, -0.32];
-    let mirror = [3.0, 0.55, 0.54, 0.48, -0.32, 0.66, 0.66, 0.58, -0.38];
-    let mut xs = Vec::new();
-    for k in 0..3 {
-        let e = 0.004 * f64::from(k + 1);
-        for c in [mode, mirror] {
-            let mut x = c;
-            x[0] += 20.0 * e;
-            x[1] -= e;
-            x[5] += e;
-            xs.push(x.to_vec());
-        }
-    }
-    let det = ex.detector(&mode).unwrap();
+    let ex = stand_in_solver().unwrap();
+    let xs = two_mode_draws(3);
+    let det = ex.detector(&STAND_IN_TRUTH).unwrap();
     let near: Vec<_> = xs.iter().map(|x| ex.detector(x).unwrap()).collect();
-    let widths: Vec<f64> = ex.space.dimensions[..9]
-        .iter()
-        .map(|d| d.range[1] - d.range[0])
-        .collect();
-    let chain = SeedChain::nearest_neighbour(&mode, &xs, &widths);
+    let chain = SeedChain::nearest_neighbour(&STAND_IN_TRUTH, &xs, &input_widths(&ex));
     assert!(matches!(chain.seeding(), NearSeeding::Chain(_)));
     let volts = [400.0, 1300.0, 2600.0];
     let solve = |seeding| {

@@ -8,6 +8,7 @@ use std::path::Path;
 
 use hpge_solver::field::{Continuation, cv_curves_near};
 use hpge_solver::{Detector, FieldSettings, Parameters};
+use hpge_validation::problems::stand_in::{STAND_IN_TRUTH, stand_in_solver};
 use hpge_validation::{LongCoax, repo_path};
 
 /// The coax file with the outer radius and the density replaced.
@@ -81,25 +82,8 @@ fn near_differences_follow_the_closed_form_in_density_and_radius() {
 /// `validation/examples/fd_near.rs`).
 #[test]
 fn near_differences_in_an_impurity_knot_are_smooth() {
-    use hpge_surrogate::{ExactSolver, ParameterSpace};
-    let space = ParameterSpace::from_file(&repo_path("spaces/super-siegfried-rz.toml")).unwrap();
-    let ex = ExactSolver::new(
-        space,
-        &repo_path("detectors/super-siegfried-k1.toml"),
-        FieldSettings::default(),
-    )
-    .unwrap();
-    let x = [
-        3.0,
-        0.6641665582231558,
-        0.6565589955022244,
-        0.5773215797217719,
-        -0.37587850097731035,
-        0.5506015329628319,
-        0.5439239787452446,
-        0.47512927644699526,
-        -0.32334667109273946,
-    ];
+    let ex = stand_in_solver().unwrap();
+    let x = STAND_IN_TRUTH;
     let h = 0.02;
     let step = |d: f64| {
         let mut y = x;
