@@ -93,16 +93,20 @@ pub fn bench(c: &mut Criterion) {
 /// The exact check's draws of a two-mode posterior, seeded from the mode or along a chain.
 fn check_draws(c: &mut Criterion) {
     use hpge_validation::problems::stand_in::{
-        STAND_IN_TRUTH, input_widths, stand_in_solver, two_mode_draws,
+        input_widths, stand_in_solver, stand_in_truth, two_mode_draws,
     };
     let ex = stand_in_solver().expect("the stand-in's exact solver sets up");
-    let xs = two_mode_draws(4);
-    let det = ex.detector(&STAND_IN_TRUTH).expect("detector");
+    let truth: [f64; 9] = stand_in_truth(&ex)
+        .expect("the stand-in's truth reads")
+        .try_into()
+        .expect("nine inputs");
+    let xs = two_mode_draws(&truth, 4);
+    let det = ex.detector(&truth).expect("detector");
     let near: Vec<_> = xs
         .iter()
         .map(|x| ex.detector(x).expect("detector"))
         .collect();
-    let chain = SeedChain::nearest_neighbour(&STAND_IN_TRUTH, &xs, &input_widths(&ex));
+    let chain = SeedChain::nearest_neighbour(&truth, &xs, &input_widths(&ex));
     let volts: Vec<f64> = (0..20).map(|k| 25.0 + 150.0 * k as f64).collect();
     let mut g = c.benchmark_group("exact_check_draws");
     g.sample_size(10).measurement_time(Duration::from_secs(40));

@@ -6,16 +6,17 @@
 
 use hpge_solver::field::{Continuation, NearSeeding, SeedChain, cv_curves_near_each};
 use hpge_validation::problems::stand_in::{
-    STAND_IN_TRUTH, input_widths, stand_in_solver, two_mode_draws,
+    input_widths, stand_in_solver, stand_in_truth, two_mode_draws,
 };
 
 #[test]
 fn a_chain_through_two_modes_gives_the_same_curves_in_fewer_steps() {
     let ex = stand_in_solver().unwrap();
-    let xs = two_mode_draws(3);
-    let det = ex.detector(&STAND_IN_TRUTH).unwrap();
+    let truth: [f64; 9] = stand_in_truth(&ex).unwrap().try_into().unwrap();
+    let xs = two_mode_draws(&truth, 3);
+    let det = ex.detector(&truth).unwrap();
     let near: Vec<_> = xs.iter().map(|x| ex.detector(x).unwrap()).collect();
-    let chain = SeedChain::nearest_neighbour(&STAND_IN_TRUTH, &xs, &input_widths(&ex));
+    let chain = SeedChain::nearest_neighbour(&truth, &xs, &input_widths(&ex));
     assert!(matches!(chain.seeding(), NearSeeding::Chain(_)));
     let volts = [400.0, 1300.0, 2600.0];
     let solve = |seeding| {

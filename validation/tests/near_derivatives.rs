@@ -8,7 +8,7 @@ use std::path::Path;
 
 use hpge_solver::field::{Continuation, cv_curves_near};
 use hpge_solver::{Detector, FieldSettings, Parameters};
-use hpge_validation::problems::stand_in::{STAND_IN_TRUTH, stand_in_solver};
+use hpge_validation::problems::stand_in::{stand_in_solver, stand_in_truth};
 use hpge_validation::{LongCoax, repo_path};
 
 /// The coax file with the outer radius and the density replaced.
@@ -83,7 +83,7 @@ fn near_differences_follow_the_closed_form_in_density_and_radius() {
 #[test]
 fn near_differences_in_an_impurity_knot_are_smooth() {
     let ex = stand_in_solver().unwrap();
-    let x = STAND_IN_TRUTH;
+    let x: [f64; 9] = stand_in_truth(&ex).unwrap().try_into().unwrap();
     let h = 0.02;
     let step = |d: f64| {
         let mut y = x;

@@ -27,6 +27,8 @@
 //! ([`NearSeeding::Chain`], [`SeedChain`]). Either way the curves come out bit for bit the same
 //! (measured on the B_Z fit's 300 exact curves).
 
+use std::sync::atomic::{AtomicUsize, Ordering};
+
 use rayon::prelude::*;
 
 use super::curve::{Continuation, CvCurve, curve_keeping};
@@ -245,7 +247,6 @@ pub fn cv_curves_near_each(
     // solved[k][j]: nearby detector k at voltage j.
     let solved: Vec<Vec<Result<Solved>>> = match seeding {
         NearSeeding::Base => {
-            use std::sync::atomic::{AtomicUsize, Ordering};
             let done = AtomicUsize::new(1);
             (0..near.len())
                 .into_par_iter()
@@ -262,7 +263,6 @@ pub fn cv_curves_near_each(
                 .collect()
         }
         NearSeeding::Chain(order) => {
-            use std::sync::atomic::{AtomicUsize, Ordering};
             let nv = kept.len();
             let volts_done = AtomicUsize::new(0);
             let by_voltage: Vec<Vec<Option<Result<Solved>>>> = kept

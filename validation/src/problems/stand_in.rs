@@ -1,7 +1,7 @@
 //! The shipped stand-in detector as the exact solver sees it: Super-Siegfried
 //! (`detectors/super-siegfried-k1.toml`) on the rz parameter space
 //! (`spaces/super-siegfried-rz.toml`) at the default field settings, the stand-in data's truth
-//! (`data/super-siegfried-k1/truth-b-rz.toml`), and draws of a two-mode posterior around it, as
+//! (read from `data/super-siegfried-k1/truth-b-rz.toml`), and draws of a two-mode posterior around it, as
 //! the exact-solver check of a B_Z fit meets them (bottom and top levels swapped).
 
 use hpge_solver::FieldSettings;
@@ -9,19 +9,35 @@ use hpge_surrogate::{ExactSolver, ParameterSpace};
 
 use crate::{Error, Result, repo_path};
 
-/// The stand-in's truth in the rz space's inputs (d_li_mm, y1..y4_bot, y1..y4_top;
-/// `data/super-siegfried-k1/truth-b-rz.toml`).
-pub const STAND_IN_TRUTH: [f64; 9] = [
-    3.0,
-    0.6641665582231558,
-    0.6565589955022244,
-    0.5773215797217719,
-    -0.37587850097731035,
-    0.5506015329628319,
-    0.5439239787452446,
-    0.47512927644699526,
-    -0.32334667109273946,
-];
+/// The file of the stand-in's truth in the B_RZ parameters.
+pub const STAND_IN_TRUTH_FILE: &str = "data/super-siegfried-k1/truth-b-rz.toml";
+
+/// The stand-in's truth ([`STAND_IN_TRUTH_FILE`]) in `solver`'s inputs, in their order
+/// (d_li_mm, y1..y4_bot, y1..y4_top for the rz space).
+///
+/// # Errors
+/// The file does not read or parse, or lacks one of the inputs as a number.
+pub fn stand_in_truth(solver: &ExactSolver) -> Result<Vec<f64>> {
+    let path = repo_path(STAND_IN_TRUTH_FILE);
+    let file = |message: String| Error::File {
+        path: path.clone(),
+        message,
+    };
+    let text = std::fs::read_to_string(&path).map_err(|e| file(e.to_string()))?;
+    let table: toml::Table = text
+        .parse()
+        .map_err(|e: toml::de::Error| file(e.to_string()))?;
+    let n = solver.space.dimensions.len() - 1;
+    solver.space.dimensions[..n]
+        .iter()
+        .map(|d| {
+            table
+                .get(&d.name)
+                .and_then(|v| v.as_float().or_else(|| v.as_integer().map(|i| i as f64)))
+                .ok_or_else(|| file(format!("`{}`: missing, or not a number", d.name)))
+        })
+        .collect()
+}
 
 /// The exact solver of the stand-in: the rz space on Super-Siegfried, default field settings.
 ///
@@ -48,11 +64,11 @@ pub fn input_widths(solver: &ExactSolver) -> Vec<f64> {
         .collect()
 }
 
-/// `per_mode` draws around [`STAND_IN_TRUTH`] and as many around its mirror (the bottom and top
-/// knots swapped), interleaved: draw k of a mode moves d_Li by +0.08 (k + 1) mm, y1_bot by
-/// -0.004 (k + 1) and y1_top by +0.004 (k + 1).
-pub fn two_mode_draws(per_mode: usize) -> Vec<Vec<f64>> {
-    let t = STAND_IN_TRUTH;
+/// `per_mode` draws around `truth` (rz inputs: d_li_mm, four bottom knots, four top knots) and
+/// as many around its mirror (the bottom and top knots swapped), interleaved: draw k of a mode
+/// moves d_Li by +0.08 (k + 1) mm, y1_bot by -0.004 (k + 1) and y1_top by +0.004 (k + 1).
+pub fn two_mode_draws(truth: &[f64; 9], per_mode: usize) -> Vec<Vec<f64>> {
+    let t = *truth;
     let mirror = [t[0], t[5], t[6], t[7], t[8], t[1], t[2], t[3], t[4]];
     let mut xs = Vec::with_capacity(2 * per_mode);
     for k in 0..per_mode {
@@ -78,13 +94,23 @@ mod tests {
     use super::*;
 
     #[test]
+    fn the_truth_reads_in_the_inputs_order() {
+        let t = stand_in_truth(&stand_in_solver().unwrap()).unwrap();
+        assert_eq!(t.len(), 9);
+        assert_eq!(t[0], 3.0);
+        assert_eq!(t[1], 0.6641665582231558);
+        assert_eq!(t[8], -0.32334667109273946);
+    }
+
+    #[test]
     fn the_draws_alternate_between_the_truth_and_its_mirror() {
-        let xs = two_mode_draws(2);
+        let t = [3.0, 0.66, 0.66, 0.58, -0.38, 0.55, 0.54, 0.48, -0.32];
+        let xs = two_mode_draws(&t, 2);
         assert_eq!(xs.len(), 4);
-        assert!((xs[0][1] - (STAND_IN_TRUTH[1] - 0.004)).abs() < 1e-15);
-        assert!((xs[1][1] - (STAND_IN_TRUTH[5] - 0.004)).abs() < 1e-15);
+        assert!((xs[0][1] - (t[1] - 0.004)).abs() < 1e-15);
+        assert!((xs[1][1] - (t[5] - 0.004)).abs() < 1e-15);
         assert!((xs[3][0] - 3.16).abs() < 1e-12);
-        assert_eq!(xs[1][6], STAND_IN_TRUTH[2]);
+        assert_eq!(xs[1][6], t[2]);
     }
 
     #[test]
