@@ -5,8 +5,9 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Result;
 use hpge_solver::{Detector, FieldSettings, Parameters};
-use hpge_surrogate::job::GenerateOptions;
-use hpge_surrogate::{Generator, ParameterSpace, merge, run};
+use hpge_surrogate::generate::label as label_rows;
+use hpge_surrogate::job::{GenerateOptions, LabelOptions};
+use hpge_surrogate::{ExactSolver, Generator, ParameterSpace, merge, run};
 use indicatif::{ProgressBar, ProgressStyle};
 
 /// Runs or resumes a generation.
@@ -74,6 +75,50 @@ pub fn merge_shards(dirs: &[PathBuf], out: &Path) -> Result<()> {
         r.rows,
         dirs.len(),
         r.failed
+    );
+    Ok(())
+}
+
+/// Labels rows made before the regime columns existed.
+pub fn label(o: &LabelOptions) -> Result<()> {
+    let space = ParameterSpace::from_file(&o.space)?;
+    let det = Detector::from_file(&o.detector, &Parameters::new())?;
+    let settings = o.grid.apply(&FieldSettings::default(), &det)?;
+    settings
+        .validate()
+        .map_err(|e| anyhow::anyhow!("solver settings: {e}"))?;
+    let exact = ExactSolver::new(space, &o.detector, settings)?;
+    let bar = ProgressBar::new(0);
+    bar.set_style(
+        ProgressStyle::with_template(
+            "{bar:40} {pos}/{len} rows, {per_sec}, {elapsed} elapsed, eta {eta}",
+        )
+        .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    let start = std::time::Instant::now();
+    let report = label_rows(&exact, &o.data, &o.out, o.threads, |done, total| {
+        bar.set_length(total as u64);
+        bar.set_position(done as u64);
+    });
+    bar.finish_and_clear();
+    let report = report?;
+    for (i, reason) in &report.failed {
+        eprintln!("row {i}: {reason}");
+    }
+    println!(
+        "{}: {} rows ({} from before, {} solved and {} copied now in {:.1} s), {} failed solves{}",
+        o.out.join("rows.csv").display(),
+        report.total,
+        report.resumed,
+        report.solved,
+        report.copied,
+        start.elapsed().as_secs_f64(),
+        report.failed.len(),
+        if report.sorted {
+            ", sorted by index"
+        } else {
+            ""
+        }
     );
     Ok(())
 }

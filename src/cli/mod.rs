@@ -72,6 +72,9 @@ enum Command {
     Generate(hpge_surrogate::job::GenerateOptions),
     /// Merge the shard folders of one `generate` run into one CSV.
     Merge(MergeArgs),
+    /// Regime labels (pockets, the largest pocket's level, their volume) for rows made before
+    /// `generate` wrote them: each row's point solved again (resumable).
+    Label(hpge_surrogate::job::LabelOptions),
     /// Train a surrogate of c12(p, U_B) on generated rows (the paper's network or a better recipe).
     Train(TrainArgs),
     /// Accuracy of a surrogate on a data set it never saw: error histograms, Gaussian sigma,
@@ -373,6 +376,7 @@ pub fn run(cli: Cli) -> Result<()> {
         }),
         Command::Generate(o) => generate::generate(&o),
         Command::Merge(a) => generate::merge_shards(&a.dirs, &a.out),
+        Command::Label(o) => generate::label(&o),
         Command::Train(a) => surrogate::train(&a.job, a.plot.as_deref(), false),
         Command::Fit(a) => fit::run(&a.options, a.json, a.allow_unconverged),
         Command::Discover(a) => discover::run(&a),

@@ -314,6 +314,29 @@ pub fn evaluate(o: &EvaluateOptions, json: bool, plot: Option<&Path>) -> Result<
             );
         }
     }
+    if !ev.regimes.is_empty() {
+        println!(
+            "by depletion regime (the data set's regime columns): Gaussian sigma, |relative \
+             error| quantiles, fraction within 2 predicted sigma"
+        );
+        println!(
+            "  {:>12} {:>6} {:>9} {:>9} {:>9} {:>9} {:>9}  rows",
+            "group", "n", "sigma", "median", "q90", "q99", "in 2 sig"
+        );
+        for g in &ev.regimes {
+            println!(
+                "  {:>12} {:>6} {:>8.3}% {:>8.3}% {:>8.3}% {:>8.3}% {:>8.1}%  {}",
+                g.group,
+                g.n,
+                100.0 * g.rel_sigma,
+                100.0 * g.abs_rel_q50,
+                100.0 * g.abs_rel_q90,
+                100.0 * g.abs_rel_q99,
+                100.0 * g.coverage_2sigma,
+                g.rule
+            );
+        }
+    }
     println!("worst samples:");
     for w in &ev.worst {
         let inputs: Vec<String> = w

@@ -7,9 +7,13 @@ use std::path::{Path, PathBuf};
 use hpge_solver::field::{Continuation, cv_curve_with};
 use hpge_solver::{Detector, FieldSettings, ImpuritySpec, Parameters, solve_point};
 
+use super::regime::Regime;
 use crate::error::{Error, Result};
 use crate::hash::fnv1a;
 use crate::space::{ParameterSpace, Target};
+
+/// The resolution (V) to which [`ExactSolver::solve_labelled_switch`] bisects a switch.
+pub const SWITCH_RESOLUTION_V: f64 = 0.5;
 
 /// A detector whose parameters and impurity model are set from points of a parameter space.
 #[derive(Debug, Clone)]
@@ -122,9 +126,67 @@ impl ExactSolver {
     /// the settings' tolerance where the adaptive grid could not reach it (a pocket's neck at
     /// pinch-off).
     pub fn solve_with_error(&self, x: &[f64]) -> Result<(f64, f64)> {
+        let (c, err, _) = self.solve_labelled(x)?;
+        Ok((c, err))
+    }
+
+    /// [`ExactSolver::solve_labelled`] and the nearest bias within `window_v` of the row's bias
+    /// at which the number of pockets changes (a pinch-off, or a pocket depleting): found on
+    /// the point's final mesh with depletion solves alone (`solve_fast`, each seeded by the
+    /// last), at U_B - w and U_B + w, then bisected to [`SWITCH_RESOLUTION_V`] where the
+    /// count differs from the count at U_B on that mesh. NaN when neither end differs (two
+    /// switches within the window that cancel are not seen). The closer side wins.
+    pub fn solve_labelled_switch(
+        &self,
+        x: &[f64],
+        window_v: f64,
+    ) -> Result<(f64, f64, Regime, f64)> {
         let (det, bias) = self.configure(x)?;
         let p = solve_point(&det, bias, &self.settings, None)?;
-        Ok((p.c12_pf, p.accuracy.c12_err_pf))
+        let regime = Regime::from_pockets(&p.potential.pockets);
+        let count = |u: f64, guess: &[f64]| -> Result<(usize, Vec<f64>)> {
+            let s = hpge_solver::field::solve_fast(&p.mesh, &det, u, Some(guess))?;
+            Ok((s.pockets.len(), s.phi_v))
+        };
+        let phi0 = &p.potential.phi_v;
+        let (n0, _) = count(bias, phi0)?;
+        let mut best = f64::NAN;
+        for side in [-1.0, 1.0] {
+            let far = (bias + side * window_v).max(0.0);
+            if far == bias {
+                continue;
+            }
+            let (n_far, mut guess) = count(far, phi0)?;
+            if n_far == n0 {
+                continue;
+            }
+            // Bisect between the row's bias (count n0) and `far` (another count).
+            let (mut near_v, mut far_v) = (bias, far);
+            while (far_v - near_v).abs() > SWITCH_RESOLUTION_V {
+                let mid = 0.5 * (near_v + far_v);
+                let (n, g) = count(mid, &guess)?;
+                guess = g;
+                if n == n0 {
+                    near_v = mid;
+                } else {
+                    far_v = mid;
+                }
+            }
+            let at = 0.5 * (near_v + far_v);
+            if best.is_nan() || (at - bias).abs() < (best - bias).abs() {
+                best = at;
+            }
+        }
+        Ok((p.c12_pf, p.accuracy.c12_err_pf, regime, best))
+    }
+
+    /// [`ExactSolver::solve_with_error`] with the pockets the solve ended with (the training
+    /// row's regime, `generate::regime`): (c12 pF, estimated error pF, regime).
+    pub fn solve_labelled(&self, x: &[f64]) -> Result<(f64, f64, Regime)> {
+        let (det, bias) = self.configure(x)?;
+        let p = solve_point(&det, bias, &self.settings, None)?;
+        let regime = Regime::from_pockets(&p.potential.pockets);
+        Ok((p.c12_pf, p.accuracy.c12_err_pf, regime))
     }
 
     /// The detector with the space's non-bias values `params` (column order, a surrogate's
@@ -180,6 +242,21 @@ impl ExactSolver {
         volts: &[f64],
         continuation: Continuation,
     ) -> Result<Vec<(f64, f64)>> {
+        Ok(self
+            .curve_labelled(params, volts, continuation)?
+            .into_iter()
+            .map(|(c, e, _)| (c, e))
+            .collect())
+    }
+
+    /// [`ExactSolver::curve_with_error`] with each point's regime (its pockets): (c12 pF,
+    /// estimated error pF, regime) per bias.
+    pub fn curve_labelled(
+        &self,
+        params: &[f64],
+        volts: &[f64],
+        continuation: Continuation,
+    ) -> Result<Vec<(f64, f64, Regime)>> {
         let det = self.detector(params)?;
         let curve = cv_curve_with(&det, volts, &self.settings, continuation, |_, _| {})?;
         if curve.points.len() != volts.len() {
@@ -191,7 +268,7 @@ impl ExactSolver {
         Ok(curve
             .points
             .iter()
-            .map(|p| (p.c12_pf, p.c12_err_pf))
+            .map(|p| (p.c12_pf, p.c12_err_pf, Regime::from_pockets(&p.pockets)))
             .collect())
     }
 

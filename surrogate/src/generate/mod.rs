@@ -2,15 +2,19 @@
 //! sharded (Slurm job arrays), merged.
 
 mod exact;
+mod label;
 mod lock;
 mod merge;
+mod regime;
 mod run;
 mod setup;
 #[cfg(test)]
 mod tests;
 
-pub use exact::ExactSolver;
+pub use exact::{ExactSolver, SWITCH_RESOLUTION_V};
+pub use label::{LABEL_C12_COLUMN, LabelInfo, LabelReport, SWITCH_COLUMN, SWITCH_WINDOW_V, label};
 pub use lock::{FolderLock, LOCK_FILE};
 pub use merge::{MergeReport, merge};
-pub use run::{RunInfo, RunReport, format_row, read_rows, run};
+pub use regime::{REGIME_COLUMNS, Regime};
+pub use run::{RunInfo, RunReport, format_row, format_row_with, read_rows, run};
 pub use setup::{Fingerprint, Generator, Sample, Shard};

@@ -18,6 +18,7 @@ use std::sync::Mutex;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use super::regime::Regime;
 use super::setup::{Fingerprint, Generator, Sample, Shard};
 use crate::error::{Error, Result};
 
@@ -58,17 +59,26 @@ pub struct RunReport {
     pub retried: usize,
 }
 
-/// One row as CSV (no newline): floats in Rust's shortest round-trip form.
+/// One row as CSV (no newline): floats in Rust's shortest round-trip form, in the columns of
+/// [`Generator::header`].
 pub fn format_row(s: &Sample) -> String {
+    format_row_with(s, true)
+}
+
+/// [`format_row`], without the regime columns when `regime` is false (the format of runs
+/// started before they existed: [`Generator::header_with`]).
+pub fn format_row_with(s: &Sample, regime: bool) -> String {
     let mut line = s.index.to_string();
     for v in s.u.iter().chain(&s.x) {
         line.push(',');
         line.push_str(&v.to_string());
     }
-    line.push_str(&format!(
-        ",{},{},{},{}",
-        s.c12_pf, s.status, s.c12_err_pf, s.seconds
-    ));
+    line.push_str(&format!(",{},{},{},", s.c12_pf, s.status, s.c12_err_pf));
+    if regime {
+        line.push_str(&Regime::csv(s.regime.as_ref()));
+        line.push(',');
+    }
+    line.push_str(&s.seconds.to_string());
     line
 }
 
@@ -159,7 +169,7 @@ pub fn run(
     let _lock = super::lock::FolderLock::acquire(out)?;
     let info_path = out.join("generate.json");
     let rows_path = out.join("rows.csv");
-    let info = RunInfo {
+    let mut info = RunInfo {
         fingerprint: g.fingerprint.clone(),
         shard: g.shard,
         header: g.header(),
@@ -168,6 +178,9 @@ pub fn run(
         settings: Some(g.settings.clone()),
         version: env!("CARGO_PKG_VERSION").to_string(),
     };
+    // The regime columns (`pockets`, ...): in every new run; a run started before they existed
+    // is resumed in its own format, so its rows stay one file of one header.
+    let mut regime_columns = true;
     if info_path.exists() {
         let old: RunInfo = serde_json::from_str(
             &std::fs::read_to_string(&info_path).map_err(io(&info_path, "cannot read"))?,
@@ -176,6 +189,10 @@ pub fn run(
             file: info_path.clone(),
             message: e.to_string(),
         })?;
+        if old.header == g.header_with(false) {
+            regime_columns = false;
+            info.header = old.header.clone();
+        }
         if old.fingerprint != info.fingerprint
             || old.shard != info.shard
             || old.header != info.header
@@ -275,7 +292,10 @@ pub fn run(
                 return;
             }
             let samples = g.unit(p);
-            let text: String = samples.iter().map(|s| format_row(s) + "\n").collect();
+            let text: String = samples
+                .iter()
+                .map(|s| format_row_with(s, regime_columns) + "\n")
+                .collect();
             let mut f = file.lock().unwrap_or_else(|e| e.into_inner());
             if let Err(e) = f.write_all(text.as_bytes()) {
                 *error.lock().unwrap_or_else(|e| e.into_inner()) =

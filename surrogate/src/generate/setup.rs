@@ -7,6 +7,7 @@ use hpge_solver::FieldSettings;
 use serde::{Deserialize, Serialize};
 
 use super::exact::ExactSolver;
+use super::regime::{REGIME_COLUMNS, Regime};
 use crate::error::{Error, Result};
 use crate::hash::fnv1a;
 use crate::sequence::{Sequence, SequenceKind};
@@ -134,6 +135,8 @@ pub struct Sample {
     /// The solver's estimated absolute error of c12, pF (`|c12_h - c12_H|` of the adaptive
     /// grid; NaN when the solve failed).
     pub c12_err_pf: f64,
+    /// The pockets the solve ended with (None when it failed).
+    pub regime: Option<Regime>,
     /// Wall time of the solve, s.
     pub seconds: f64,
 }
@@ -322,20 +325,14 @@ impl Generator {
         // a row then equals the point-mode solve at its x bit for bit.
         let result =
             self.exact
-                .curve_with_error(&params, &volts, hpge_solver::field::Continuation::Cold);
+                .curve_labelled(&params, &volts, hpge_solver::field::Continuation::Cold);
         let seconds = start.elapsed().as_secs_f64() / k as f64;
         rows.into_iter()
             .enumerate()
             .map(|(j, (u, x))| {
-                let (c12_pf, c12_err_pf, status) = match &result {
-                    Ok(c) => (c[j].0, c[j].1, "ok".to_string()),
-                    Err(e) => (
-                        f64::NAN,
-                        f64::NAN,
-                        format!("failed: {e}")
-                            .replace([',', '\n', '\r'], ";")
-                            .replace(['#', '"'], "'"),
-                    ),
+                let (c12_pf, c12_err_pf, regime, status) = match &result {
+                    Ok(c) => (c[j].0, c[j].1, Some(c[j].2), "ok".to_string()),
+                    Err(e) => (f64::NAN, f64::NAN, None, failure(e)),
                 };
                 Sample {
                     index: p * k + j as u64,
@@ -344,19 +341,32 @@ impl Generator {
                     c12_pf,
                     status,
                     c12_err_pf,
+                    regime,
                     seconds,
                 }
             })
             .collect()
     }
 
-    /// The CSV header: index, u_<name>..., <name>..., c12_pF, status, c12_err_pF, seconds.
+    /// The CSV header: index, u_<name>..., <name>..., c12_pF, status, c12_err_pF, pockets,
+    /// pocket_level_V, pocket_cm3, seconds ([`super::regime`]).
     pub fn header(&self) -> String {
+        self.header_with(true)
+    }
+
+    /// [`Generator::header`], or without the regime columns (`regime` false): the header of
+    /// runs started before they existed, which a resume continues in their own format.
+    pub fn header_with(&self, regime: bool) -> String {
         let names = self.space.dimensions.iter().map(|d| d.name.as_str());
         let u: Vec<String> = names.clone().map(|n| format!("u_{n}")).collect();
         let x: Vec<&str> = names.collect();
+        let regime = if regime {
+            format!("{},", REGIME_COLUMNS.join(","))
+        } else {
+            String::new()
+        };
         format!(
-            "index,{},{},c12_pF,status,c12_err_pF,seconds",
+            "index,{},{},c12_pF,status,c12_err_pF,{regime}seconds",
             u.join(","),
             x.join(",")
         )
@@ -368,16 +378,10 @@ impl Generator {
     pub fn sample(&self, index: u64) -> Sample {
         let start = std::time::Instant::now();
         let (u, x) = self.space.from_sampled_unit(&self.sequence.point(index));
-        let result = self.exact.solve_with_error(&x);
-        let (c12_pf, c12_err_pf, status) = match result {
-            Ok((c, err)) => (c, err, "ok".to_string()),
-            Err(e) => (
-                f64::NAN,
-                f64::NAN,
-                format!("failed: {e}")
-                    .replace([',', '\n', '\r'], ";")
-                    .replace(['#', '"'], "'"),
-            ),
+        let result = self.exact.solve_labelled(&x);
+        let (c12_pf, c12_err_pf, regime, status) = match result {
+            Ok((c, err, regime)) => (c, err, Some(regime), "ok".to_string()),
+            Err(e) => (f64::NAN, f64::NAN, None, failure(&e)),
         };
         Sample {
             index,
@@ -386,7 +390,16 @@ impl Generator {
             c12_pf,
             status,
             c12_err_pf,
+            regime,
             seconds: start.elapsed().as_secs_f64(),
         }
     }
+}
+
+/// A failed solve's `status`: `failed: <reason>` on one CSV field (no commas, line breaks,
+/// comment marks or quotes).
+fn failure(e: &impl std::fmt::Display) -> String {
+    format!("failed: {e}")
+        .replace([',', '\n', '\r'], ";")
+        .replace(['#', '"'], "'")
 }

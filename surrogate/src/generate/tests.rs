@@ -68,6 +68,13 @@ fn curve_rows_are_point_solves_on_bias_strata() {
             "row {j}: error estimate {err}"
         );
         assert!(super::format_row(r).contains(&format!(",ok,{err},")));
+        // The regime is the point solve's pockets, written between the error and the time.
+        let (_, _, regime) = g.exact.solve_labelled(&r.x).unwrap();
+        assert_eq!(r.regime.map(|x| x.pockets), Some(regime.pockets));
+        assert!(
+            super::format_row(r)
+                .contains(&format!(",ok,{err},{},", super::Regime::csv(Some(&regime))))
+        );
     }
     // The three strata's shift is the point's own quasi-random bias coordinate.
     let shift = rows[0].u[b] * k as f64;
@@ -144,13 +151,22 @@ fn retry_failed_solves_failed_rows_again_and_keeps_the_others() {
     run(&g, &dir, Some(1), |_, _| {}).unwrap();
     let rows_path = dir.join("rows.csv");
     let full = std::fs::read_to_string(&rows_path).unwrap();
-    // Row 1 as a failed solve would have written it: NaN c12 and the reason.
+    // Row 1 as a failed solve would have written it: NaN c12, error and regime, and the
+    // reason (columns found by name).
+    let header: Vec<&str> = full.lines().next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
     let failed_line = |l: &str| {
-        let f: Vec<&str> = l.split(',').collect();
-        let n = f.len();
-        let mut g: Vec<String> = f.iter().map(|s| s.to_string()).collect();
-        g[n - 3] = "NaN".into();
-        g[n - 2] = "failed: the fast solver did not converge".into();
+        let mut g: Vec<String> = l.split(',').map(|s| s.to_string()).collect();
+        for name in [
+            "c12_pF",
+            "c12_err_pF",
+            "pockets",
+            "pocket_level_V",
+            "pocket_cm3",
+        ] {
+            g[col(name)] = "NaN".into();
+        }
+        g[col("status")] = "failed: the fast solver did not converge".into();
         g.join(",")
     };
     let hurt: Vec<String> = full
@@ -182,4 +198,64 @@ fn retry_failed_solves_failed_rows_again_and_keeps_the_others() {
     };
     assert_eq!(without_seconds(&now), without_seconds(&full));
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn rows_carry_the_regime_columns_and_a_run_from_before_them_resumes_in_its_own_format() {
+    let g = generator(3, 1);
+    assert!(
+        g.header()
+            .ends_with(",c12_pF,status,c12_err_pF,pockets,pocket_level_V,pocket_cm3,seconds")
+    );
+    let dir = std::env::temp_dir().join(format!("hpge-regime-cols-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let new = run(&g, &dir, Some(1), |_, _| {}).unwrap();
+    assert_eq!(new.written, 3);
+    let text = std::fs::read_to_string(dir.join("rows.csv")).unwrap();
+    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+    let pockets = header.iter().position(|h| *h == "pockets").unwrap();
+    for line in text.lines().skip(1) {
+        let f: Vec<&str> = line.split(',').collect();
+        assert_eq!(f.len(), header.len());
+        let r = super::Regime::parse(f[pockets], f[pockets + 1], f[pockets + 2]);
+        assert!(r.is_some(), "{line}");
+    }
+    // A run started before the columns existed: its generate.json and rows have the old
+    // header. Resuming it keeps that format (no mixed rows), and its rows are the new rows
+    // less the three regime fields.
+    let old_dir = dir.with_extension("old");
+    let _ = std::fs::remove_dir_all(&old_dir);
+    std::fs::create_dir_all(&old_dir).unwrap();
+    let info_text = std::fs::read_to_string(dir.join("generate.json")).unwrap();
+    let mut info: super::RunInfo = serde_json::from_str(&info_text).unwrap();
+    info.header = g.header_with(false);
+    std::fs::write(
+        old_dir.join("generate.json"),
+        serde_json::to_string_pretty(&info).unwrap(),
+    )
+    .unwrap();
+    let strip = |line: &str| {
+        let mut f: Vec<&str> = line.split(',').collect();
+        f.drain(pockets..pockets + 3);
+        f.join(",")
+    };
+    let first_two: Vec<String> = text.lines().skip(1).take(2).map(strip).collect();
+    std::fs::write(
+        old_dir.join("rows.csv"),
+        format!("{}\n{}\n", info.header, first_two.join("\n")),
+    )
+    .unwrap();
+    let resumed = run(&g, &old_dir, Some(1), |_, _| {}).unwrap();
+    assert_eq!((resumed.resumed, resumed.written), (2, 1));
+    let old_text = std::fs::read_to_string(old_dir.join("rows.csv")).unwrap();
+    let n_old = info.header.split(',').count();
+    assert!(old_text.lines().all(|l| l.split(',').count() == n_old));
+    let no_time = |l: &str| l[..l.rfind(',').unwrap()].to_string();
+    let last_new = strip(text.lines().nth(3).unwrap());
+    assert_eq!(
+        no_time(old_text.lines().nth(3).unwrap()),
+        no_time(&last_new)
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+    let _ = std::fs::remove_dir_all(&old_dir);
 }

@@ -68,7 +68,7 @@ pub fn bias_bands(model: &Surrogate, data: &DataSet, rel: &[f64], sigma: &[f64])
 }
 
 /// The figures of one band's relative errors `rel` with predicted sigmas `sigma`.
-fn band(range_v: [f64; 2], rel: &[f64], sigma: &[f64]) -> BiasBand {
+pub(crate) fn band(range_v: [f64; 2], rel: &[f64], sigma: &[f64]) -> BiasBand {
     let n = rel.len();
     let mut abs: Vec<f64> = rel.iter().map(|r| r.abs()).collect();
     abs.sort_by(f64::total_cmp);

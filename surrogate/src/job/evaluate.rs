@@ -7,6 +7,7 @@ use std::path::Path;
 use serde::Serialize;
 
 use super::bands::{BiasBand, bias_bands};
+use super::regimes::{RegimeGroup, regime_groups};
 use crate::model::{DataSet, Figures, Surrogate, dimension_from_unit, quantile};
 use crate::{Error, Result};
 
@@ -138,6 +139,9 @@ pub struct Evaluation {
     pub sigma_kind: &'static str,
     /// The accuracy by band of the bias ([`super::bias_bands`]).
     pub bias_bands: Vec<BiasBand>,
+    /// The accuracy by depletion regime, where the data set is labelled
+    /// ([`super::regime_groups`]).
+    pub regimes: Vec<RegimeGroup>,
 }
 
 /// `evaluate --json`: the fields first, then the rest (the field order is the JSON's).
@@ -195,6 +199,9 @@ pub struct EvaluationJson<'a> {
     /// The accuracy by band of the bias voltage, finer at low bias (empty for a space without
     /// one).
     pub bias_bands: &'a [BiasBand],
+    /// The accuracy within the solver's pinch-off transition and away from it, and with and
+    /// without a pocket (empty for a data set without the regime columns).
+    pub regimes: &'a [RegimeGroup],
 }
 
 /// Reads a data set against the space of `model` (loaded from `model_file`); a refusal names the
@@ -237,6 +244,7 @@ impl Evaluation {
         let sigma = model.sigma_set(data);
         let coverage = crate::model::coverage_of(&rels, sigma.iter().copied());
         let bias_bands = bias_bands(model, data, &rels, &sigma);
+        let regimes = regime_groups(data, &rels, &sigma);
         Evaluation {
             figures,
             excluded: data.excluded,
@@ -249,6 +257,7 @@ impl Evaluation {
             coverage,
             sigma_kind: model.sigma_kind(),
             bias_bands,
+            regimes,
         }
     }
 
@@ -280,6 +289,7 @@ impl Evaluation {
             program_version: env!("CARGO_PKG_VERSION"),
             edges: &self.edges,
             bias_bands: &self.bias_bands,
+            regimes: &self.regimes,
         }
     }
 }

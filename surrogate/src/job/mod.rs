@@ -11,6 +11,7 @@ mod checkpoint;
 mod evaluate;
 mod options;
 mod params;
+mod regimes;
 mod train;
 
 #[cfg(test)]
@@ -23,8 +24,11 @@ pub use evaluate::{
     EDGE_FRACTION, EdgeFigures, EdgeStats, Evaluation, EvaluationJson, Worst, edge_figures,
     read_for_model,
 };
-pub use options::{DEFAULT_SHARD, DEFAULT_WORST, EvaluateOptions, GenerateOptions, PredictOptions};
+pub use options::{
+    DEFAULT_SHARD, DEFAULT_WORST, EvaluateOptions, GenerateOptions, LabelOptions, PredictOptions,
+};
 pub use params::parse_params;
+pub use regimes::{RegimeGroup, TRANSITION_V, regime_groups};
 pub use train::{
     DEFAULT_EPOCHS_SCALE, DEFAULT_RECIPE, DEFAULT_SEED, DEFAULT_SPACE, POLYNOMIAL_RECIPE,
     TrainEvent, TrainJob, TrainOutcome, detector_info,

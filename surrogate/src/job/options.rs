@@ -65,6 +65,32 @@ pub struct GenerateOptions {
     pub grid: GridOverrides,
 }
 
+/// Everything a user chooses about labelling rows made before the regime columns existed
+/// (`hpge-cv label`, [`crate::generate::label`]): the rows, their space and detector, the solver
+/// settings they were made with.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "clap", derive(clap::Args))]
+pub struct LabelOptions {
+    /// The rows to label (a `generate` rows file, or a set such as data/training/heldout.csv).
+    #[cfg_attr(feature = "clap", arg(long, value_name = "FILE"))]
+    pub data: PathBuf,
+    /// The rows' parameter space (TOML).
+    #[cfg_attr(feature = "clap", arg(long, value_name = "FILE"))]
+    pub space: PathBuf,
+    /// The rows' detector description (TOML).
+    #[cfg_attr(feature = "clap", arg(long, value_name = "FILE"))]
+    pub detector: PathBuf,
+    /// Output folder (rows.csv + label.json); rerun with the same arguments to resume.
+    #[cfg_attr(feature = "clap", arg(long, value_name = "DIR"))]
+    pub out: PathBuf,
+    /// Worker threads [default: all cores].
+    #[cfg_attr(feature = "clap", arg(long, value_name = "T"))]
+    pub threads: Option<usize>,
+    /// The exact solver's grid and accuracy (those the rows were made with).
+    #[cfg_attr(feature = "clap", command(flatten))]
+    pub grid: GridOverrides,
+}
+
 /// The command line's names and one-line descriptions of the sequences (the names are
 /// [`SequenceKind::as_str`]).
 #[cfg(feature = "clap")]

@@ -8,6 +8,7 @@ use serde::{Deserialize, Serialize};
 
 use super::transform::unit_to_z;
 use crate::error::{Error, Result};
+use crate::generate::{REGIME_COLUMNS, Regime, SWITCH_COLUMN};
 use crate::hash::fnv1a;
 use crate::space::{Dimension, ParameterSpace, Target};
 
@@ -32,6 +33,13 @@ pub struct DataSet {
     pub excluded: usize,
     /// Number of input dimensions d.
     pub dim: usize,
+    /// Each sample's regime (`pockets`, `pocket_level_V`, `pocket_cm3`), where the file has
+    /// those columns (`generate` since they exist, or `hpge-cv label`); else empty.
+    pub regime: Vec<Option<Regime>>,
+    /// Each sample's nearest bias (V) at which the pocket count changes (`pocket_switch_V`
+    /// of `hpge-cv label`; NaN: none within its window); empty where the file has no such
+    /// column.
+    pub switch_v: Vec<f64>,
     /// The space's bias dimension (the last in network order).
     pub bias: Dimension,
 }
@@ -117,8 +125,18 @@ impl DataSet {
             c12_pf: Vec::new(),
             excluded: 0,
             dim: d,
+            regime: Vec::new(),
+            switch_v: Vec::new(),
             bias: space.dimensions[order[d - 1]].clone(),
         };
+        let column = |name: &str| header.iter().position(|h| h.trim() == name);
+        let regime_col = column(REGIME_COLUMNS[0]).filter(|&c| {
+            REGIME_COLUMNS[1..]
+                .iter()
+                .enumerate()
+                .all(|(k, n)| header.get(c + 1 + k).map(|h| h.trim()) == Some(*n))
+        });
+        let switch_col = column(SWITCH_COLUMN);
         let mut u = vec![0.0; d];
         let mut x = vec![0.0; d];
         let mut seen: std::collections::HashMap<u64, usize> = std::collections::HashMap::new();
@@ -206,6 +224,14 @@ impl DataSet {
             set.unit.extend(order.iter().map(|&j| u[j]));
             set.physical.extend(order.iter().map(|&j| x[j]));
             set.c12_pf.push(c12);
+            if let Some(c) = regime_col {
+                let field = |k: usize| cols.get(c + k).copied().unwrap_or("");
+                set.regime.push(Regime::parse(field(0), field(1), field(2)));
+            }
+            if let Some(c) = switch_col {
+                let v = cols.get(c).and_then(|t| t.trim().parse().ok());
+                set.switch_v.push(v.unwrap_or(f64::NAN));
+            }
         }
         if set.is_empty() {
             return Err(invalid(
