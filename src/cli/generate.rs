@@ -27,6 +27,29 @@ pub fn generate(o: &GenerateOptions) -> Result<()> {
     )?
     .with_curve_points(o.curve_points)?
     .with_retry_failed(o.retry_failed);
+    let g = if o.where_models.is_empty() {
+        g
+    } else {
+        let mut models = Vec::new();
+        for f in &o.where_models {
+            let bytes = std::fs::read(f).map_err(|e| {
+                anyhow::anyhow!("--where {}: cannot read the model ({e})", f.display())
+            })?;
+            let model = hpge_surrogate::model::Surrogate::load(f)?;
+            models.push((f.display().to_string(), bytes, model));
+        }
+        let g = g.with_selection(&models, o.share)?;
+        eprintln!(
+            "--where: {} of {} candidates chosen by {}",
+            g.chosen.as_ref().map_or(0, |c| c.len()),
+            o.n,
+            g.fingerprint
+                .selection
+                .as_ref()
+                .map_or("", |s| s.score.as_str())
+        );
+        g
+    };
     let bar = ProgressBar::new(0);
     bar.set_style(
         ProgressStyle::with_template(

@@ -7,6 +7,7 @@ mod lock;
 mod merge;
 mod regime;
 mod run;
+mod select;
 mod setup;
 #[cfg(test)]
 mod tests;
@@ -17,4 +18,5 @@ pub use lock::{FolderLock, LOCK_FILE};
 pub use merge::{MergeReport, merge};
 pub use regime::{REGIME_COLUMNS, Regime};
 pub use run::{RunInfo, RunReport, format_row, format_row_with, read_rows, run};
+pub use select::{SelectionInfo, choose, committee_scores};
 pub use setup::{Fingerprint, Generator, Sample, Shard};

@@ -8,6 +8,7 @@ use serde::{Deserialize, Serialize};
 
 use super::exact::ExactSolver;
 use super::regime::{REGIME_COLUMNS, Regime};
+use super::select::{SelectionInfo, choose, selection_info};
 use crate::error::{Error, Result};
 use crate::hash::fnv1a;
 use crate::sequence::{Sequence, SequenceKind};
@@ -82,6 +83,11 @@ pub struct Fingerprint {
     /// fingerprints are what they were before curve mode existed.
     #[serde(default = "one", skip_serializing_if = "is_one")]
     pub curve_points: u64,
+    /// Active learning (`generate --where`): the models and share that chose which of the
+    /// `n` candidates are solved ([`super::select`]). Absent from the files of runs that
+    /// solve every index, so their fingerprints are what they were before.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub selection: Option<SelectionInfo>,
 }
 
 fn one() -> u64 {
@@ -117,6 +123,8 @@ pub struct Generator {
     /// On resume, solve again the points whose rows failed (`--retry-failed`; not part of the
     /// fingerprint: a retry adds rows of the same run, e.g. after a solver fix).
     pub retry_failed: bool,
+    /// Active learning: the candidate indices chosen to be solved (None: every index).
+    pub chosen: Option<std::collections::HashSet<u64>>,
 }
 
 /// The outcome of one sample.
@@ -199,6 +207,7 @@ impl Generator {
             offset,
             n,
             curve_points: 1,
+            selection: None,
         };
         let g = Self {
             space,
@@ -211,6 +220,7 @@ impl Generator {
             fingerprint,
             exact,
             retry_failed: false,
+            chosen: None,
         };
         Ok(g)
     }
@@ -264,6 +274,29 @@ impl Generator {
         Ok(self)
     }
 
+    /// Active learning: of the run's `n` candidate indices, solve only the top `share` by the
+    /// disagreement of `models` ((file as given, its bytes, the loaded model); see
+    /// [`super::select`]). Refused for a model of another space or detector (naming both
+    /// hashes), a share outside (0, 1], and in curve mode.
+    pub fn with_selection(
+        mut self,
+        models: &[(String, Vec<u8>, crate::model::Surrogate)],
+        share: f64,
+    ) -> Result<Self> {
+        if self.curve_points() > 1 {
+            return Err(Error::Argument {
+                name: "--where".into(),
+                message: "cannot be combined with --curve-points above 1".into(),
+            });
+        }
+        let info = selection_info(&self, models, share)?;
+        let loaded: Vec<crate::model::Surrogate> =
+            models.iter().map(|(_, _, m)| m.clone()).collect();
+        self.chosen = Some(choose(&self, &loaded, share)?.into_iter().collect());
+        self.fingerprint.selection = Some(info);
+        Ok(self)
+    }
+
     /// Rows per parameter point (1 in point mode).
     pub fn curve_points(&self) -> u64 {
         self.fingerprint.curve_points
@@ -281,7 +314,9 @@ impl Generator {
     /// indices themselves). Shards stride over points, so one point's rows stay together.
     pub fn units(&self) -> impl Iterator<Item = u64> + '_ {
         let k = self.curve_points();
-        self.shard.indices(self.offset / k, self.n / k)
+        self.shard
+            .indices(self.offset / k, self.n / k)
+            .filter(|p| self.chosen.as_ref().is_none_or(|c| c.contains(p)))
     }
 
     /// The row indices of work unit `p`.

@@ -60,6 +60,14 @@ pub struct GenerateOptions {
     /// fix); the other rows are kept.
     #[cfg_attr(feature = "clap", arg(long))]
     pub retry_failed: bool,
+    /// Active learning: the --n indices are candidates, scored by the disagreement of these
+    /// surrogates (repeat the flag for a committee; one model alone: its sigma_s), and only the
+    /// top --share of them is solved. The models must be of this space and detector.
+    #[cfg_attr(feature = "clap", arg(long = "where", value_name = "MODEL"))]
+    pub where_models: Vec<PathBuf>,
+    /// With --where: the share of the candidates to solve, in (0, 1].
+    #[cfg_attr(feature = "clap", arg(long, value_name = "F", default_value_t = 0.1))]
+    pub share: f64,
     /// The exact solver's grid and accuracy.
     #[cfg_attr(feature = "clap", command(flatten))]
     pub grid: GridOverrides,
