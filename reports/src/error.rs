@@ -49,6 +49,15 @@ pub enum Error {
         /// What is wrong with it.
         message: String,
     },
+    /// The output folder already holds a results file of another run (other inputs, settings
+    /// or truths), which a run replaces only with `--force` ([`crate::replace`]).
+    #[error("{}: {message}", file.display())]
+    OtherRun {
+        /// The results file there.
+        file: PathBuf,
+        /// Both runs and what differs.
+        message: String,
+    },
     /// A file or folder could not be created, written or copied.
     #[error("{action} {}", file.display())]
     Io {

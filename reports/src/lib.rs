@@ -16,6 +16,7 @@
 //!   (C-V curve, transform and example density, training samples, surrogate), the impurity
 //!   models of section 9, and the README and report.json of a run.
 //! - [`status`]: the README's status table, derived from the shipped results files.
+//! - [`replace`]: a run refuses to replace another run's results file unless `--force`.
 //!
 //! Every failure is an [`Error`] naming the file at fault.
 //!
@@ -49,6 +50,7 @@ mod json_file;
 pub mod paper;
 pub mod plot;
 mod provenance;
+pub mod replace;
 pub mod status;
 
 pub use error::{Error, Result};
