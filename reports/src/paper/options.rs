@@ -4,16 +4,18 @@
 
 use std::path::PathBuf;
 
-/// Where `report paper` writes when not told: the committed report.
-pub const PAPER_OUT: &str = "reports/paper";
-/// Where the section 9 step alone writes when not told.
-pub const SECTION9_OUT: &str = "reports/section9";
+/// Where `report paper` writes when not told: a folder under the working directory (the
+/// committed report, `reports/paper`, is remade with `--out reports/paper`).
+pub const PAPER_OUT: &str = "paper-report";
+/// Where the section 9 step alone writes when not told (under the working directory).
+pub const SECTION9_OUT: &str = "section9";
 
 /// Everything a user chooses about `report paper` (see [`super::run_paper`]).
 #[derive(Debug, Clone, PartialEq, Eq)]
 #[cfg_attr(feature = "clap", derive(clap::Args))]
 pub struct PaperOptions {
-    /// Output folder (figures/, fits/, section9/, README.md, report.json).
+    /// Output folder (figures/, fits/, section9/, README.md, report.json); the committed report
+    /// is remade with --out reports/paper.
     #[cfg_attr(feature = "clap", arg(long, value_name = "DIR", default_value = PAPER_OUT))]
     pub out: PathBuf,
     /// A fast reduced run (for tests): few voltages and densities, no fits, no section 9.
@@ -22,6 +24,10 @@ pub struct PaperOptions {
     /// Run the fits' exact-solver re-weighting check (100 draws each, a few minutes more).
     #[cfg_attr(feature = "clap", arg(long))]
     pub exact_check: bool,
+    /// Replace a report of another run (other --quick or --exact-check) in --out; without it
+    /// such a folder is refused.
+    #[cfg_attr(feature = "clap", arg(long))]
+    pub force: bool,
 }
 
 impl Default for PaperOptions {
@@ -31,6 +37,7 @@ impl Default for PaperOptions {
             out: PAPER_OUT.into(),
             quick: false,
             exact_check: false,
+            force: false,
         }
     }
 }

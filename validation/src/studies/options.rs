@@ -18,6 +18,9 @@ use hpge_surrogate::Shard;
 use super::coverage::{CoverageSettings, DataFrom, PipelineSettings};
 use crate::error::Result;
 
+/// The folder, under the working directory, that holds a coverage study's folder
+/// (`<prior>[-exact]`) when `--out` is not given.
+pub const COVERAGE_OUT: &str = "coverage";
 /// Target bulk and tail ESS of each fit of a coverage study: ranks among L draws need about L
 /// independent draws (L = [`COVERAGE_RANKS`]), far fewer than a real fit's 1000.
 pub const COVERAGE_ESS: f64 = 300.0;
@@ -79,7 +82,8 @@ pub struct CoverageOptions {
     pub mode_starts: usize,
     /// Output folder for coverage.json, ranks.csv, the figures and truths/ (each fitted truth,
     /// written as it finishes: the same command again resumes, more --truths extend the study)
-    /// [default: reports/coverage/<prior>[-exact]].
+    /// [default: coverage/<prior>[-exact] in the working directory; the committed studies are
+    /// regenerated with --out reports/coverage/<prior>[-exact]].
     #[cfg_attr(feature = "clap", arg(long, value_name = "DIR"))]
     pub out: Option<PathBuf>,
     /// With --exact: fit each truth with the surrogate alone, without the exact check and
@@ -125,15 +129,16 @@ impl CoverageOptions {
         }
     }
 
-    /// The output folder: `out`, else `reports/coverage/<prior file stem>` (with `-exact` for
-    /// exact-solver data).
+    /// The output folder: `out`, else [`COVERAGE_OUT`]`/<prior file stem>` (with `-exact` for
+    /// exact-solver data) under the working directory, never the committed studies in
+    /// `reports/coverage/` unless `--out` names them.
     pub fn out_dir(&self) -> PathBuf {
         self.out.clone().unwrap_or_else(|| {
             let stem = self
                 .prior
                 .file_stem()
                 .map_or("coverage".into(), |s| s.to_string_lossy().to_string());
-            PathBuf::from("reports/coverage").join(if self.exact {
+            PathBuf::from(COVERAGE_OUT).join(if self.exact {
                 format!("{stem}-exact")
             } else {
                 stem
@@ -250,8 +255,9 @@ impl CoverageOptions {
 
 /// Seed of the hidden-effect study (data set i uses seed + i; the workflow runs with it too).
 pub const HIDDEN_SEED: u64 = 7;
-/// Output folder of the hidden-effect study.
-pub const HIDDEN_OUT: &str = "reports/discovery/hidden";
+/// Output folder of the hidden-effect study when `--out` is not given (under the working
+/// directory; the committed study, `reports/discovery/hidden`, is regenerated with `--out`).
+pub const HIDDEN_OUT: &str = "discoveries/hidden";
 /// The start model of the hidden-effect study: the paper's B_Z, which the base truth fits
 /// exactly.
 pub const HIDDEN_START_MODEL: &str = "priors/b-z.toml";
