@@ -80,8 +80,31 @@ fn status(a: &StatusArgs) -> Result<()> {
     Ok(())
 }
 
-/// Runs `report paper` with progress on stderr and the fits' summaries on stdout.
+/// Runs `report paper` with progress on stderr and the fits' summaries on stdout. A folder
+/// holding a report of another run (other `--quick` or `--exact-check`) is refused unless
+/// `--force`.
 pub fn paper(a: &PaperOptions) -> Result<()> {
+    let record = serde_json::json!({ "quick": a.quick, "exact_check": a.exact_check });
+    let describe = |v: &serde_json::Value| {
+        format!(
+            "report paper{}{}",
+            if v["quick"] == true { " --quick" } else { "" },
+            if v["exact_check"] == true {
+                " --exact-check"
+            } else {
+                ""
+            }
+        )
+    };
+    if let Some(w) = hpge_reports::replace::check_replace(
+        &a.out.join("report.json"),
+        &record,
+        &describe,
+        a.force,
+    )? {
+        eprintln!("warning: {w}");
+    }
+    eprintln!("report paper: the report's folder is {}", a.out.display());
     let r = hpge_reports::paper::run_paper(
         a.out.clone(),
         a.quick,

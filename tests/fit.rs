@@ -312,8 +312,9 @@ fn a_killed_fit_resumes_its_finished_rounds_and_never_mixes_runs() {
         assert_eq!(p["mean"], q["mean"]);
         assert_eq!(p["std"], q["std"]);
     }
-    // Another seed in the same folder: the old rounds are not taken (cleared), nothing mixes.
-    let other = fit_args(
+    // Another seed in the same folder: refused without --force (the folder holds another run's
+    // fit, issue 69); with it the old rounds are not taken (cleared), nothing mixes.
+    let mut other = fit_args(
         killed.to_str().unwrap(),
         &[
             "--no-plots",
@@ -330,6 +331,15 @@ fn a_killed_fit_resumes_its_finished_rounds_and_never_mixes_runs() {
             "5",
         ],
     );
+    bad(
+        &run(&other),
+        &[
+            "summary.json",
+            "another run",
+            "/settings/seed (0 there, 5 here)",
+        ],
+    );
+    other.push("--force");
     let o = run(&other);
     let err = String::from_utf8_lossy(&o.stderr).to_string();
     assert!(o.status.success(), "{err}");

@@ -27,7 +27,8 @@ use crate::{HpgeError, array, err, json_to_py, matrix};
 /// surrogate's support, as `--extrapolate`), `constant_sigma` (the model's constant sigma_p in
 /// the likelihood even where its file has a calibrated per-point sigma_s, as `--constant-sigma`),
 /// `exact_ascents` (after a passing check, climb the exact posterior from this many local modes
-/// in other basins, as `--exact-ascents`).
+/// in other basins, as `--exact-ascents`), `force` (replace the fit of another run in `out`, as
+/// `--force`; without it such a folder is refused).
 ///
 /// Returns a dict: `summary` (the `summary.json` object as a dict), `names` (parameters),
 /// `draws` (array [chain, draw, parameter] in the prior's units), `ln_posterior` ([chain, draw]),
@@ -37,7 +38,8 @@ use crate::{HpgeError, array, err, json_to_py, matrix};
     data=None, model=None, prior=None, detector=None, seed=None, sampler=None, likelihood=None,
     chains=None, ess=None, rhat=None, max_seconds=None, exact_check=false, exact_draws=None,
     out=None, progress=None, extrapolate=false, exact_grids=None, exact_grid_check=None,
-    refine_rounds=None, constant_sigma=false, exact_ascents=None, refine_variance=None
+    refine_rounds=None, constant_sigma=false, exact_ascents=None, refine_variance=None,
+    force=false
 ))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn fit<'py>(
@@ -64,6 +66,7 @@ pub(crate) fn fit<'py>(
     constant_sigma: bool,
     exact_ascents: Option<usize>,
     refine_variance: Option<String>,
+    force: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let d = FitOptions::default();
     let o = FitOptions {
@@ -88,6 +91,7 @@ pub(crate) fn fit<'py>(
         max_seconds: max_seconds.unwrap_or(d.max_seconds),
         extrapolate,
         constant_sigma,
+        force,
         ..d
     };
     let progress = progress_arg(progress, "fit")?;
@@ -177,13 +181,15 @@ pub(crate) fn fit<'py>(
 /// machine's speed; pass a large value for results that depend on the seed alone),
 /// `min_ln_bayes` (smallest ln Bayes factor for an extension to be added), `surrogate_only`
 /// (leave out the exact-solver extensions, which are slow), `out` (a folder: also write
-/// `discovery.json`, `residuals.csv`, `report.md` and the figures there), `progress`.
+/// `discovery.json`, `residuals.csv`, `report.md` and the figures there; a folder holding the
+/// discovery of another run is refused unless `force`, as `--force`), `progress`.
 ///
 /// Returns the summary (`discovery.json`'s object) as a dict. The GIL is released while it runs.
 #[pyfunction]
 #[pyo3(signature = (
     data=None, model=None, detector=None, start_model=None, only=None, seed=None, ess=None,
-    max_seconds=None, min_ln_bayes=None, surrogate_only=false, out=None, progress=None
+    max_seconds=None, min_ln_bayes=None, surrogate_only=false, out=None, progress=None,
+    force=false
 ))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn discover<'py>(
@@ -200,6 +206,7 @@ pub(crate) fn discover<'py>(
     surrogate_only: bool,
     out: Option<PathBuf>,
     progress: Option<Bound<'py, PyAny>>,
+    force: bool,
 ) -> PyResult<Bound<'py, PyAny>> {
     use hpge_inference::discover::DiscoverOptions;
     let mut o = DiscoverOptions::default();
@@ -259,6 +266,7 @@ pub(crate) fn discover<'py>(
             &settings,
             dir.as_deref(),
             w.no_plots,
+            force,
             &progress,
         )
         .map_err(err)?;

@@ -93,6 +93,7 @@ pub fn run(a: &DiscoverArgs) -> Result<()> {
         &settings,
         Some(&out),
         w.no_plots,
+        o.force,
         &printer,
     )?;
     bar.finish_and_clear();

@@ -12,6 +12,7 @@ mod generate;
 mod impurity;
 mod measure;
 mod pulse;
+mod replace;
 mod sensitivity;
 mod sidecar;
 mod simulate;
@@ -83,7 +84,7 @@ enum Command {
     /// Calibrate a surrogate's per-point uncertainty sigma_s(p, U_B) on rows it never saw and
     /// write it into the model file (the weights unchanged); `fit` then uses it in place of the
     /// constant sigma_p.
-    Calibrate(hpge_surrogate::job::CalibrateOptions),
+    Calibrate(CalibrateArgs),
     /// c12 along a curve from a surrogate (optionally with its Jacobian).
     Predict(PredictArgs),
     /// The posterior of an impurity model given a measured C-V curve (Bayesian fit with the
@@ -124,6 +125,11 @@ struct CoverageArgs {
     /// Print the result as one JSON object on stdout.
     #[arg(long)]
     json: bool,
+    /// Replace another study in --out (other inputs, settings or more truths; its truths are
+    /// removed); without it such a folder is refused. The same study again, a resumed one or a
+    /// larger one (an extension) goes on without it.
+    #[arg(long)]
+    force: bool,
 }
 
 #[derive(Debug, clap::Args)]
@@ -145,6 +151,20 @@ struct TrainArgs {
     /// Folder for the learning curves and the test-set error figures (svg and png).
     #[arg(long, value_name = "DIR")]
     plot: Option<PathBuf>,
+    /// Replace a model file at --out of another run (other recipe, seed, training or test
+    /// set); without it such a file is refused.
+    #[arg(long)]
+    force: bool,
+}
+
+#[derive(Debug, clap::Args)]
+struct CalibrateArgs {
+    #[command(flatten)]
+    options: hpge_surrogate::job::CalibrateOptions,
+    /// Replace a per-point uncertainty calibrated on another data set (or, with --out, a model
+    /// file of another run); without it such a file is refused.
+    #[arg(long)]
+    force: bool,
 }
 
 #[derive(Debug, clap::Args)]
@@ -377,7 +397,10 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Generate(o) => generate::generate(&o),
         Command::Merge(a) => generate::merge_shards(&a.dirs, &a.out),
         Command::Label(o) => generate::label(&o),
-        Command::Train(a) => surrogate::train(&a.job, a.plot.as_deref(), false),
+        Command::Train(a) => {
+            replace::check_train(&a.job, a.force)?;
+            surrogate::train(&a.job, a.plot.as_deref(), false)
+        }
         Command::Fit(a) => fit::run(&a.options, a.json, a.allow_unconverged),
         Command::Discover(a) => discover::run(&a),
         Command::Report(a) => crate::report::run(&a),
@@ -395,10 +418,13 @@ pub fn run(cli: Cli) -> Result<()> {
         }
         Command::Validate(v) => match v.study {
             ValidateStudy::Discovery(a) => validate_discovery::run(&a),
-            ValidateStudy::Coverage(a) => validate::coverage(&a.options, a.json),
+            ValidateStudy::Coverage(a) => validate::coverage(&a.options, a.json, a.force),
         },
         Command::Evaluate(a) => surrogate::evaluate(&a.options, a.json, a.plot.as_deref()),
-        Command::Calibrate(o) => surrogate::calibrate(&o),
+        Command::Calibrate(a) => {
+            replace::check_calibrate(&a.options, a.force)?;
+            surrogate::calibrate(&a.options)
+        }
         Command::Predict(a) => surrogate::predict(&a.options, a.json),
         Command::Measure(a) => measure::run(&a.options, a.plot.as_ref(), a.json),
         Command::Synthesize(o) => measure::synthesize(&o),

@@ -4,7 +4,7 @@ use std::io::Write as _;
 
 use anyhow::{Context, Result};
 use hpge_inference::{CvModel, ExactModel};
-use hpge_validation::studies::coverage::store::{TruthStore, study_fingerprint};
+use hpge_validation::studies::coverage::store::{TRUTHS_DIR, TruthStore, study_fingerprint};
 use hpge_validation::studies::coverage::{ParameterCoverage, SubsetCoverage, TruthEvent, progress};
 use hpge_validation::{
     CoverageModels, CoverageOptions, CoverageOutcome, CoverageReport, CoverageRun,
@@ -14,8 +14,9 @@ use indicatif::{ProgressBar, ProgressStyle};
 
 use super::fit::setup;
 
-/// Runs the study, writes coverage.json, ranks.csv and figures; exit code 1 if it fails.
-pub fn coverage(o: &CoverageOptions, as_json: bool) -> Result<()> {
+/// Runs the study, writes coverage.json, ranks.csv and figures; exit code 1 if it fails. A
+/// folder holding another study is refused unless `force` ([`check_other_study`]).
+pub fn coverage(o: &CoverageOptions, as_json: bool, force: bool) -> Result<()> {
     let settings = o.settings()?;
     let kind = settings.fit.sample.sampler;
     let s = setup(
@@ -32,8 +33,20 @@ pub fn coverage(o: &CoverageOptions, as_json: bool) -> Result<()> {
     if o.progress {
         return coverage_progress(out, &fingerprint, &s.prior, &settings, as_json);
     }
+    if let Some(w) = check_other_study(out, &s.inputs, o, &settings, &fingerprint, force)? {
+        eprintln!("warning: {w}");
+    }
     std::fs::create_dir_all(out)
         .with_context(|| format!("--out {}: cannot create the folder", out.display()))?;
+    eprintln!(
+        "coverage: the study's folder is {}{}",
+        out.display(),
+        if o.out.is_none() {
+            " (the default; --out DIR chooses another)"
+        } else {
+            ""
+        }
+    );
     let exact;
     let (data_model, data_sigma): (&dyn CvModel, f64) = if o.exact {
         exact = ExactModel::new(s.exact.clone(), &s.data.voltage_v)?;
@@ -173,6 +186,7 @@ pub fn coverage(o: &CoverageOptions, as_json: bool) -> Result<()> {
     )?;
     if as_json {
         println!("{}", brief_json(&report));
+        eprintln!("outputs in {}", out.display());
     } else {
         print_report(&report, true);
         println!("outputs in {}", out.display());
@@ -181,6 +195,107 @@ pub fn coverage(o: &CoverageOptions, as_json: bool) -> Result<()> {
         std::process::exit(1);
     }
     Ok(())
+}
+
+/// Refuses a study folder that holds another study's results (issue 69), unless `force` (then
+/// the warning to print): a `coverage.json` of other inputs (their hashes), data source or
+/// settings, or of more truths than `--truths` (a smaller study would replace it; a larger one
+/// extends it, as documented), or truth files in `truths/` that another run wrote (other
+/// inputs, settings or program version: the study would remove them). The same study again, a
+/// resumed one, a larger one and every shard of one go on as before.
+fn check_other_study(
+    out: &std::path::Path,
+    inputs: &std::collections::BTreeMap<String, String>,
+    o: &CoverageOptions,
+    settings: &hpge_validation::studies::coverage::CoverageSettings,
+    fingerprint: &str,
+    force: bool,
+) -> Result<Option<String>> {
+    use hpge_reports::replace::{Existing, differences, existing, refuse_other_run};
+    use serde_json::Value;
+    let without_truths = |v: &Value| {
+        let mut v = v.clone();
+        if let Some(s) = v.get_mut("settings").and_then(Value::as_object_mut) {
+            s.remove("n_truths");
+        }
+        v
+    };
+    let record = without_truths(&serde_json::json!({
+        "inputs": inputs,
+        "data_from": o.data_from().as_str(),
+        "settings": settings,
+    }));
+    let here = describe_study(&record, o.truths as u64);
+    let file = out.join("coverage.json");
+    let old = existing(&file);
+    let mut diffs = Vec::new();
+    let mut there = String::from("unknown");
+    if let Some(old) = &old {
+        diffs = differences(&without_truths(&old.record), &record);
+        if let Some(n) = old.record.get("n_truths").and_then(Value::as_u64) {
+            if n > o.truths as u64 {
+                diffs.push(format!(
+                    "/n_truths ({n} there, {} here: the study would shrink)",
+                    o.truths
+                ));
+            }
+            there = describe_study(&old.record, n);
+        }
+    }
+    // Truth files another run wrote (TruthStore::open removes them).
+    let stale = std::fs::read_dir(out.join(TRUTHS_DIR))
+        .map(|d| {
+            d.filter_map(|e| std::fs::read_to_string(e.ok()?.path()).ok())
+                .filter_map(|t| serde_json::from_str::<Value>(&t).ok())
+                .filter(|v| {
+                    v.get("fingerprint")
+                        .and_then(Value::as_str)
+                        .is_some_and(|f| f != fingerprint)
+                })
+                .count()
+        })
+        .unwrap_or(0);
+    if stale > 0 {
+        diffs.push(format!(
+            "{stale} truth file(s) in {} written by another run (other inputs, settings or \
+             program version), which this study would remove",
+            out.join(TRUTHS_DIR).display()
+        ));
+        if old.is_none() {
+            there = format!("a study whose truths are in {}", out.display());
+        }
+    }
+    let old = match old {
+        Some(old) => old,
+        None if stale > 0 => Existing {
+            file: out.join(TRUTHS_DIR),
+            record: Value::Null,
+            readable: true,
+        },
+        None => return Ok(None),
+    };
+    Ok(refuse_other_run(&old, &diffs, &there, &here, force)?)
+}
+
+/// A coverage study's record (`coverage.json`, or this run's) with `n` truths, in a few words.
+fn describe_study(v: &serde_json::Value, n: u64) -> String {
+    use hpge_reports::replace::{text_at, value_at};
+    format!(
+        "{n} truths of prior {}, model {} (hash {}), data {} ({} data); seed {}, {} sampler, \
+         ESS {}{}",
+        text_at(v, "/inputs/prior"),
+        text_at(v, "/inputs/model"),
+        text_at(v, "/inputs/model_hash"),
+        text_at(v, "/inputs/data"),
+        text_at(v, "/data_from"),
+        value_at(v, "/settings/seed"),
+        value_at(v, "/settings/fit/sample/sampler"),
+        value_at(v, "/settings/fit/sample/ess_min"),
+        match v.pointer("/settings/pipeline") {
+            Some(p) if !p.is_null() => ", exact check and refinement",
+            _ => "",
+        }
+    )
 }
 
 /// `validate coverage --progress`: the statistics over the truths written so far, nothing run.

@@ -28,6 +28,10 @@ pub struct DiscoveryArgs {
     /// Print the summary as JSON on stdout.
     #[arg(long)]
     pub json: bool,
+    /// Replace a study of another run (other seed, effects, inputs or settings) in --out;
+    /// without it such a folder is refused.
+    #[arg(long)]
+    pub force: bool,
 }
 
 /// The study's result.
@@ -35,6 +39,9 @@ pub struct DiscoveryArgs {
 struct Study {
     pass: bool,
     seed: u64,
+    /// What makes two studies the same run: the effects, the start model, the inputs with
+    /// their hashes and the workflow's settings (compared before a study replaces this one).
+    run: serde_json::Value,
     program_version: String,
     outcomes: Vec<HiddenOutcome>,
     seconds: f64,
@@ -63,6 +70,31 @@ pub fn run(a: &DiscoveryArgs) -> Result<()> {
     )?;
     let start = PriorSpec::from_file(&o.start_model)?;
     let settings = o.settings(noise)?;
+    let effects: Vec<&str> = all
+        .iter()
+        .map(|h| h.effect.as_str())
+        .filter(|e| o.effects.is_empty() || o.effects.iter().any(|x| x == e))
+        .collect();
+    let run = serde_json::json!({
+        "effects": effects,
+        "start_model": o.start_model.display().to_string(),
+        "inputs": s.inputs,
+        "settings": settings,
+    });
+    // A folder holding another run's study is refused unless --force (issue 69).
+    let record = serde_json::json!({ "seed": o.seed, "run": run });
+    if let Some(w) = hpge_reports::replace::check_replace(
+        &o.out.join("summary.json"),
+        &record,
+        &describe_study,
+        a.force,
+    )? {
+        eprintln!("warning: {w}");
+    }
+    eprintln!(
+        "validate discovery: the study's folder is {}",
+        o.out.display()
+    );
     let surrogate: Arc<dyn CvModel> = Arc::new(s.surrogate.clone());
     let volts = s.data.voltage_v.clone();
     let mut outcomes = Vec::new();
@@ -131,6 +163,7 @@ pub fn run(a: &DiscoveryArgs) -> Result<()> {
     let study = Study {
         pass: outcomes.iter().all(|o| o.correct && o.consistent),
         seed: o.seed,
+        run,
         program_version: env!("CARGO_PKG_VERSION").into(),
         outcomes,
         seconds: t0.elapsed().as_secs_f64(),
@@ -142,8 +175,11 @@ pub fn run(a: &DiscoveryArgs) -> Result<()> {
     let mut md = std::fs::File::create(o.out.join("summary.md"))?;
     writeln!(
         md,
-        "# Hidden-effect tests of model discovery\n\n`hpge-cv validate discovery --seed {}` ({:.0} s). Pass: {}.\n",
-        o.seed, study.seconds, study.pass
+        "# Hidden-effect tests of model discovery\n\n`hpge-cv validate discovery --seed {} --out {}` ({:.0} s). Pass: {}.\n",
+        o.seed,
+        o.out.display(),
+        study.seconds,
+        study.pass
     )?;
     writeln!(
         md,
@@ -174,6 +210,7 @@ pub fn run(a: &DiscoveryArgs) -> Result<()> {
     if a.json {
         println!("{}", serde_json::to_string_pretty(&study)?);
     }
+    eprintln!("outputs in {}", o.out.display());
     if !study.pass {
         eprintln!(
             "validate discovery: FAILED (see {}/summary.md)",
@@ -182,4 +219,17 @@ pub fn run(a: &DiscoveryArgs) -> Result<()> {
         std::process::exit(1);
     }
     Ok(())
+}
+
+/// A hidden-effect study's record (`summary.json`, or this run's) in a few words.
+fn describe_study(v: &serde_json::Value) -> String {
+    use hpge_reports::replace::{text_at, value_at};
+    format!(
+        "seed {}, effects {}, start model {}, model {} (hash {})",
+        value_at(v, "/seed"),
+        value_at(v, "/run/effects"),
+        text_at(v, "/run/start_model"),
+        text_at(v, "/run/inputs/model"),
+        text_at(v, "/run/inputs/model_hash"),
+    )
 }

@@ -131,9 +131,13 @@ pub struct DiscoverOptions {
         arg(long, value_name = "NAME|FILE", default_value = DEFAULT_START_MODEL)
     )]
     pub start_model: String,
-    /// Output folder [default: discoveries/<start model>].
+    /// Output folder [default: discoveries/<start model>, under the working directory].
     #[cfg_attr(feature = "clap", arg(long, value_name = "DIR"))]
     pub out: Option<PathBuf>,
+    /// Replace a discovery of another run (other inputs or settings) in the output folder;
+    /// without it such a folder is refused (the same run again, or a resumed one, goes on).
+    #[cfg_attr(feature = "clap", arg(long))]
+    pub force: bool,
     /// Seed of every random step (sampling, predictive replicates).
     #[cfg_attr(feature = "clap", arg(long, default_value_t = DEFAULT_SEED))]
     pub seed: u64,
@@ -156,6 +160,7 @@ impl Default for DiscoverOptions {
             workflow: WorkflowOptions::default(),
             start_model: DEFAULT_START_MODEL.into(),
             out: None,
+            force: false,
             seed: DEFAULT_SEED,
             min_ln_bayes: DEFAULT_MIN_LN_BAYES,
             max_seconds: FIT_MAX_SECONDS,

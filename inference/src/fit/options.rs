@@ -64,9 +64,13 @@ pub struct FitOptions {
         arg(long, value_name = "FILE", default_value = DEFAULT_DETECTOR)
     )]
     pub detector: PathBuf,
-    /// Output folder [default: fits/<prior name>].
+    /// Output folder [default: fits/<prior name>, under the working directory].
     #[cfg_attr(feature = "clap", arg(long, value_name = "DIR"))]
     pub out: Option<PathBuf>,
+    /// Replace a fit of another run (other inputs or settings) in the output folder; without
+    /// it such a folder is refused (the same fit again, or a resumed one, goes on without it).
+    #[cfg_attr(feature = "clap", arg(long))]
+    pub force: bool,
     /// Sampler: metropolis (adaptive, like BAT.jl's default) or nuts.
     #[cfg_attr(feature = "clap", arg(long, default_value = SamplerKind::default().as_str()))]
     pub sampler: String,
@@ -161,6 +165,7 @@ impl Default for FitOptions {
             prior: DEFAULT_PRIOR.into(),
             detector: DEFAULT_DETECTOR.into(),
             out: None,
+            force: false,
             sampler: SamplerKind::default().as_str().into(),
             seed: DEFAULT_SEED,
             no_exact_check: false,

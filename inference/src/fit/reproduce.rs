@@ -86,6 +86,17 @@ impl FitOptions {
         a.push(out.display().to_string());
         a
     }
+
+    /// What makes two fits the same run, as `summary.json` records it (`run`): the arguments
+    /// of [`Self::reproduce_args`] without `--out` and `--allow-exact-mismatch` (which change no
+    /// result, only the exit code). A fit into a folder whose summary records other arguments
+    /// is another run's ([`FitOptions::force`]).
+    pub fn run_args(&self) -> Vec<String> {
+        let mut a = self.reproduce_args(Path::new(""));
+        a.truncate(a.len() - 2);
+        a.retain(|x| x != "--allow-exact-mismatch");
+        a
+    }
 }
 
 #[cfg(test)]
@@ -116,6 +127,30 @@ mod tests {
             ]
         );
         assert_eq!(a.last().map(String::as_str), Some("fits/b-rz"));
+    }
+
+    #[test]
+    fn the_run_is_the_line_without_the_folder_and_the_exit_code_switch() {
+        let o = FitOptions {
+            out: Some(PathBuf::from("fits/x")),
+            allow_exact_mismatch: true,
+            force: true,
+            seed: 3,
+            ..FitOptions::default()
+        };
+        let a = o.run_args();
+        assert!(a.windows(2).any(|w| w == ["--seed", "3"]), "{a:?}");
+        for gone in ["--out", "fits/x", "--allow-exact-mismatch", "--force"] {
+            assert!(!a.iter().any(|x| x == gone), "{gone} in {a:?}");
+        }
+        assert_eq!(
+            a,
+            FitOptions {
+                seed: 3,
+                ..FitOptions::default()
+            }
+            .run_args()
+        );
     }
 
     #[test]

@@ -74,7 +74,10 @@ pub fn write_outputs(
 /// and every output is written there at the end (figures unless `no_plots`).
 ///
 /// # Errors
-/// An output folder that cannot be made or is locked, the workflow's errors, writing failures.
+/// An output folder that cannot be made or is locked, or holds the discovery of another run
+/// (other inputs or settings: [`Error::OtherRun`], unless `force`), the workflow's errors,
+/// writing failures.
+#[allow(clippy::too_many_arguments)]
 pub fn run_discover(
     job: &FitJob,
     start: &PriorSpec,
@@ -82,12 +85,23 @@ pub fn run_discover(
     settings: &DiscoverSettings,
     out: Option<&Path>,
     no_plots: bool,
+    force: bool,
     progress: &dyn Progress,
 ) -> Result<Discovery> {
     let mut inputs = job.inputs.clone();
     inputs.insert("start_model".into(), start_file.display().to_string());
     let (lock, stages) = match out {
         Some(dir) => {
+            // A folder holding another run's discovery is refused unless `force` (issue 69).
+            let record = serde_json::json!({ "inputs": inputs, "settings": settings });
+            if let Some(w) = crate::replace::check_replace(
+                &dir.join("discovery.json"),
+                &record,
+                &describe_run,
+                force,
+            )? {
+                progress.stage(&format!("warning: {w}"));
+            }
             std::fs::create_dir_all(dir).map_err(|e| Error::Output {
                 flag: "--out".into(),
                 file: dir.to_path_buf(),
@@ -118,4 +132,30 @@ pub fn run_discover(
     }
     drop(lock);
     Ok(d)
+}
+
+/// A discovery's record (its inputs and settings, as `discovery.json` has them) in a few words.
+pub fn describe_run(v: &serde_json::Value) -> String {
+    use crate::replace::{text_at, value_at};
+    format!(
+        "start model {}, model {} (hash {}), data {} (hash {}); seed {}, {}, extensions {}",
+        text_at(v, "/inputs/start_model"),
+        text_at(v, "/inputs/model"),
+        text_at(v, "/inputs/model_hash"),
+        text_at(v, "/inputs/data"),
+        text_at(v, "/inputs/data_hash"),
+        value_at(v, "/settings/seed"),
+        if v.pointer("/settings/exact") == Some(&serde_json::Value::Bool(false)) {
+            "surrogate only"
+        } else {
+            "exact solver"
+        },
+        match v
+            .pointer("/settings/only")
+            .and_then(serde_json::Value::as_array)
+        {
+            Some(a) if !a.is_empty() => value_at(v, "/settings/only"),
+            _ => "all".into(),
+        }
+    )
 }

@@ -74,6 +74,15 @@ pub fn run_fit(o: &FitOptions, observer: &dyn FitObserver) -> Result<FitRun> {
     };
     job.posterior()?;
     let out = o.out_dir();
+    // A folder holding another run's fit is refused unless `--force` (issue 69).
+    if let Some(w) = crate::replace::check_replace(
+        &out.join("summary.json"),
+        &run_record(o, &job, &settings),
+        &describe_run,
+        o.force,
+    )? {
+        job.warnings.push(w);
+    }
     std::fs::create_dir_all(&out).map_err(|e| Error::Output {
         flag: "--out".into(),
         file: out.clone(),
@@ -122,7 +131,10 @@ pub fn run_fit(o: &FitOptions, observer: &dyn FitObserver) -> Result<FitRun> {
     }
     let records = truth.as_ref().map(|t| truth_records(&fit.summary, t));
     write_outputs(o, &out, &job, &fit, truth.as_deref(), records.as_deref())?;
-    let summary_json = outputs::summary_json(&fit, records.as_deref())?;
+    let mut summary_json = outputs::summary_json(&fit, records.as_deref())?;
+    if let Some(obj) = summary_json.as_object_mut() {
+        obj.insert("run".into(), o.run_args().into());
+    }
     outputs::write_summary(&out.join("summary.json"), &summary_json)?;
     Ok(FitRun {
         job,
@@ -130,6 +142,37 @@ pub fn run_fit(o: &FitOptions, observer: &dyn FitObserver) -> Result<FitRun> {
         out,
         summary_json,
     })
+}
+
+/// What identifies a fit in its `summary.json`: its inputs with their hashes, the sampler's
+/// settings and the command line without the output folder (`run`, [`FitOptions::run_args`]).
+pub fn run_record(o: &FitOptions, job: &FitJob, settings: &FitSettings) -> serde_json::Value {
+    serde_json::json!({
+        "inputs": job.inputs,
+        "settings": settings.sample,
+        "run": o.run_args(),
+    })
+}
+
+/// A fit's record ([`run_record`], or a `summary.json`) in a few words.
+pub fn describe_run(v: &serde_json::Value) -> String {
+    use crate::replace::{text_at, value_at};
+    format!(
+        "prior {}, model {} (hash {}), data {} (hash {}); {} sampler, seed {}, ESS {}{}",
+        text_at(v, "/inputs/prior"),
+        text_at(v, "/inputs/model"),
+        text_at(v, "/inputs/model_hash"),
+        text_at(v, "/inputs/data"),
+        text_at(v, "/inputs/data_hash"),
+        value_at(v, "/settings/sampler"),
+        value_at(v, "/settings/seed"),
+        value_at(v, "/settings/ess_min"),
+        match v.get("run").and_then(serde_json::Value::as_array) {
+            Some(a) if a.iter().any(|x| x == "--no-exact-check") => ", no exact check",
+            Some(_) => ", exact check",
+            None => "",
+        }
+    )
 }
 
 /// Writes the fit's tables (samples, posterior predictive, zeta at the mode), its figures

@@ -58,6 +58,8 @@ fn run_fit(ctx: &Ctx, key: &str, prior: &Path, truth: Option<&Path>) -> Result<V
             no_exact_check: !ctx.exact_check,
             truth: truth.map(Path::to_path_buf),
             likelihood: NoiseKind::Paper.as_str().into(),
+            // The report's own folder: `report paper` has checked it as a whole (report.json).
+            force: true,
             ..FitOptions::default()
         },
         ctx.fit_observer.as_ref(),
