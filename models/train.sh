@@ -7,6 +7,8 @@
 #   TRUNK=W,W,W HEAD=W MEMBERS=N WEIGHT_DECAY=WD bash models/train.sh ...   other layer widths,
 #     ensemble size or AdamW's weight decay (train --trunk/--head/--members/--weight-decay);
 #     suffixes -tW-W-W, -hdW, -mN, -wdWD.
+#   FORCE=1 bash models/train.sh ...   replace a model file of another run (other seed, training
+#     or test rows: train --force, calibrate --force); without it train refuses one.
 # Needs data/training/{train,test}.csv (bash data/training/make.sh, ~40 min) and the committed
 # data/training/{heldout,calibration}.csv. Writes models/super-siegfried-rz-RECIPE.safetensors, its learning
 # curves (.curves.csv), the held-out figures (.heldout.json, and as text with the worst samples,
@@ -31,8 +33,10 @@ cargo build --release -q
 B=target/release/hpge-cv
 $B train --data data/training/train.csv --test data/training/test.csv --space spaces/super-siegfried-rz.toml \
   --detector detectors/super-siegfried-k1.toml --recipe "$RECIPE" --seed "$SEED" --out "$NAME.safetensors" \
-  "${VARIANT[@]}" --plot "$FIGS"
-# The per-point uncertainty sigma_s(p, U_B), fitted on rows neither training nor held out.
-$B calibrate --model "$NAME.safetensors" --data data/training/calibration.csv
+  "${VARIANT[@]}" --plot "$FIGS" ${FORCE:+--force}
+# The per-point uncertainty sigma_s(p, U_B), fitted on rows neither training nor held out, written
+# into the model file.
+$B calibrate --model "$NAME.safetensors" --data data/training/calibration.csv \
+  --out "$NAME.safetensors" ${FORCE:+--force}
 $B evaluate --model "$NAME.safetensors" --data data/training/heldout.csv --json > "$NAME.heldout.json"
 $B evaluate --model "$NAME.safetensors" --data data/training/heldout.csv --plot "$FIGS" > "$NAME.heldout.txt"

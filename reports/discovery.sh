@@ -6,7 +6,9 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cargo build --release
-./target/release/hpge-cv discover --out reports/discovery/super-siegfried --seed 0
-./target/release/hpge-cv validate discovery --seed 7 --out reports/discovery/hidden
+# Both name their committed folders (the defaults are discoveries/...) and replace a run of
+# other inputs there (--force; issue 69).
+./target/release/hpge-cv discover --out reports/discovery/super-siegfried --seed 0 --force
+./target/release/hpge-cv validate discovery --seed 7 --out reports/discovery/hidden --force
 # The effect sizes: cargo run --release -p hpge-validation --example identifiability -- \
 #   quadratic-z y_quad -0.08 -0.15 0.15   (and: li-slope d_li_slope_mm 2.5)
