@@ -167,7 +167,16 @@ fn tiny_network_on_a_tiny_generated_set() {
     );
     assert_eq!(eval(), a);
     checkpoint();
-    bad(&train("4", &[]), &["member-0.safetensors", "another run"]);
+    // Another seed: the model file of seed 3 is refused without --force (issue 69); with it,
+    // the checkpoint of seed 3 is still refused.
+    bad(
+        &train("4", &[]),
+        &["tiny.safetensors", "another run", "--force"],
+    );
+    bad(
+        &train("4", &["--force"]),
+        &["member-0.safetensors", "another run"],
+    );
     std::fs::remove_dir_all(&partial).unwrap();
 
     // Bad input: exit code 2 naming the flag or the file. The library's refusals one by one

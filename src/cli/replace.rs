@@ -98,8 +98,13 @@ fn refuse(
 /// # Errors
 /// The refusal (exit code 2).
 pub fn check_train(job: &TrainJob, force: bool) -> Result<()> {
-    // A recipe the options cannot make is reported by `train` itself.
-    let (true, Ok(recipe)) = (job.out.is_file(), job.recipe()) else {
+    // A recipe the options cannot make, or rows that cannot be read, are reported by `train`.
+    let (true, true, true, Ok(recipe)) = (
+        job.out.is_file(),
+        job.data.is_file(),
+        job.test.is_file(),
+        job.recipe(),
+    ) else {
         return Ok(());
     };
     let here = json!({
@@ -141,7 +146,8 @@ pub fn check_train(job: &TrainJob, force: bool) -> Result<()> {
 /// The refusal (exit code 2).
 pub fn check_calibrate(o: &CalibrateOptions, force: bool) -> Result<()> {
     let target = o.out_file();
-    if !target.is_file() {
+    // Rows that cannot be read are reported by `calibrate`.
+    if !target.is_file() || !o.data.is_file() {
         return Ok(());
     }
     // The model itself is read (and any fault in it reported) by `calibrate`.
