@@ -371,3 +371,79 @@ fn checkpoint_parts_restore_to_a_resumable_run() {
     );
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// `label` and `generate --where` as a user mistypes them: exit 2 naming the file, flag or
+/// hashes; `--where` solves only its share of the candidates.
+#[test]
+fn label_and_where_refuse_bad_input_and_where_solves_its_share() {
+    let d = temp("label-where");
+    let label = |data: &str, space: &str| {
+        run(&[
+            "label",
+            "--data",
+            data,
+            "--space",
+            space,
+            "--detector",
+            "detectors/super-siegfried-k1.toml",
+            "--out",
+            d.join("labels").to_str().unwrap(),
+        ])
+    };
+    let o = label("no/such/rows.csv", "spaces/super-siegfried-rz.toml");
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("no/such/rows.csv"));
+    // Rows of the full space read against the B_Z slice's (the same column names, its knots
+    // tied): refused at the first row whose values are not the slice's.
+    let o = label(
+        "data/training/heldout.csv",
+        "spaces/super-siegfried-bz-slice.toml",
+    );
+    assert_eq!(o.status.code(), Some(2));
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        e.contains("heldout.csv") && e.contains("line 2") && e.contains("another space"),
+        "{e}"
+    );
+    let model = "models/super-siegfried-rz-split-steps-t256-256-256-hd128-wd0.01.safetensors";
+    let out = d.join("where");
+    for (share, want) in [("0", "--share"), ("1.5", "--share")] {
+        let o = generate(&out, "20", &["--where", model, "--share", share]);
+        assert_eq!(o.status.code(), Some(2), "{share}");
+        assert!(String::from_utf8_lossy(&o.stderr).contains(want));
+    }
+    let o = generate(
+        &out,
+        "40",
+        &[
+            "--where",
+            model,
+            "--where",
+            "models/super-siegfried-rz-paper.safetensors",
+            "--share",
+            "0.05",
+            "--offset",
+            "600000",
+        ],
+    );
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let text = std::fs::read_to_string(out.join("rows.csv")).unwrap();
+    assert_eq!(text.lines().count(), 1 + 2, "{text}");
+    assert!(
+        text.lines()
+            .next()
+            .unwrap()
+            .contains(",pockets,pocket_level_V,pocket_cm3,")
+    );
+    let info = std::fs::read_to_string(out.join("generate.json")).unwrap();
+    assert!(
+        info.contains("\"selection\"") && info.contains("committee"),
+        "{info}"
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}

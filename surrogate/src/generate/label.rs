@@ -169,6 +169,49 @@ fn read_input(path: &Path, exact: &ExactSolver) -> Result<(Input, String)> {
         if !seen.insert(index) {
             return Err(invalid(key, format!("index {index} appears twice")));
         }
+        // The physical values must be the space's map of the unit coordinates: rows of another
+        // space with the same column names (the B_Z slice's ties) are refused here, not solved.
+        let d = space.dim();
+        let num = |c: usize| f[c].parse::<f64>().unwrap_or(f64::NAN);
+        let u: Vec<f64> = (1..=d).map(num).collect();
+        let mapped = space.from_unit(&u);
+        for (j, m) in mapped.iter().enumerate() {
+            let x = num(1 + d + j);
+            if x.is_nan() || (x - m).abs() > 1e-9 * (1.0 + m.abs()) {
+                return Err(invalid(
+                    format!("{key}, column `{}`", space.dimensions[j].name),
+                    format!(
+                        "{x} is not the space's value {m} for u = {} (space `{}`, {}): rows of \
+                         another space?",
+                        u[j],
+                        space.name,
+                        space.file.display()
+                    ),
+                ));
+            }
+        }
+        // A tied dimension (`same_as`) must hold its knot's value: rows of the full space are
+        // not points of a slice with the same columns.
+        for (j, dim) in space.dimensions.iter().enumerate() {
+            let Some(t) = dim.same_as.as_deref() else {
+                continue;
+            };
+            let Some(k) = space.dimensions.iter().position(|e| e.name == t) else {
+                continue;
+            };
+            let (xj, xk) = (num(1 + d + j), num(1 + d + k));
+            if (xj - xk).abs() > 1e-9 * (1.0 + xk.abs()) {
+                return Err(invalid(
+                    format!("{key}, column `{}`", dim.name),
+                    format!(
+                        "{xj} differs from `{t}` = {xk}, to which space `{}` ({}) ties it: rows \
+                         of another space?",
+                        space.name,
+                        space.file.display()
+                    ),
+                ));
+            }
+        }
         rows.push((index, f));
     }
     Ok((
