@@ -24,7 +24,7 @@ use serde::{Deserialize, Serialize};
 
 use super::exact::ExactSolver;
 use super::regime::{REGIME_COLUMNS, Regime};
-use super::run::read_rows;
+use super::run::{on_threads, read_rows};
 use crate::error::{Error, Result};
 use crate::hash::fnv1a;
 
@@ -412,17 +412,7 @@ pub fn label(
             progress(n, total);
         })
     };
-    match threads {
-        Some(t) => rayon::ThreadPoolBuilder::new()
-            .num_threads(t.max(1))
-            .build()
-            .map_err(|e| Error::Argument {
-                name: "--threads".into(),
-                message: e.to_string(),
-            })?
-            .install(work),
-        None => work(),
-    }
+    on_threads(threads, work)?;
     if let Some(e) = error.into_inner().unwrap_or_else(|e| e.into_inner()) {
         return Err(e);
     }

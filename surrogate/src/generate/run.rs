@@ -314,17 +314,7 @@ pub fn run(
             progress(n, total);
         })
     };
-    match threads {
-        Some(t) => rayon::ThreadPoolBuilder::new()
-            .num_threads(t.max(1))
-            .build()
-            .map_err(|e| Error::Argument {
-                name: "--threads".into(),
-                message: e.to_string(),
-            })?
-            .install(work),
-        None => work(),
-    }
+    on_threads(threads, work)?;
     if let Some(e) = error.into_inner().unwrap_or_else(|e| e.into_inner()) {
         return Err(e);
     }
@@ -338,6 +328,22 @@ pub fn run(
         repaired,
         retried: failed_before.len(),
     })
+}
+
+/// Runs `work` on a pool of `threads` threads (None: rayon's global pool, all cores).
+pub(super) fn on_threads(threads: Option<usize>, work: impl FnOnce() + Send) -> Result<()> {
+    match threads {
+        Some(t) => rayon::ThreadPoolBuilder::new()
+            .num_threads(t.max(1))
+            .build()
+            .map_err(|e| Error::Argument {
+                name: "--threads".into(),
+                message: e.to_string(),
+            })?
+            .install(work),
+        None => work(),
+    }
+    Ok(())
 }
 
 fn describe(i: &RunInfo) -> String {
