@@ -141,8 +141,7 @@ impl ExactSolver {
         x: &[f64],
         window_v: f64,
     ) -> Result<(f64, f64, Regime, f64)> {
-        let (det, bias) = self.configure(x)?;
-        let p = solve_point(&det, bias, &self.settings, None)?;
+        let (det, bias, p) = self.point(x)?;
         let regime = Regime::from_pockets(&p.potential.pockets);
         let count = |u: f64, guess: &[f64]| -> Result<(usize, Vec<f64>)> {
             let s = hpge_solver::field::solve_fast(&p.mesh, &det, u, Some(guess))?;
@@ -183,10 +182,16 @@ impl ExactSolver {
     /// [`ExactSolver::solve_with_error`] with the pockets the solve ended with (the training
     /// row's regime, `generate::regime`): (c12 pF, estimated error pF, regime).
     pub fn solve_labelled(&self, x: &[f64]) -> Result<(f64, f64, Regime)> {
-        let (det, bias) = self.configure(x)?;
-        let p = solve_point(&det, bias, &self.settings, None)?;
+        let (_, _, p) = self.point(x)?;
         let regime = Regime::from_pockets(&p.potential.pockets);
         Ok((p.c12_pf, p.accuracy.c12_err_pf, regime))
+    }
+
+    /// The detector at `x`, its bias and the point's solve at the settings.
+    fn point(&self, x: &[f64]) -> Result<(Detector, f64, hpge_solver::PointResult)> {
+        let (det, bias) = self.configure(x)?;
+        let p = solve_point(&det, bias, &self.settings, None)?;
+        Ok((det, bias, p))
     }
 
     /// The detector with the space's non-bias values `params` (column order, a surrogate's

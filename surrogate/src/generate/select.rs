@@ -38,7 +38,7 @@ impl Eq for SelectionInfo {}
 
 /// The committee's relative disagreement at each of `xs` (physical values in the space's
 /// column order): see the module's formula.
-pub fn committee_scores(models: &[Surrogate], g: &Generator, xs: &[Vec<f64>]) -> Result<Vec<f64>> {
+pub fn committee_scores(models: &[&Surrogate], g: &Generator, xs: &[Vec<f64>]) -> Result<Vec<f64>> {
     let targets = g.space.targets();
     let b = targets
         .iter()
@@ -154,7 +154,7 @@ pub fn selection_info(
 
 /// The chosen indices: the top ceil(share n) of the run's candidates by score (ties: lower
 /// index first), in increasing index order.
-pub fn choose(g: &Generator, models: &[Surrogate], share: f64) -> Result<Vec<u64>> {
+pub fn choose(g: &Generator, models: &[&Surrogate], share: f64) -> Result<Vec<u64>> {
     let candidates: Vec<u64> = (g.offset..g.offset + g.n).collect();
     let xs: Vec<Vec<f64>> = candidates
         .iter()

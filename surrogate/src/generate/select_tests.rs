@@ -100,7 +100,7 @@ fn the_top_share_by_committee_disagreement_is_chosen_the_same_every_time() {
     assert!(chosen.windows(2).all(|w| w[0] < w[1]));
     assert!(chosen.iter().all(|&i| (700_000..700_000 + n).contains(&i)));
     // Every chosen candidate scores at least as high as every other.
-    let loaded: Vec<Surrogate> = models.iter().map(|m| m.2.clone()).collect();
+    let loaded: Vec<&Surrogate> = models.iter().map(|m| &m.2).collect();
     let xs: Vec<Vec<f64>> = (700_000..700_000 + n)
         .map(|i| g.space.from_sampled_unit(&g.sequence.point(i)).1)
         .collect();

@@ -290,8 +290,7 @@ impl Generator {
             });
         }
         let info = selection_info(&self, models, share)?;
-        let loaded: Vec<crate::model::Surrogate> =
-            models.iter().map(|(_, _, m)| m.clone()).collect();
+        let loaded: Vec<&crate::model::Surrogate> = models.iter().map(|(_, _, m)| m).collect();
         self.chosen = Some(choose(&self, &loaded, share)?.into_iter().collect());
         self.fingerprint.selection = Some(info);
         Ok(self)
