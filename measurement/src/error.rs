@@ -48,13 +48,13 @@ pub enum Error {
         /// What is wrong with it ("must be positive, got -1").
         message: String,
     },
-    /// A file that the HDF5 library cannot open as HDF5 (not HDF5, truncated, unreadable): an
+    /// A file that the HDF5 reader cannot open as HDF5 (not HDF5, truncated, unreadable): an
     /// `.lh5` pulse file.
     #[error("{}: cannot open as an HDF5 (LH5) file: {reason}", file.display())]
     Hdf5Open {
         /// The file.
         file: PathBuf,
-        /// The HDF5 library's reason.
+        /// The HDF5 reader's reason.
         reason: String,
     },
     /// An HDF5 file that opens but does not hold the expected LH5 waveform table: a missing

@@ -1,11 +1,13 @@
 //! LH5 pulse files: a file written with the layout of legend-pydataobj reads back as the same
 //! pulses as the `.npy` file, and every bad file is an error naming the file and the dataset
-//! (never a panic, nothing printed by the HDF5 library). The comparison with files written by
-//! legend-pydataobj itself is `python/tests/test_lh5.py`.
+//! (never a panic, nothing printed by the HDF5 library). The files here are written by
+//! `hdf5-pure` (the reader's crate, in Rust) and, in `tests/data/lh5/`, by legend-pydataobj's
+//! writer itself (libhdf5 through h5py: chunked, shuffle + gzip, LZF, contiguous, zstd); the
+//! comparison of a whole run written by legend-pydataobj is `python/tests/test_lh5.py`.
 
 use std::path::{Path, PathBuf};
 
-use hdf5::types::VarLenUnicode;
+use hdf5_pure::{AttrValue, FileBuilder, GroupBuilder};
 use hpge_measurement::{Error, PulseSet, read_pulse_file, read_raw_dir, write_pulses};
 
 fn dir(name: &str) -> PathBuf {
@@ -39,44 +41,66 @@ fn sidecar(lh5: &Path, bias_v: f64) {
     .unwrap();
 }
 
-fn units(ds: &hdf5::Dataset, unit: &str) {
-    let value: VarLenUnicode = unit.parse().unwrap();
-    ds.new_attr::<VarLenUnicode>()
-        .create("units")
-        .unwrap()
-        .write_scalar(&value)
-        .unwrap();
+fn units(unit: &str) -> AttrValue {
+    AttrValue::VarLenString(unit.to_string())
+}
+
+/// Writes a file of one or more tables: each a group path (`ch000/raw/waveform`, its groups
+/// nested) and the function that fills the innermost group.
+type Table<'a> = (&'a str, &'a dyn Fn(&mut GroupBuilder));
+
+fn write_file(path: &Path, tables: &[Table]) {
+    let mut file = FileBuilder::new();
+    for (group_path, fill) in tables {
+        let names: Vec<&str> = group_path.split('/').collect();
+        let top = file.create_group(names[0]);
+        let finished = nest(top, &names[1..], *fill);
+        file.add_group(finished);
+    }
+    file.write(path).unwrap();
+}
+
+fn nest(
+    mut group: GroupBuilder,
+    rest: &[&str],
+    fill: &dyn Fn(&mut GroupBuilder),
+) -> hdf5_pure::FinishedGroup {
+    if rest.is_empty() {
+        fill(&mut group);
+    } else {
+        let child = group.create_group(rest[0]);
+        let finished = nest(child, &rest[1..], fill);
+        group.add_group(finished);
+    }
+    group.finish()
 }
 
 /// Writes `set` as legend-pydataobj lays out a waveform table: `ch000/raw/waveform/{t0,dt,values}`
 /// with `units` attributes (dt in `dt_unit`, scaled accordingly).
 fn write_lh5(path: &Path, set: &PulseSet, dt_unit: &str, ns_per_unit: f64) {
-    let file = hdf5::File::create(path).unwrap();
-    let table = file.create_group("ch000/raw/waveform").unwrap();
-    let values = ndarray::Array2::from_shape_vec(
-        (set.n_pulses, set.n_samples),
-        set.charge_pc.iter().map(|&q| q as f32).collect(),
-    )
-    .unwrap();
-    let ds = table
-        .new_dataset_builder()
-        .with_data(&values)
-        .create("values")
-        .unwrap();
-    units(&ds, "pC");
-    let dt = vec![set.sampling_period_ns / ns_per_unit; set.n_pulses];
-    let ds = table
-        .new_dataset_builder()
-        .with_data(&dt)
-        .create("dt")
-        .unwrap();
-    units(&ds, dt_unit);
-    let t0 = vec![0.0_f64; set.n_pulses];
+    write_file(
+        path,
+        &[("ch000/raw/waveform", &|table| {
+            waveform(table, set, dt_unit, ns_per_unit)
+        })],
+    );
+}
+
+fn waveform(table: &mut GroupBuilder, set: &PulseSet, dt_unit: &str, ns_per_unit: f64) {
+    let values: Vec<f32> = set.charge_pc.iter().map(|&q| q as f32).collect();
     table
-        .new_dataset_builder()
-        .with_data(&t0)
-        .create("t0")
-        .unwrap();
+        .create_dataset("values")
+        .with_f32_data(&values)
+        .with_shape(&[set.n_pulses as u64, set.n_samples as u64])
+        .set_attr("units", units("pC"));
+    let dt = vec![set.sampling_period_ns / ns_per_unit; set.n_pulses];
+    table
+        .create_dataset("dt")
+        .with_f64_data(&dt)
+        .set_attr("units", units(dt_unit));
+    table
+        .create_dataset("t0")
+        .with_f64_data(&vec![0.0_f64; set.n_pulses]);
 }
 
 #[test]
@@ -175,67 +199,69 @@ fn a_file_without_the_waveform_table_is_an_error_naming_it() {
     let d = dir("layout");
 
     let empty = d.join("no_table.lh5");
-    let file = hdf5::File::create(&empty).unwrap();
-    let raw = file.create_group("ch000/raw").unwrap();
-    raw.new_dataset_builder()
-        .with_data(&[1.0_f64, 2.0])
-        .create("energy")
-        .unwrap();
-    drop(raw);
-    drop(file);
+    write_file(
+        &empty,
+        &[("ch000/raw", &|raw| {
+            raw.create_dataset("energy").with_f64_data(&[1.0, 2.0]);
+        })],
+    );
     sidecar(&empty, 10.0);
     expect_lh5_error(&empty, "waveform", "no waveform table");
 
     let no_dt = d.join("no_dt.lh5");
-    let file = hdf5::File::create(&no_dt).unwrap();
-    let table = file.create_group("raw/waveform").unwrap();
-    table
-        .new_dataset_builder()
-        .with_data(&ndarray::Array2::<f64>::zeros((2, 4)))
-        .create("values")
-        .unwrap();
-    drop(table);
-    drop(file);
+    write_file(
+        &no_dt,
+        &[("raw/waveform", &|table| {
+            table
+                .create_dataset("values")
+                .with_f64_data(&[0.0; 8])
+                .with_shape(&[2, 4]);
+        })],
+    );
     sidecar(&no_dt, 10.0);
     expect_lh5_error(&no_dt, "/raw/waveform/dt", "missing dataset");
 
     let rank = d.join("rank.lh5");
-    let file = hdf5::File::create(&rank).unwrap();
-    let table = file.create_group("raw/waveform").unwrap();
-    table
-        .new_dataset_builder()
-        .with_data(&[1.0_f64, 2.0, 3.0])
-        .create("values")
-        .unwrap();
-    drop(table);
-    drop(file);
+    write_file(
+        &rank,
+        &[("raw/waveform", &|table| {
+            table
+                .create_dataset("values")
+                .with_f64_data(&[1.0, 2.0, 3.0]);
+        })],
+    );
     sidecar(&rank, 10.0);
     expect_lh5_error(&rank, "/raw/waveform/values", "2-D");
 
     let ints = d.join("ints.lh5");
-    let file = hdf5::File::create(&ints).unwrap();
-    let table = file.create_group("raw/waveform").unwrap();
-    table
-        .new_dataset_builder()
-        .with_data(&ndarray::Array2::<u16>::zeros((2, 4)))
-        .create("values")
-        .unwrap();
-    drop(table);
-    drop(file);
+    write_file(
+        &ints,
+        &[("raw/waveform", &|table| {
+            table
+                .create_dataset("values")
+                .with_u16_data(&[0; 8])
+                .with_shape(&[2, 4]);
+        })],
+    );
     sidecar(&ints, 10.0);
     expect_lh5_error(&ints, "/raw/waveform/values", "float32 or float64");
 
     let two = d.join("two_channels.lh5");
-    write_lh5(&two, &set(10.0), "ns", 1.0);
-    let file = hdf5::File::open_rw(&two).unwrap();
-    let table = file.create_group("ch001/raw/waveform").unwrap();
-    table
-        .new_dataset_builder()
-        .with_data(&ndarray::Array2::<f64>::zeros((2, 4)))
-        .create("values")
-        .unwrap();
-    drop(table);
-    drop(file);
+    let s10 = set(10.0);
+    write_file(
+        &two,
+        &[
+            ("ch000/raw/waveform", &|table| {
+                waveform(table, &s10, "ns", 1.0)
+            }),
+            ("ch001/raw/waveform", &|table| {
+                table
+                    .create_dataset("values")
+                    .with_f64_data(&[0.0; 8])
+                    .with_shape(&[2, 4]);
+            }),
+        ],
+    );
     sidecar(&two, 10.0);
     expect_lh5_error(&two, "waveform", "2 waveform tables");
 
@@ -245,4 +271,44 @@ fn a_file_without_the_waveform_table_is_an_error_naming_it() {
     write_lh5(&unit, &s, "ns", 1.0);
     sidecar(&unit, 10.0);
     expect_lh5_error(&unit, "/ch000/raw/waveform/dt", "sampling_period_ns");
+}
+
+/// The fixtures of `tests/data/lh5/`, written by legend-pydataobj's writer (`make_fixtures.py`).
+fn fixture(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/lh5")
+        .join(name)
+}
+
+#[test]
+fn files_written_by_legend_pydataobj_read_as_written() {
+    // Sample k (row-major) = 0.1 k + 0.1 pC, stored as float32 or float64.
+    let exact: Vec<f64> = (0..15).map(|k| 0.1 * k as f64 + 100.0 * 1e-3).collect();
+    let as_f32: Vec<f64> = exact.iter().map(|&q| f64::from(q as f32)).collect();
+    for (name, expected) in [
+        // The writer's default: chunked, shuffle + gzip.
+        ("gzip_f32.lh5", &as_f32),
+        // dt in us (4e-3).
+        ("gzip_f64_us.lh5", &exact),
+        ("lzf_f32.lh5", &as_f32),
+        ("contiguous_f64.lh5", &exact),
+    ] {
+        let set = read_pulse_file(&fixture(name)).unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!((set.n_pulses, set.n_samples), (3, 5), "{name}");
+        assert_eq!(&set.charge_pc, expected, "{name}");
+        assert_eq!(set.bias_v, 100.0, "{name}");
+        assert_eq!(set.sampling_period_ns, 4.0, "{name}");
+    }
+    // A plugin filter (zstd through hdf5plugin) is an error naming the filter's id.
+    expect_lh5_error(
+        &fixture("zstd_f32.lh5"),
+        "/ch000/raw/waveform/values",
+        "32015",
+    );
+    // LEGEND's encoded waveforms: an error naming the codec.
+    expect_lh5_error(
+        &fixture("encoded_uleb128.lh5"),
+        "/ch000/raw/waveform/values",
+        "uleb128_zigzag_diff",
+    );
 }

@@ -17,12 +17,19 @@
 //! `t0` and the other columns of the table are not used. The bias is the sidecar's `bias_V`:
 //! the sidecar `<stem>.toml` is required as for `.npy` files (same keys, same checks).
 //!
-//! HDF5's own error printing is silenced by the `hdf5` crate; every failure of the library is a
+//! LEGEND's encoded waveforms (`values` a group with a `codec` attribute, as
+//! `lh5.compression.encode` writes them) are refused with an error naming the codec: decode them
+//! to floats first.
+//!
+//! The file is read by `hdf5-pure`, an HDF5 reader in Rust (no HDF5 C library, nothing printed
+//! by it): contiguous and chunked datasets, deflate (gzip), shuffle, LZF and Fletcher-32, which
+//! covers what legend-pydataobj writes by default (chunked, shuffle + gzip). Datasets behind
+//! plugin filters (zstd, blosc, ...) are an error naming the filter. Every failure is an
 //! [`Error::Lh5`] naming the file, the dataset and the reason.
 
 use std::path::Path;
 
-use hdf5::types::{FloatSize, TypeDescriptor, VarLenAscii, VarLenUnicode};
+use hdf5_pure::{AttrValue, DType};
 
 use super::sidecar;
 use crate::error::{Error, Result};
@@ -63,16 +70,30 @@ fn lh5(file: &Path, dataset: impl Into<String>, reason: impl Into<String>) -> Er
 /// `.npy` files.
 pub fn read_lh5_pulses(path: &Path) -> Result<PulseSet> {
     let checked = sidecar::read_checked(path)?;
-    let file = hdf5::File::open(path).map_err(|e| Error::Hdf5Open {
+    let file_bytes = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
+    let file = hdf5_pure::File::open(path).map_err(|e| Error::Hdf5Open {
         file: path.to_path_buf(),
         reason: e.to_string(),
     })?;
-    let root = file
-        .as_group()
-        .map_err(|e| lh5(path, "/", format!("cannot open the root group: {e}")))?;
+    // A file cut short (an interrupted copy) can still parse where its cut-off part holds
+    // nothing the reader visits; the superblock's end-of-file address says how long it was
+    // written (the check libhdf5 makes on opening).
+    let superblock = file.superblock();
+    let written = superblock
+        .base_address
+        .get()
+        .saturating_add(superblock.eof_address);
+    if file_bytes < written {
+        return Err(Error::Hdf5Open {
+            file: path.to_path_buf(),
+            reason: format!(
+                "truncated file: {file_bytes} bytes where its superblock records {written}"
+            ),
+        });
+    }
     let mut tables = Vec::new();
-    find_waveform_tables(path, &root, &mut tables)?;
-    let table = match tables.len() {
+    find_waveform_tables(path, &file.root(), "", &mut tables)?;
+    let (table_name, table) = match tables.len() {
         1 => tables.remove(0),
         0 => {
             return Err(lh5(
@@ -83,7 +104,7 @@ pub fn read_lh5_pulses(path: &Path) -> Result<PulseSet> {
             ));
         }
         _ => {
-            let names: Vec<String> = tables.iter().map(|g| g.name()).collect();
+            let names: Vec<String> = tables.iter().map(|(name, _)| name.clone()).collect();
             return Err(lh5(
                 path,
                 "*/waveform",
@@ -96,15 +117,31 @@ pub fn read_lh5_pulses(path: &Path) -> Result<PulseSet> {
             ));
         }
     };
-    let table_name = table.name();
     let values_name = format!("{table_name}/values");
     let dt_name = format!("{table_name}/dt");
 
     // values: 2-D float [pulses, samples].
+    if let Ok(encoded) = table.group("values") {
+        let codec = encoded
+            .attrs()
+            .ok()
+            .and_then(|a| a.get("codec").and_then(attr_text))
+            .unwrap_or_else(|| "unknown".to_string());
+        return Err(lh5(
+            path,
+            &values_name,
+            format!(
+                "LEGEND-encoded waveforms (codec {codec}) are not read: decode them to float \
+                 samples in the sidecar's charge_unit first (lh5.compression.decode)"
+            ),
+        ));
+    }
     let values = table
         .dataset("values")
         .map_err(|e| lh5(path, &values_name, format!("missing dataset: {e}")))?;
-    let shape = values.shape();
+    let shape = values
+        .shape()
+        .map_err(|e| lh5(path, &values_name, format!("cannot read the shape: {e}")))?;
     if shape.len() != 2 {
         return Err(lh5(
             path,
@@ -115,7 +152,7 @@ pub fn read_lh5_pulses(path: &Path) -> Result<PulseSet> {
             ),
         ));
     }
-    let (n_pulses, n_samples) = (shape[0], shape[1]);
+    let (n_pulses, n_samples) = (to_usize(shape[0]), to_usize(shape[1]));
     if n_pulses < 1 || n_samples < 2 {
         return Err(lh5(
             path,
@@ -126,6 +163,7 @@ pub fn read_lh5_pulses(path: &Path) -> Result<PulseSet> {
         ));
     }
     check_float(path, &values_name, &values)?;
+    check_size(path, &values_name, n_pulses, n_samples, file_bytes)?;
     if let Some(unit) = units(path, &values_name, &values)?
         && unit != checked.sidecar.charge_unit
     {
@@ -139,11 +177,21 @@ pub fn read_lh5_pulses(path: &Path) -> Result<PulseSet> {
             ),
         ));
     }
-    let array = values
-        .read_2d::<f64>()
-        .map_err(|e| lh5(path, &values_name, format!("cannot read: {e}")))?;
     checked.check_shape(path, n_pulses, n_samples)?;
-    let mut charge_pc: Vec<f64> = array.iter().copied().collect();
+    let mut charge_pc = values
+        .read_f64()
+        .map_err(|e| lh5(path, &values_name, format!("cannot read: {e}")))?;
+    if charge_pc.len() != n_pulses * n_samples {
+        return Err(lh5(
+            path,
+            &values_name,
+            format!(
+                "read {} samples where the shape {n_pulses} x {n_samples} declares {}",
+                charge_pc.len(),
+                n_pulses * n_samples
+            ),
+        ));
+    }
     if let Some(k) = charge_pc.iter().position(|q| !q.is_finite()) {
         return Err(lh5(
             path,
@@ -166,13 +214,16 @@ pub fn read_lh5_pulses(path: &Path) -> Result<PulseSet> {
     let dt = table
         .dataset("dt")
         .map_err(|e| lh5(path, &dt_name, format!("missing dataset: {e}")))?;
-    if dt.shape() != [n_pulses] {
+    let dt_shape = dt
+        .shape()
+        .map_err(|e| lh5(path, &dt_name, format!("cannot read the shape: {e}")))?;
+    if dt_shape != [n_pulses as u64] {
         return Err(lh5(
             path,
             &dt_name,
             format!(
-                "expected a 1-D array of {n_pulses} sampling periods (one per pulse), got shape {:?}",
-                dt.shape()
+                "expected a 1-D array of {n_pulses} sampling periods (one per pulse), got shape \
+                 {dt_shape:?}"
             ),
         ));
     }
@@ -191,7 +242,7 @@ pub fn read_lh5_pulses(path: &Path) -> Result<PulseSet> {
             })?,
     };
     let periods = dt
-        .read_1d::<f64>()
+        .read_f64()
         .map_err(|e| lh5(path, &dt_name, format!("cannot read: {e}")))?;
     let period_ns = checked.sidecar.sampling_period_ns;
     for (p, &d) in periods.iter().enumerate() {
@@ -221,34 +272,85 @@ pub fn read_lh5_pulses(path: &Path) -> Result<PulseSet> {
     })
 }
 
-/// Collects every group named `waveform` that holds a `values` dataset, depth first.
+/// Collects every group named `waveform` that holds a member `values`, depth first, with its
+/// absolute path (`/ch000/raw/waveform`).
 fn find_waveform_tables(
     path: &Path,
-    group: &hdf5::Group,
-    out: &mut Vec<hdf5::Group>,
+    group: &hdf5_pure::Group,
+    group_name: &str,
+    out: &mut Vec<(String, hdf5_pure::Group)>,
 ) -> Result<()> {
+    let listed = if group_name.is_empty() {
+        "/"
+    } else {
+        group_name
+    };
     let children = group
         .groups()
-        .map_err(|e| lh5(path, group.name(), format!("cannot list the group: {e}")))?;
-    for child in children {
-        let name = child.name();
-        if name.rsplit('/').next() == Some(WAVEFORM) && child.link_exists("values") {
-            out.push(child);
+        .map_err(|e| lh5(path, listed, format!("cannot list the group: {e}")))?;
+    for name in children {
+        let child_name = format!("{group_name}/{name}");
+        let child = group
+            .group(&name)
+            .map_err(|e| lh5(path, &child_name, format!("cannot open the group: {e}")))?;
+        if name == WAVEFORM && has_member(&child, "values") {
+            out.push((child_name, child));
         } else {
-            find_waveform_tables(path, &child, out)?;
+            find_waveform_tables(path, &child, &child_name, out)?;
         }
     }
     Ok(())
 }
 
+/// Whether a group has a dataset or a group of this name.
+fn has_member(group: &hdf5_pure::Group, name: &str) -> bool {
+    group.datasets().is_ok_and(|d| d.iter().any(|n| n == name))
+        || group.groups().is_ok_and(|g| g.iter().any(|n| n == name))
+}
+
+/// A dimension of an HDF5 shape as `usize` (saturating: a shape too large for memory is refused
+/// by [`check_size`] anyway).
+fn to_usize(n: u64) -> usize {
+    usize::try_from(n).unwrap_or(usize::MAX)
+}
+
+/// Largest ratio of decoded to stored bytes of the filters read (deflate's limit is 1032:1;
+/// shuffle and Fletcher-32 keep the size, LZF compresses less).
+const MAX_EXPANSION: u64 = 1032;
+
+/// Refuses a shape that the file cannot hold even at the filters' highest compression ratio
+/// (a damaged header declaring billions of samples), before memory is allocated for it.
+fn check_size(
+    path: &Path,
+    name: &str,
+    n_pulses: usize,
+    n_samples: usize,
+    file_bytes: u64,
+) -> Result<()> {
+    let bytes = (n_pulses as u64)
+        .saturating_mul(n_samples as u64)
+        .saturating_mul(8);
+    let limit = file_bytes.saturating_mul(MAX_EXPANSION).max(1 << 20);
+    if bytes > limit {
+        return Err(lh5(
+            path,
+            name,
+            format!(
+                "the shape {n_pulses} x {n_samples} declares more samples than a file of \
+                 {file_bytes} bytes can hold (damaged file?)"
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// Checks that a dataset holds float32 or float64 numbers.
-fn check_float(path: &Path, name: &str, ds: &hdf5::Dataset) -> Result<()> {
-    let descriptor = ds
+fn check_float(path: &Path, name: &str, ds: &hdf5_pure::Dataset) -> Result<()> {
+    let dtype = ds
         .dtype()
-        .and_then(|t| t.to_descriptor())
         .map_err(|e| lh5(path, name, format!("cannot read the element type: {e}")))?;
-    match descriptor {
-        TypeDescriptor::Float(FloatSize::U4 | FloatSize::U8) => Ok(()),
+    match dtype {
+        DType::F32 | DType::F64 => Ok(()),
         other => Err(lh5(
             path,
             name,
@@ -257,42 +359,42 @@ fn check_float(path: &Path, name: &str, ds: &hdf5::Dataset) -> Result<()> {
     }
 }
 
-/// The `units` attribute of a dataset, if it has one (a string, variable or fixed length).
-fn units(path: &Path, name: &str, ds: &hdf5::Dataset) -> Result<Option<String>> {
-    if !ds
-        .attr_names()
-        .is_ok_and(|n| n.iter().any(|a| a == "units"))
-    {
-        return Ok(None);
+/// The text of a string attribute (fixed or variable length, ASCII or UTF-8), `None` for any
+/// other type.
+fn attr_text(value: &AttrValue) -> Option<String> {
+    match value {
+        AttrValue::String(s)
+        | AttrValue::AsciiString(s)
+        | AttrValue::VarLenString(s)
+        | AttrValue::VarLenAsciiString(s)
+        | AttrValue::StringSized { value: s, .. }
+        | AttrValue::AsciiStringSized { value: s, .. } => Some(s.clone()),
+        AttrValue::StringArray(v)
+        | AttrValue::AsciiStringArray(v)
+        | AttrValue::VarLenStringArray(v)
+        | AttrValue::VarLenAsciiStringArray(v)
+            if v.len() == 1 =>
+        {
+            Some(v[0].clone())
+        }
+        _ => None,
     }
-    let attr = ds.attr("units").map_err(|e| {
+}
+
+/// The `units` attribute of a dataset, if it has one (a string, variable or fixed length).
+fn units(path: &Path, name: &str, ds: &hdf5_pure::Dataset) -> Result<Option<String>> {
+    let attrs = ds
+        .attrs()
+        .map_err(|e| lh5(path, name, format!("cannot read the attributes: {e}")))?;
+    let Some(value) = attrs.get("units") else {
+        return Ok(None);
+    };
+    let text = attr_text(value).ok_or_else(|| {
         lh5(
             path,
             name,
-            format!("cannot open the `units` attribute: {e}"),
+            format!("the `units` attribute is not a string: {value:?}"),
         )
     })?;
-    let text = attr
-        .read_scalar::<VarLenUnicode>()
-        .map(|s| s.as_str().to_string())
-        .or_else(|_| {
-            attr.read_scalar::<VarLenAscii>()
-                .map(|s| s.as_str().to_string())
-        })
-        .or_else(|_| {
-            attr.read_scalar::<hdf5::types::FixedAscii<256>>()
-                .map(|s| s.as_str().to_string())
-        })
-        .or_else(|_| {
-            attr.read_scalar::<hdf5::types::FixedUnicode<256>>()
-                .map(|s| s.as_str().to_string())
-        })
-        .map_err(|e| {
-            lh5(
-                path,
-                name,
-                format!("the `units` attribute is not a string: {e}"),
-            )
-        })?;
     Ok(Some(text.trim().to_string()))
 }

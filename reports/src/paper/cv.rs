@@ -13,6 +13,7 @@ use super::criterion::{Cmp, Criterion, Judgement};
 use super::ctx::Ctx;
 use crate::error::{Error, Result};
 use crate::plot::Format;
+use crate::plot::fonts::Glyphs;
 use crate::plot::style::err;
 
 /// The figure's stem.
@@ -143,14 +144,15 @@ pub fn run(ctx: &mut Ctx) -> Result<()> {
 
 fn figure(path: &Path, data: &[(f64, f64, f64)], sim: &CvCurve, foot: &[String]) -> Result<()> {
     let size = (1000, 720);
+    crate::plot::fonts::register();
     match Format::from_path(path) {
         Some(Format::Svg) => {
-            let root = SVGBackend::new(path, size).into_drawing_area();
+            let root = Glyphs(SVGBackend::new(path, size)).into_drawing_area();
             draw(&root, data, sim, foot)?;
             root.present().map_err(err)
         }
         Some(Format::Png) => {
-            let root = BitMapBackend::new(path, size).into_drawing_area();
+            let root = Glyphs(BitMapBackend::new(path, size)).into_drawing_area();
             draw(&root, data, sim, foot)?;
             root.present().map_err(err)
         }

@@ -17,6 +17,7 @@ mod depletion;
 mod discovery;
 mod field;
 mod fit;
+pub(crate) mod fonts;
 mod format;
 mod lines;
 mod measure;

@@ -14,14 +14,20 @@ macro_rules! render {
         };
         match $crate::plot::format::Format::from_path(path) {
             Some(format) => {
+                $crate::plot::fonts::register();
                 let $svg = format == $crate::plot::format::Format::Svg;
                 if $svg {
-                    let $root = plotters::prelude::SVGBackend::new(path, $size).into_drawing_area();
+                    let $root = $crate::plot::fonts::Glyphs(plotters::prelude::SVGBackend::new(
+                        path, $size,
+                    ))
+                    .into_drawing_area();
                     $body.map_err(|e: $crate::error::Error| draw(e.chain_text()))?;
                     $root.present().map_err(|e| draw(e.to_string()))?;
                 } else {
-                    let $root =
-                        plotters::prelude::BitMapBackend::new(path, $size).into_drawing_area();
+                    let $root = $crate::plot::fonts::Glyphs(plotters::prelude::BitMapBackend::new(
+                        path, $size,
+                    ))
+                    .into_drawing_area();
                     $body.map_err(|e: $crate::error::Error| draw(e.chain_text()))?;
                     $root.present().map_err(|e| draw(e.to_string()))?;
                 }
