@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use hpge_reports::status::{status_rows, status_table, table_in};
+use hpge_reports::status::{MAX_CELL_CHARS, status_rows, status_table, table_in};
 
 #[test]
 fn readme_status_table_agrees_with_the_results_files() {
@@ -28,5 +28,17 @@ fn readme_status_table_agrees_with_the_results_files() {
     // Every row's source exists.
     for r in &rows {
         assert!(root.join(&r.source).exists(), "{} is missing", r.source);
+    }
+    // The README fits one screen (issue 61): at most 70 lines, no table cell over the limit.
+    let lines = readme.lines().count();
+    assert!(lines <= 70, "README.md has {lines} lines, more than 70");
+    for line in have.lines() {
+        for cell in line.trim_matches('|').split(" | ") {
+            let n = cell.trim().chars().count();
+            assert!(
+                n <= MAX_CELL_CHARS,
+                "a status cell of {n} characters: {cell}"
+            );
+        }
     }
 }
