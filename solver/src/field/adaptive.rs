@@ -27,9 +27,11 @@
 //! on thin depletion layers H2 does not resolve the layer (planar p-n at 18.25 V: the guard said
 //! 2.4%).
 //!
-//! A fully depleted point starts from the detector's initial grid, not from the potential's
-//! (which depends on the bias and on the neighbouring voltage's front): its weighting potentials
-//! do not depend on the bias, so neither does its c12, exactly.
+//! A fully depleted point takes the depleted reference's grid and weighting stage, computed once
+//! from the detector's initial grid (`field::depleted`), not the potential's grid (which depends
+//! on the bias and on the neighbouring voltage's front): its weighting potentials do not depend
+//! on the bias, so neither does its c12, exactly. An undepleted point carries that reference
+//! over to its own grid as a control variate, so the curve has no step at full depletion.
 
 use super::capacitance::CapacitanceMatrix;
 use super::depletion::PotentialSolution;
@@ -69,6 +71,33 @@ pub(crate) fn weigh(
     mesh: &Mesh,
     pot: &PotentialSolution,
     bias_v: f64,
+    pair: (usize, usize),
+) -> Result<Weighed> {
+    let cross = super::front::crossings(mesh, &pot.phi_v, &pot.undepleted, pot.bounds_v);
+    weigh_undepleted(det, settings, mesh, &pot.undepleted, &cross, bias_v, pair)
+}
+
+/// The weighting potentials and C* of the fully depleted detector on `mesh`: no undepleted
+/// node, no front (`field::depleted`).
+pub(crate) fn weigh_depleted(
+    det: &Detector,
+    settings: &FieldSettings,
+    mesh: &Mesh,
+    pair: (usize, usize),
+) -> Result<Weighed> {
+    let none = vec![false; mesh.kind.len()];
+    weigh_undepleted(det, settings, mesh, &none, &[], 0.0, pair)
+}
+
+/// [`weigh`] given the undepleted nodes and the front's crossings (`bias_v` names the point
+/// in the message of a short).
+fn weigh_undepleted(
+    det: &Detector,
+    settings: &FieldSettings,
+    mesh: &Mesh,
+    undepleted: &[bool],
+    cross: &[super::front::Crossing],
+    bias_v: f64,
     (a, b): (usize, usize),
 ) -> Result<Weighed> {
     let solve = |mesh: &Mesh, undepleted: &[bool]| match settings.backend {
@@ -81,20 +110,19 @@ pub(crate) fn weigh(
             settings.gpu_precision,
         ),
     };
-    let cross = super::front::crossings(mesh, &pot.phi_v, &pot.undepleted, pot.bounds_v);
     let (wmesh, weighting) = match settings.weighting {
         WeightingMode::Conductor => {
             // The weighting problem sees the conductors end at the sub-cell front.
             let wmesh = if settings.subcell_front {
-                super::front::front_corrected(mesh, &cross)
+                super::front::front_corrected(mesh, cross)
             } else {
                 mesh.clone()
             };
-            let w = solve(&wmesh, &pot.undepleted)?;
+            let w = solve(&wmesh, undepleted)?;
             (wmesh, w)
         }
         WeightingMode::PaperEpsilon => {
-            let wmesh = paper_epsilon_mesh(mesh, &pot.undepleted, PAPER_EPSILON_FACTOR);
+            let wmesh = paper_epsilon_mesh(mesh, undepleted, PAPER_EPSILON_FACTOR);
             let none = vec![false; mesh.kind.len()];
             let w = solve(&wmesh, &none)?;
             (wmesh, w)
@@ -161,7 +189,7 @@ pub(crate) fn refinement_marks(
 
 /// The intervals across which W_a or W_b changes by more than `MARK_FRACTION` of the largest
 /// change across any interval of either axis.
-fn weighting_marks(grid: &Grid, fields: &[&[f64]]) -> (Vec<bool>, Vec<bool>) {
+pub(crate) fn weighting_marks(grid: &Grid, fields: &[&[f64]]) -> (Vec<bool>, Vec<bool>) {
     let (nr, nz) = (grid.nr(), grid.nz());
     let mut dr = vec![0.0f64; nr - 1];
     let mut dz = vec![0.0f64; nz - 1];

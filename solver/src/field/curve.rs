@@ -111,8 +111,10 @@ pub fn cv_curve_with(
     Ok(curve_keeping(det, volts, settings, continuation, false, progress)?.0)
 }
 
-/// The final grid and potential (V, one value per node) of one point of a curve.
-pub(crate) type KeptPoint = (Grid, Vec<f64>);
+/// The final grid, potential (V, one value per node) and the shift of c12 by the depleted
+/// reference carried over (pF, `field::depleted`; 0 where fully depleted) of one point of a
+/// curve.
+pub(crate) type KeptPoint = (Grid, Vec<f64>, f64);
 
 /// [`cv_curve_with`], also returning every point's final grid and potential where `keep` is
 /// set (empty otherwise): what [`super::near`] solves nearby parameter points on.
@@ -141,11 +143,10 @@ pub(crate) fn curve_keeping(
             let mut points = Vec::with_capacity(chunk.len());
             let mut prev: Option<Seed> = None;
             let mut depleted_mesh: Option<Mesh> = None;
-            let mut depleted_stage = None;
             let mut kept = Vec::new();
             for (k, &v) in chunk.iter().enumerate() {
                 let start = std::time::Instant::now();
-                let p = solve_point_with(det, v, settings, prev.as_ref(), &mut depleted_stage)?;
+                let p = solve_point_with(det, v, settings, prev.as_ref())?;
                 // Scale the potential to the next bias for a better seed.
                 let scale = chunk.get(k + 1).map_or(1.0, |next| next / v);
                 points.push(CvPoint {
@@ -166,7 +167,8 @@ pub(crate) fn curve_keeping(
                     depleted_mesh = Some(p.mesh.clone());
                 }
                 if keep {
-                    kept.push((p.mesh.grid.clone(), p.potential.phi_v.clone()));
+                    let shift = p.carried.map_or(0.0, |c| c.shift_pf);
+                    kept.push((p.mesh.grid.clone(), p.potential.phi_v.clone(), shift));
                 }
                 if continuation == Continuation::Seeded {
                     prev = Some(p.seed(scale));

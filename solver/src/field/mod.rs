@@ -9,6 +9,7 @@ mod charge;
 mod cholesky;
 mod convergence;
 mod curve;
+mod depleted;
 mod depletion;
 mod front;
 mod full_depletion;
@@ -30,14 +31,17 @@ mod weighting;
 /// (potentials, c12) beyond round-off, so that resumable runs built on exact solves (a fit's
 /// refinement rounds, the exact-data coverage study) never mix answers of two solvers. History:
 /// 2026-11-29, the space charge integrated over each control volume (`field::space_charge`;
-/// before it, zeta at the node times the node's volume: files of that solver carry no name).
-pub const PHYSICS_REVISION: &str = "2026-11-29 integrated space charge";
+/// before it, zeta at the node times the node's volume: files of that solver carry no name);
+/// 2026-12-06, the fully depleted reference carried over to every undepleted point's grid
+/// (`field::depleted`: no step in c12 at full depletion).
+pub const PHYSICS_REVISION: &str = "2026-12-06 depleted reference";
 
 pub use adaptive::Accuracy;
 pub use capacitance::CapacitanceMatrix;
 pub use charge::{contact_charge_c, quasi_static_c12_pf};
 pub use convergence::{ConvergenceRow, convergence_study};
 pub use curve::{Continuation, CvCurve, CvPoint, cv_curve, cv_curve_with, normalise_voltages};
+pub use depleted::{CARRY_POWER, Carried, carried_weight};
 pub use depletion::{MAX_POCKET_ROUNDS, PotentialSolution, solve_fast, solve_fast_with};
 pub use full_depletion::full_depletion_voltage;
 pub use mesh::{Mesh, NodeKind};

@@ -12,6 +12,10 @@
 //! one potential solve and one weighting stage instead of the refinement passes and the two
 //! coarsened grids of the error estimate.
 //!
+//! An undepleted base point's c12 carries the fully depleted reference over to its grid
+//! (`field::depleted`); its nearby points take the same shift, part of the base's
+//! discretisation like the grid itself, and cost no extra weighting solve.
+//!
 //! Where the nearby detector's geometry ticks cannot be matched to the base's one for one (two
 //! boundaries merge, a feature appears), that point is solved adaptively on its own and counted
 //! in [`NearCurves::regridded`].
@@ -219,14 +223,16 @@ pub fn cv_curves_near_each(
     let ticks: Vec<_> = near.iter().map(Detector::ticks).collect();
     // One nearby point on the base point's grid deformed to the nearby geometry, seeded node
     // for node by `seed` (a potential on a grid of the base's nodes), or adaptively on its own.
-    let solve = |k: usize, (grid, seed): (&Grid, &[f64]), v: f64| -> Result<Solved> {
+    // The base point's shift by the depleted reference (`field::depleted`) goes with its grid:
+    // a nearby point differs from the base by the difference on one discretisation.
+    let solve = |k: usize, (grid, seed, shift): (&Grid, &[f64], f64), v: f64| -> Result<Solved> {
         let to = &ticks[k];
         match grid.deformed((&from.0, &from.1), (&to.0, &to.1)) {
             Some(g) => {
                 let r = solve_point_on_grid(&near[k], v, settings, g.clone(), Some((&g, seed)))?;
                 let iterations = r.reports.iter().map(|x| x.iterations).sum();
                 Ok(Solved {
-                    c12_pf: r.c12_pf,
+                    c12_pf: r.c12_pf + shift,
                     own: false,
                     iterations,
                     phi_v: Some(r.potential.phi_v),
@@ -254,7 +260,7 @@ pub fn cv_curves_near_each(
                     let points = kept
                         .par_iter()
                         .zip(base.points.par_iter())
-                        .map(|((grid, phi), p)| solve(k, (grid, phi), p.voltage_v))
+                        .map(|((grid, phi, shift), p)| solve(k, (grid, phi, *shift), p.voltage_v))
                         .map(|r| r.map(|s| Solved { phi_v: None, ..s }))
                         .collect();
                     progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);
@@ -268,13 +274,13 @@ pub fn cv_curves_near_each(
             let by_voltage: Vec<Vec<Option<Result<Solved>>>> = kept
                 .par_iter()
                 .zip(base.points.par_iter())
-                .map(|((grid, phi), p)| {
+                .map(|((grid, phi, shift), p)| {
                     let mut out: Vec<Option<Result<Solved>>> =
                         (0..near.len()).map(|_| None).collect();
                     let mut last: Option<Vec<f64>> = None;
                     for &k in order {
                         let seed = last.as_deref().unwrap_or(phi);
-                        let mut r = solve(k, (grid, seed), p.voltage_v);
+                        let mut r = solve(k, (grid, seed, *shift), p.voltage_v);
                         if let Ok(Solved {
                             phi_v: phi_v @ Some(_),
                             ..

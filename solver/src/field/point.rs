@@ -2,6 +2,7 @@
 
 use super::adaptive::{Accuracy, Weighed, refinement_marks, undepleted_nodes, weigh};
 use super::capacitance::CapacitanceMatrix;
+use super::depleted::{self, Carried};
 use super::depletion::{FastSeed, PotentialSolution, solve_fast_seeded};
 use super::mesh::Mesh;
 use super::pockets::pocket_nodes;
@@ -36,6 +37,10 @@ pub struct PointResult {
     pub reports: Vec<SolveReport>,
     /// The estimated error of c12 and the adaptive passes (`field::adaptive`).
     pub accuracy: Accuracy,
+    /// The fully depleted reference carried over to this undepleted point's grid
+    /// (`field::depleted`); None where the point is fully depleted or was solved on a given
+    /// grid alone ([`solve_point_on_grid`]).
+    pub carried: Option<Carried>,
 }
 
 impl PointResult {
@@ -154,26 +159,17 @@ pub fn solve_point(
     settings: &FieldSettings,
     seed: Option<&Seed>,
 ) -> Result<PointResult> {
-    solve_point_with(det, bias_v, settings, seed, &mut None)
+    solve_point_with(det, bias_v, settings, seed)
 }
 
-/// The weighting stage of a fully depleted point on its final grid: the same for every fully
-/// depleted bias of one detector and settings, so a C-V curve computes it once.
-#[derive(Clone)]
-pub(crate) struct DepletedStage {
-    grid: Grid,
-    weighed: Weighed,
-    accuracy: Accuracy,
-}
-
-/// [`solve_point`], reusing (and filling) `depleted`, the weighting stage of a fully depleted
-/// point at another bias.
+/// [`solve_point`]: the potential on its refined grid, then the fully depleted reference's
+/// grid where the point is fully depleted (`field::depleted`), else the adaptive weighting
+/// passes with the reference carried over as a control variate.
 pub(crate) fn solve_point_with(
     det: &Detector,
     bias_v: f64,
     settings: &FieldSettings,
     seed: Option<&Seed>,
-    depleted: &mut Option<DepletedStage>,
 ) -> Result<PointResult> {
     let pair = pair(det)?;
     let gs = &settings.grid;
@@ -194,33 +190,27 @@ pub(crate) fn solve_point_with(
     let finish = |mesh, pot, w, reports, accuracy| {
         PointResult::assemble(bias_v, mesh, pot, w, reports, accuracy)
     };
-    // A fully depleted point restarts from the detector's initial grid (or the grid another
-    // depleted bias ended on): its c12 then does not depend on the bias or on the neighbouring
-    // voltage.
-    let depleted_start = fully_depleted(&mesh, &potential);
-    let start_grid = match (depleted_start, depleted.as_ref()) {
-        (true, Some(stage)) => Some(stage.grid.clone()),
-        (true, None) => Some(Grid::initial(det, gs)),
-        (false, _) => None,
-    };
-    let (mut mesh, mut pot) = match start_grid {
-        Some(grid) if grid != mesh.grid => {
-            let guess = Guess::interpolated(&mesh, &potential, &grid);
-            let m = Mesh::new(det, grid);
+    // A fully depleted point moves to the depleted reference's grid (the same for every bias):
+    // its c12 then does not depend on the bias or on the neighbouring voltage.
+    let (mut mesh, mut pot) = if fully_depleted(&mesh, &potential) {
+        let stage = depleted::reference(det, settings, pair)?;
+        let (mesh, pot) = if stage.grid == mesh.grid {
+            (mesh, potential)
+        } else {
+            let guess = Guess::interpolated(&mesh, &potential, &stage.grid);
+            let m = Mesh::new(det, stage.grid.clone());
             let p = solve(&m, Some(&guess))?;
             reports.push(p.report.clone());
             (m, p)
+        };
+        if fully_depleted(&mesh, &pot) {
+            let (w, acc) = (stage.weighed.clone(), stage.accuracy);
+            return Ok(finish(mesh, pot, w, reports, acc));
         }
-        _ => (mesh, potential),
+        (mesh, pot)
+    } else {
+        (mesh, potential)
     };
-    if let Some(stage) = depleted.as_ref()
-        && depleted_start
-        && stage.grid == mesh.grid
-        && fully_depleted(&mesh, &pot)
-    {
-        let (w, acc) = (stage.weighed.clone(), stage.accuracy);
-        return Ok(finish(mesh, pot, w, reports, acc));
-    }
     let (keep_r, keep_z) = det.ticks();
     let mut passes = 0;
     loop {
@@ -265,14 +255,10 @@ pub(crate) fn solve_point_with(
                 passes,
                 reached,
             };
-            if depleted_start && fully_depleted(&mesh, &pot) {
-                *depleted = Some(DepletedStage {
-                    grid: mesh.grid.clone(),
-                    weighed: w.clone(),
-                    accuracy,
-                });
-            }
-            return Ok(finish(mesh, pot, w, reports, accuracy));
+            let (w, carried) = depleted::corrected(w, det, settings, &mesh, pair)?;
+            let mut p = finish(mesh, pot, w, reports, accuracy);
+            p.carried = Some(carried);
+            return Ok(p);
         };
         let guess = Guess::interpolated(&mesh, &pot, &finer);
         mesh = Mesh::new(det, finer);
@@ -284,7 +270,9 @@ pub(crate) fn solve_point_with(
 /// One point on a given grid, without refinement of any kind (the reference solves of
 /// convergence checks): the potential with depletion on `grid` (seeded by `guess`, a node field
 /// on `guess_grid`, when given), the weighting potentials and C*. `accuracy.c12_err_pf` is NaN
-/// (no estimate).
+/// (no estimate). The c12 of this grid alone: no depleted reference carried over
+/// (`field::depleted`), so that it is an independent answer to compare an adaptive point with;
+/// the nearby solves of `field::near` add their base point's shift.
 pub fn solve_point_on_grid(
     det: &Detector,
     bias_v: f64,
@@ -330,6 +318,7 @@ impl PointResult {
             contact_layers: w.contact_layers,
             reports,
             accuracy,
+            carried: None,
         }
     }
 }
