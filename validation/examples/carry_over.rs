@@ -42,7 +42,7 @@ fn main() -> AnyResult<()> {
         ("detectors/icpc-legend.toml", 2281.1),
         ("detectors/coax-closed-end.toml", 2582.4),
     ] {
-        cases.push((f.to_string(), (0.97 * u as f64).round()));
+        cases.push((f.to_string(), (0.97 * u).round()));
     }
     for (file, bias) in cases {
         let det = Detector::from_file(&repo_path(&file), &Parameters::new())?;
