@@ -36,7 +36,7 @@ fn main() -> AnyResult<()> {
     }
     // 97% of the full-depletion voltages of monotone_sweep (2026-12-06).
     for (f, u) in [
-        ("detectors/super-siegfried-k1.toml", 3775.6),
+        ("detectors/super-siegfried-k1.toml", 3775.6_f64),
         ("detectors/bege.toml", 1262.2),
         ("detectors/ppc.toml", 3126.2),
         ("detectors/icpc-legend.toml", 2281.1),
