@@ -318,16 +318,19 @@ fn coverage_row(
     } else {
         format!("outside: {}", failing.join(", "))
     };
-    if let Some(why) = &stale {
-        detail = format!("{detail}; stale: {why}");
-    }
     detail.push_str(&subsets_note(&s));
-    Ok(StatusRow {
-        what: what.into(),
-        result: format!(
+    // A stale study's own verdict is moot: the cell says why it is stale (its record, linked,
+    // has the rest).
+    let result = match &stale {
+        Some(why) => format!("{n} truths, stale: {why}"),
+        None => format!(
             "{n} truths, {} ({detail})",
             if pass { "passes" } else { "fails" }
         ),
+    };
+    Ok(StatusRow {
+        what: what.into(),
+        result,
         target: format!(
             ">= {needed} truths; each parameter: rank KS p > 0.01, coverage in 99% bands"
         ),
