@@ -17,6 +17,13 @@ use hpge_validation::repo_path;
 use plotters::prelude::*;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
+    // plotters draws text only with a registered font (no system fonts: issue 61).
+    plotters::style::register_font(
+        "sans-serif",
+        plotters::style::FontStyle::Normal,
+        include_bytes!("../../reports/fonts/DejaVuSans.ttf"),
+    )
+    .map_err(|_| "reports/fonts/DejaVuSans.ttf is not a font file")?;
     let args: Vec<String> = std::env::args().skip(1).collect();
     let file = args.first().map_or("detectors/icpc-example.toml", |s| s);
     let num = |k: usize, d: f64| args.get(k).map_or(Ok(d), |a| a.parse::<f64>());
