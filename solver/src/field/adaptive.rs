@@ -140,6 +140,33 @@ fn weigh_undepleted(
     })
 }
 
+/// The estimate |c12_h - c12_H| (pF) of a point with c12 `c12_pf` on `grid`: the larger
+/// difference over the two complementary coarsenings H_0, H_1 (module text), `c12_on(H)` the
+/// same point solved on H (an error there counts as an infinite difference: refine). With
+/// `stop_above` (the tolerance, when there is a finer grid to go to), the second coarsening is
+/// not solved once the first is above it: it cannot change the outcome.
+pub(crate) fn coarsened_estimate(
+    grid: &Grid,
+    (keep_r, keep_z): (&[f64], &[f64]),
+    c12_pf: f64,
+    stop_above: Option<f64>,
+    mut c12_on: impl FnMut(Grid) -> Result<f64>,
+) -> f64 {
+    let relative = |err: f64| err / c12_pf.abs().max(f64::MIN_POSITIVE);
+    let mut c12_err_pf = 0.0f64;
+    for phase in 0..2 {
+        if stop_above.is_some_and(|tol| relative(c12_err_pf) > tol) {
+            break;
+        }
+        let Some(h) = grid.coarsened_phase(keep_r, keep_z, phase) else {
+            continue;
+        };
+        let err = c12_on(h).map_or(f64::INFINITY, |c| (c12_pf - c).abs());
+        c12_err_pf = c12_err_pf.max(err);
+    }
+    c12_err_pf
+}
+
 /// Number of undepleted semiconductor nodes of a potential.
 pub(crate) fn undepleted_nodes(mesh: &Mesh, pot: &PotentialSolution) -> usize {
     pot.undepleted

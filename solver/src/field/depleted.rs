@@ -46,7 +46,7 @@ use std::collections::HashMap;
 use std::hash::{Hash, Hasher};
 use std::sync::{Arc, Mutex, OnceLock};
 
-use super::adaptive::{Accuracy, Weighed, weigh_depleted, weighting_marks};
+use super::adaptive::{Accuracy, Weighed, coarsened_estimate, weigh_depleted, weighting_marks};
 use super::capacitance::CapacitanceMatrix;
 use super::mesh::Mesh;
 use super::settings::FieldSettings;
@@ -145,20 +145,11 @@ fn solve_reference(
             })
             .flatten()
             .filter(|g| g.nr() * g.nz() <= gs.max_nodes);
-        let relative = |err: f64| err / w.c12_pf.abs().max(f64::MIN_POSITIVE);
-        let mut c12_err_pf = 0.0f64;
-        for phase in 0..2 {
-            if finer.is_some() && relative(c12_err_pf) > gs.tolerance {
-                break;
-            }
-            let Some(h) = mesh.grid.coarsened_phase(&keep_r, &keep_z, phase) else {
-                continue;
-            };
-            let err = weigh_depleted(det, settings, &Mesh::new(det, h), pair)
-                .map_or(f64::INFINITY, |hw| (w.c12_pf - hw.c12_pf).abs());
-            c12_err_pf = c12_err_pf.max(err);
-        }
-        let reached = relative(c12_err_pf) <= gs.tolerance;
+        let stop = finer.is_some().then_some(gs.tolerance);
+        let c12_err_pf = coarsened_estimate(&mesh.grid, (&keep_r, &keep_z), w.c12_pf, stop, |h| {
+            Ok(weigh_depleted(det, settings, &Mesh::new(det, h), pair)?.c12_pf)
+        });
+        let reached = c12_err_pf / w.c12_pf.abs().max(f64::MIN_POSITIVE) <= gs.tolerance;
         match finer.filter(|_| !reached) {
             Some(g) => mesh = Mesh::new(det, g),
             None => {

@@ -1,6 +1,8 @@
 //! One bias point: grid refinement, potential with depletion, weighting potentials, C*.
 
-use super::adaptive::{Accuracy, Weighed, refinement_marks, undepleted_nodes, weigh};
+use super::adaptive::{
+    Accuracy, Weighed, coarsened_estimate, refinement_marks, undepleted_nodes, weigh,
+};
 use super::capacitance::CapacitanceMatrix;
 use super::depleted::{self, Carried};
 use super::depletion::{FastSeed, PotentialSolution, solve_fast_seeded};
@@ -231,23 +233,14 @@ pub(crate) fn solve_point_with(
         // leaves the estimate unknown, i.e. refine. The estimate is their maximum, so once one
         // coarsening is above the tolerance and there is a finer grid to go to, the other
         // cannot change the outcome and is not solved (the final pass always solves both).
-        let relative = |err: f64| err / w.c12_pf.abs().max(f64::MIN_POSITIVE);
-        let mut c12_err_pf = 0.0f64;
-        for phase in 0..2 {
-            if finer.is_some() && relative(c12_err_pf) > gs.tolerance {
-                break;
-            }
-            let Some(h) = mesh.grid.coarsened_phase(&keep_r, &keep_z, phase) else {
-                continue;
-            };
+        let stop = finer.is_some().then_some(gs.tolerance);
+        let c12_err_pf = coarsened_estimate(&mesh.grid, (&keep_r, &keep_z), w.c12_pf, stop, |h| {
             let guess = Guess::interpolated(&mesh, &pot, &h);
             let hm = Mesh::new(det, h);
-            let err = solve(&hm, Some(&guess))
-                .and_then(|hp| weigh(det, settings, &hm, &hp, bias_v, pair))
-                .map_or(f64::INFINITY, |hw| (w.c12_pf - hw.c12_pf).abs());
-            c12_err_pf = c12_err_pf.max(err);
-        }
-        let reached = relative(c12_err_pf) <= gs.tolerance;
+            let hp = solve(&hm, Some(&guess))?;
+            Ok(weigh(det, settings, &hm, &hp, bias_v, pair)?.c12_pf)
+        });
+        let reached = c12_err_pf / w.c12_pf.abs().max(f64::MIN_POSITIVE) <= gs.tolerance;
         let finer = finer.filter(|_| !reached);
         let Some(finer) = finer else {
             let accuracy = Accuracy {
