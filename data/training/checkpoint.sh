@@ -4,7 +4,8 @@
 #   bash data/training/checkpoint.sh save DIR NAME
 #       stores the `ok` rows of the generation folder DIR that data/training/parts/NAME/ does not
 #       hold yet as a new part (part-NNN.csv.xz, rows in index order, no header) and copies
-#       DIR/generate.json beside the parts (the run's fingerprint and header). Failed rows are
+#       DIR/generate.json beside the parts (the run's fingerprint and header; and DIR/cpu.json,
+#       the run's CPU record, where there is one). Failed rows are
 #       left out: `generate --retry-failed` solves them again after a restore.
 #   bash data/training/checkpoint.sh restore NAME DIR
 #       rebuilds DIR (generate.json and rows.csv from every part) so that the same `generate`
@@ -33,6 +34,8 @@ case "${1:-}" in
       die "$dir/generate.json differs from $PARTS/$name/generate.json: rows of another run"
     fi
     cp "$dir/generate.json" "$PARTS/$name/generate.json"
+    # The run's CPU record (data/training/cpu.py), where it keeps one.
+    if [ -f "$dir/cpu.json" ]; then cp "$dir/cpu.json" "$PARTS/$name/cpu.json"; fi
     names=$(head -n 1 "$dir/rows.csv" | tr ',' '\n')
     status_col=$(grep -nx status <<< "$names" | cut -d: -f1)
     [ -n "$status_col" ] || die "$dir/rows.csv: no status column"
@@ -58,6 +61,7 @@ case "${1:-}" in
     [ ! -e "$dir" ] || die "$dir exists: refusing to overwrite a generation folder"
     mkdir -p "$dir"
     cp "$PARTS/$name/generate.json" "$dir/generate.json"
+    if [ -f "$PARTS/$name/cpu.json" ]; then cp "$PARTS/$name/cpu.json" "$dir/cpu.json"; fi
     # generate.json is pretty-printed JSON; its header is a string of names without quotes.
     header=$(sed -n 's/^ *"header": "\([^"]*\)",\{0,1\}$/\1/p' "$dir/generate.json")
     [ -n "$header" ] || die "$dir/generate.json: no \"header\" line"

@@ -174,9 +174,10 @@ pub fn train(job: &TrainJob, plot: Option<&Path>, quiet: bool) -> Result<()> {
 pub fn calibrate(o: &CalibrateOptions) -> Result<()> {
     let m = o.run()?;
     eprintln!(
-        "error model: ln sigma_s^2 quadratic in the {} inputs' z, fitted on {} rows of {} in {} \
+        "error model: ln sigma_s^2 quadratic in the {} inputs ({}), fitted on {} rows of {} in {} \
          Newton steps; kappa {:.3}; on those rows {:.1}% within 1 sigma_s, {:.1}% within 2",
         m.inputs.len(),
+        m.inputs.join(", "),
         m.calibration.n,
         o.data.display(),
         m.iterations,

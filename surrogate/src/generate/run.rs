@@ -40,6 +40,11 @@ pub struct RunInfo {
     pub settings: Option<hpge_solver::FieldSettings>,
     /// Program version that started the run.
     pub version: String,
+    /// The solver's physics revision that made the rows (`hpge_solver::field::PHYSICS_REVISION`;
+    /// `None` in runs started before 2026-12-06, which resume as they are). A run is never
+    /// resumed by a solver of another revision: its rows would mix two physics.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub solver_revision: Option<String>,
 }
 
 /// What a run did.
@@ -177,6 +182,7 @@ pub fn run(
         detector_file: g.detector_file.display().to_string(),
         settings: Some(g.settings.clone()),
         version: env!("CARGO_PKG_VERSION").to_string(),
+        solver_revision: Some(hpge_solver::field::PHYSICS_REVISION.to_string()),
     };
     // The regime columns (`pockets`, ...): in every new run; a run started before they existed
     // is resumed in its own format, so its rows stay one file of one header.
@@ -192,6 +198,20 @@ pub fn run(
         if old.header == g.header_with(false) {
             regime_columns = false;
             info.header = old.header.clone();
+        }
+        match &old.solver_revision {
+            Some(there) if Some(there) != info.solver_revision.as_ref() => {
+                return Err(Error::Argument {
+                    name: "--out".into(),
+                    message: format!(
+                        "{} holds rows of the solver revision \"{there}\", this program's is \"{}\"; refusing to mix two physics in one run, use another folder",
+                        out.display(),
+                        hpge_solver::field::PHYSICS_REVISION
+                    ),
+                });
+            }
+            Some(_) => {}
+            None => info.solver_revision = None,
         }
         if old.fingerprint != info.fingerprint
             || old.shard != info.shard

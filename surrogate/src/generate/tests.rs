@@ -259,3 +259,39 @@ fn rows_carry_the_regime_columns_and_a_run_from_before_them_resumes_in_its_own_f
     let _ = std::fs::remove_dir_all(&dir);
     let _ = std::fs::remove_dir_all(&old_dir);
 }
+
+#[test]
+fn a_run_of_another_solver_revision_is_never_resumed() {
+    let g = generator(2, 1);
+    let dir = std::env::temp_dir().join(format!("hpge-revision-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    // One row of the run, as a run cut off after it would leave.
+    let one = generator(1, 1);
+    run(&one, &dir, Some(1), |_, _| {}).unwrap();
+    let info_path = dir.join("generate.json");
+    let mut info: super::RunInfo =
+        serde_json::from_str(&std::fs::read_to_string(&info_path).unwrap()).unwrap();
+    assert_eq!(
+        info.solver_revision.as_deref(),
+        Some(hpge_solver::field::PHYSICS_REVISION)
+    );
+    info.fingerprint = g.fingerprint.clone();
+    let write = |info: &super::RunInfo| {
+        std::fs::write(&info_path, serde_json::to_string_pretty(info).unwrap()).unwrap()
+    };
+    info.solver_revision = Some("1999-01-01 another physics".into());
+    write(&info);
+    let e = run(&g, &dir, Some(1), |_, _| {}).unwrap_err().to_string();
+    assert!(
+        e.contains("1999-01-01 another physics")
+            && e.contains(hpge_solver::field::PHYSICS_REVISION)
+            && e.contains("another folder"),
+        "{e}"
+    );
+    // A run from before the revision was recorded resumes as it did.
+    info.solver_revision = None;
+    write(&info);
+    let resumed = run(&g, &dir, Some(1), |_, _| {}).unwrap();
+    assert_eq!((resumed.resumed, resumed.written), (1, 1));
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -50,7 +50,7 @@ pub struct TrainJob {
     #[cfg_attr(feature = "clap", arg(long, value_name = "FILE", default_value = DEFAULT_SPACE))]
     pub space: PathBuf,
     /// Recipe: paper, paper-log, paper-log-ensemble, split, split-wide, split-ensemble,
-    /// split-steps, split-steps-ensemble, tiny, tiny-steps (networks) or poly3 (the polynomial
+    /// split-steps, split-steps-ensemble, split-gate, tiny, tiny-steps (networks) or poly3 (the polynomial
     /// baseline).
     #[cfg_attr(feature = "clap", arg(long, default_value = DEFAULT_RECIPE))]
     pub recipe: String,

@@ -217,3 +217,82 @@ fn a_calibrated_model_file_reloads_with_its_error_model_and_unchanged_prediction
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A gated surrogate's error model takes the gate's proximity as a fifth input; its variance's
+/// Jacobian (through z_p and through e(z_p)) matches central differences, and the same error
+/// model on a network without the gate is not used.
+#[test]
+fn a_gated_surrogate_feeds_the_gate_proximity_to_sigma_s() {
+    let mut recipe = Recipe::named("tiny-steps").unwrap();
+    recipe.architecture.gate = true;
+    let arch = recipe.architecture.clone();
+    let mut info = unit_info();
+    info.recipe = Some(recipe);
+    info.error_model = Some(ErrorModel {
+        inputs: vec![
+            "p0".into(),
+            "p1".into(),
+            "p2".into(),
+            "U_B".into(),
+            super::uncertainty::GATE_INPUT.into(),
+        ],
+        weights: vec![-8.0, 0.1, 0.05, -0.2, 0.02, 0.3, 0.1, -0.4, 0.15, 3.0, 1.0],
+        kappa: 1.1,
+        calibration: info.test.clone(),
+        coverage_1sigma: 0.7,
+        coverage_2sigma: 0.9545,
+        iterations: 1,
+    });
+    let mut net = random_network(&arch, 7);
+    // Place the gate inside the bias range (its place output's bias: v_g = 1.25 + 0.5 b).
+    let gate_place = net.out.b.len() - 3;
+    net.out.b[gate_place] = -1.0;
+    let m = Surrogate::new(info.clone(), Predictor::Networks(vec![net])).unwrap();
+    assert!(m.has_gate() && m.error_model().is_some());
+    let u = m.voltages(&[25.0, 300.0, 800.0, 2500.0]).unwrap();
+    let p = [1.7, 0.4, -0.3];
+    let (mut v, mut j) = ([0.0; 4], [0.0; 12]);
+    m.curve_variance_into(&p, &u, &mut v, Some(&mut j)).unwrap();
+    let mut v0 = [0.0; 4];
+    m.curve_variance_into(&p, &u, &mut v0, None).unwrap();
+    assert_eq!(v, v0);
+    // The gate's input matters here: without its weights sigma_s^2 is smaller near the gate.
+    let mut blind = m.clone();
+    let w = &mut blind.info.error_model.as_mut().unwrap().weights;
+    w[9] = 0.0;
+    w[10] = 0.0;
+    let mut vb0 = [0.0; 4];
+    blind.curve_variance_into(&p, &u, &mut vb0, None).unwrap();
+    assert!(
+        v.iter().zip(&vb0).any(|(a, b)| a > &(1.5 * b)),
+        "{v:?} vs {vb0:?}"
+    );
+    for k in 0..3 {
+        let h = 1e-6 * (1.0 + p[k].abs());
+        let (mut a, mut b) = (p, p);
+        a[k] += h;
+        b[k] -= h;
+        let (mut va, mut vb) = ([0.0; 4], [0.0; 4]);
+        m.curve_variance_into(&a, &u, &mut va, None).unwrap();
+        m.curve_variance_into(&b, &u, &mut vb, None).unwrap();
+        for q in 0..4 {
+            let fd = (va[q] - vb[q]) / (2.0 * h);
+            assert!(
+                (fd - j[q * 3 + k]).abs() < 1e-5 * fd.abs().max(1e-12),
+                "{q} {k}: {fd} vs {}",
+                j[q * 3 + k]
+            );
+        }
+    }
+    // The same error model on a steps network without the gate: not used (sigma_p instead).
+    let mut plain_recipe = Recipe::named("tiny-steps").unwrap();
+    plain_recipe.architecture.gate = false;
+    let plain_arch = plain_recipe.architecture.clone();
+    info.recipe = Some(plain_recipe);
+    let plain = Surrogate::new(
+        info,
+        Predictor::Networks(vec![random_network(&plain_arch, 7)]),
+    )
+    .unwrap();
+    assert!(!plain.has_gate() && plain.error_model().is_none());
+}

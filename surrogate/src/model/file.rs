@@ -188,7 +188,11 @@ impl Surrogate {
                         let bias = &info.space.dimensions[order[n_params]];
                         let bias =
                             BiasMap::of(bias).map_err(|e| bad("metadata.space", e.to_string()))?;
-                        Some(StepsHead { count, bias })
+                        Some(StepsHead {
+                            count,
+                            bias,
+                            gate: recipe.architecture.gate,
+                        })
                     }
                     None => None,
                 };

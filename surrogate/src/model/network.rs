@@ -324,25 +324,11 @@ impl Network {
         jac: Option<&mut [f64]>,
     ) {
         let np = self.n_params;
-        let mut buf = Buffers::default();
-        let mut jh = Vec::new();
-        self.trunk_pass(zp, &mut buf, jac.is_some().then_some(&mut jh));
-        let n_out = self.out.n_out;
-        let mut o = vec![0.0; n_out];
-        self.out.apply(&buf.h, &mut o);
+        let (o, jo) = self.steps_outputs(zp, jac.is_some());
         let Some(jac) = jac else {
             s.curve(&o, zu, y);
             return;
         };
-        let mut jo = vec![0.0; n_out * np];
-        for (a, row) in jh.chunks_exact(np).enumerate() {
-            let col = &self.out.wt[a * n_out..(a + 1) * n_out];
-            for (i, &w) in col.iter().enumerate() {
-                for (x, &r) in jo[i * np..(i + 1) * np].iter_mut().zip(row) {
-                    *x += w * r;
-                }
-            }
-        }
         s.curve_gradient(&o, zu, &mut |k, yk, g| {
             y[k] = yk;
             let row = &mut jac[k * np..(k + 1) * np];
@@ -353,6 +339,69 @@ impl Network {
                 }
             }
         });
+    }
+
+    /// A steps network's outputs o = out(head(trunk(z_p))) and, with `jac`, do/dz_p (n_out x
+    /// n_params, row-major; empty without), by forward mode through the layers.
+    fn steps_outputs(&self, zp: &[f64], jac: bool) -> (Vec<f64>, Vec<f64>) {
+        let np = self.n_params;
+        let mut buf = Buffers::default();
+        let mut jh = Vec::new();
+        self.trunk_pass(zp, &mut buf, jac.then_some(&mut jh));
+        let n_out = self.out.n_out;
+        let mut o = vec![0.0; n_out];
+        self.out.apply(&buf.h, &mut o);
+        if !jac {
+            return (o, Vec::new());
+        }
+        let mut jo = vec![0.0; n_out * np];
+        for (a, row) in jh.chunks_exact(np).enumerate() {
+            let col = &self.out.wt[a * n_out..(a + 1) * n_out];
+            for (i, &w) in col.iter().enumerate() {
+                for (x, &r) in jo[i * np..(i + 1) * np].iter_mut().zip(row) {
+                    *x += w * r;
+                }
+            }
+        }
+        (o, jo)
+    }
+
+    /// Whether the network has the steps head's pinch-off gate.
+    pub fn has_gate(&self) -> bool {
+        self.steps.is_some_and(|s| s.gate)
+    }
+
+    /// The pinch-off gate's proximity e_k at each z_U,k ([`StepsHead::gate_proximity`]) and,
+    /// with `jac`, de_k/dz_p (voltages x n_params, row-major): de/dz_p = (de/do) (do/dz_p).
+    /// Returns false (and leaves `e` alone) for a network without a gate.
+    pub fn gate_proximity(
+        &self,
+        zp: &[f64],
+        zu: &[f64],
+        e: &mut [f64],
+        jac: Option<&mut [f64]>,
+    ) -> bool {
+        let Some(s) = self.steps.filter(|s| s.gate) else {
+            return false;
+        };
+        let np = self.n_params;
+        let (o, jo) = self.steps_outputs(zp, jac.is_some());
+        let mut g = vec![0.0; s.outputs()];
+        let mut jac = jac;
+        for (k, &z) in zu.iter().enumerate() {
+            e[k] = s.gate_proximity(&o, z, &mut g).unwrap_or(0.0);
+            if let Some(jac) = jac.as_deref_mut() {
+                let row = &mut jac[k * np..(k + 1) * np];
+                row.fill(0.0);
+                // Only the gate's three outputs have a non-zero de/do.
+                for (i, &gi) in g.iter().enumerate().filter(|(_, gi)| **gi != 0.0) {
+                    for (x, &r) in row.iter_mut().zip(&jo[i * np..(i + 1) * np]) {
+                        *x += gi * r;
+                    }
+                }
+            }
+        }
+        true
     }
 
     #[inline(always)]

@@ -19,6 +19,10 @@ pub struct Architecture {
     /// K of the steps head; `None`: the bias enters the head as an input.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub steps: Option<usize>,
+    /// The steps head's pinch-off gate ([`super::StepsHead`], issue 59); files written before
+    /// it have none.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub gate: bool,
 }
 
 /// What the network's single output y means (a closed set).
@@ -114,7 +118,7 @@ fn is_zero(x: &f64) -> bool {
 }
 
 /// The recipe names `train --recipe` accepts.
-pub const RECIPES: [&str; 10] = [
+pub const RECIPES: [&str; 11] = [
     "paper",
     "paper-log",
     "paper-log-ensemble",
@@ -123,6 +127,7 @@ pub const RECIPES: [&str; 10] = [
     "split-ensemble",
     "split-steps",
     "split-steps-ensemble",
+    "split-gate",
     "tiny",
     "tiny-steps",
 ];
@@ -158,11 +163,13 @@ impl Recipe {
             trunk: vec![],
             head: vec![128; 5],
             steps: None,
+            gate: false,
         };
         let split_arch = Architecture {
             trunk: vec![128, 128, 128],
             head: vec![64, 32],
             steps: None,
+            gate: false,
         };
         let split_cycles = vec![
             Cycle {
@@ -183,12 +190,14 @@ impl Recipe {
             trunk: vec![128, 128, 128],
             head: vec![64],
             steps: Some(STEPS),
+            gate: false,
         };
         // Test size: one layer of 16 before and after the bias would join.
         let tiny_arch = |steps| Architecture {
             trunk: vec![16],
             head: vec![16],
             steps,
+            gate: false,
         };
         let tiny_cycles = vec![
             Cycle {
@@ -254,6 +263,7 @@ impl Recipe {
                     trunk: vec![128, 128, 128],
                     head: vec![128, 64],
                     steps: None,
+                    gate: false,
                 },
                 log_output: true,
                 loss: Loss::RelativeRobust { h: 4.0 },
@@ -290,6 +300,20 @@ impl Recipe {
                 loss: Loss::RelativeRobust { h: 4.0 },
                 cycles: split_cycles,
                 members: 4,
+                weight_decay: 0.0,
+            },
+            // `split-steps` with the pinch-off gate (issue 59): one learnt place v_g(p) beyond
+            // which every step still ahead collapses to the depleted plateau.
+            "split-gate" => Recipe {
+                name: name.into(),
+                architecture: Architecture {
+                    gate: true,
+                    ..steps_arch.clone()
+                },
+                log_output: true,
+                loss: Loss::RelativeRobust { h: 4.0 },
+                cycles: split_cycles,
+                members: 1,
                 weight_decay: 0.0,
             },
             // The steps head at test size.
@@ -349,6 +373,11 @@ impl Recipe {
                     "the steps head learns ln c12: it needs a log output".into()
                 ));
             }
+        }
+        if self.architecture.gate && self.architecture.steps.is_none() {
+            return Err(bad(
+                "the pinch-off gate belongs to a steps head (steps = K)".into(),
+            ));
         }
         for c in &self.cycles {
             let lr_ok = c.lr > 0.0 && c.lr.is_finite() && c.lr_end.is_none_or(|l| l > 0.0);

@@ -68,16 +68,25 @@ fn jacobian_matches_central_differences() {
             trunk: vec![],
             head: vec![12, 12],
             steps: None,
+            gate: false,
         },
         Architecture {
             trunk: vec![10, 8],
             head: vec![6, 5],
             steps: None,
+            gate: false,
         },
         Architecture {
             trunk: vec![10, 8],
             head: vec![6],
             steps: Some(5),
+            gate: false,
+        },
+        Architecture {
+            trunk: vec![10, 8],
+            head: vec![6],
+            steps: Some(5),
+            gate: true,
         },
     ] {
         let net = random_network(&arch, 3);
@@ -111,11 +120,12 @@ fn jacobian_matches_central_differences() {
 
 #[test]
 fn plain_path_matches_candle() {
-    for steps in [None, Some(6)] {
+    for (steps, gate) in [(None, false), (Some(6), false), (Some(6), true)] {
         let arch = Architecture {
             trunk: vec![16, 16],
             head: vec![16, 8],
             steps,
+            gate,
         };
         let net = random_network(&arch, 5);
         let units: Vec<f64> = (0..40)
@@ -160,14 +170,15 @@ fn the_steps_bias_map_is_the_log_bias_range() {
 
 #[test]
 fn a_steps_network_falls_with_the_bias_everywhere() {
-    let arch = Architecture {
-        trunk: vec![12],
-        head: vec![12],
-        steps: Some(8),
-    };
     let zu: Vec<f64> = (1..400).map(|k| unit_to_z(k as f64 / 400.0)).collect();
     let mut y = vec![0.0; zu.len()];
-    for seed in 0..20 {
+    for (seed, gate) in (0..20).flat_map(|s| [(s, false), (s, true)]) {
+        let arch = Architecture {
+            trunk: vec![12],
+            head: vec![12],
+            steps: Some(8),
+            gate,
+        };
         let mut net = random_network(&arch, seed);
         // Large outputs too: narrow, far-moved, tall steps.
         for (i, b) in net.out.b.iter_mut().enumerate() {
@@ -178,7 +189,7 @@ fn a_steps_network_falls_with_the_bias_everywhere() {
             for k in 1..y.len() {
                 assert!(
                     y[k] <= y[k - 1],
-                    "seed {seed} {zp:?} k {k}: {} > {}",
+                    "seed {seed} gate {gate} {zp:?} k {k}: {} > {}",
                     y[k],
                     y[k - 1]
                 );
@@ -373,6 +384,7 @@ fn physical_jacobian_matches_finite_differences() {
         trunk: vec![8],
         head: vec![8],
         steps: None,
+        gate: false,
     };
     let net = random_network(&arch, 9);
     let info = unit_info();
@@ -497,8 +509,15 @@ fn a_recipe_adjusted_trains_longer_or_with_another_loss_scale() {
 
 #[test]
 fn a_tiny_steps_network_trains_reloads_and_falls_with_the_bias() {
-    let (dir, _, _, _, train_set, test_set) = synthetic_sets("steps");
-    let recipe = Recipe::named("tiny-steps").unwrap();
+    for gate in [false, true] {
+        tiny_steps_network_trains_reloads_and_falls(gate);
+    }
+}
+
+fn tiny_steps_network_trains_reloads_and_falls(gate: bool) {
+    let (dir, _, _, _, train_set, test_set) = synthetic_sets(if gate { "gate" } else { "steps" });
+    let mut recipe = Recipe::named("tiny-steps").unwrap();
+    recipe.architecture.gate = gate;
     let t = train(&recipe, &train_set, &test_set, 2, &mut |_| {}).unwrap();
     let (first, last) = (t.curves.first().unwrap(), t.curves.last().unwrap());
     assert!(

@@ -88,7 +88,11 @@ pub fn initial_network(
 ) -> Result<Network> {
     let steps = match (arch.steps, bias) {
         (None, _) => None,
-        (Some(count), Some(bias)) => Some(StepsHead { count, bias }),
+        (Some(count), Some(bias)) => Some(StepsHead {
+            count,
+            bias,
+            gate: arch.gate,
+        }),
         (Some(_), None) => {
             return Err(Error::Argument {
                 name: "architecture.steps".into(),

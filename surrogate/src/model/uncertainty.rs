@@ -4,17 +4,78 @@
 
 use super::dataset::{DataInfo, DataSet};
 use super::error_model::ErrorModel;
-use super::surrogate::{Surrogate, Voltages};
+use super::surrogate::{Predictor, Surrogate, Voltages};
 use super::transform::physical_to_z;
 use crate::error::Result;
 
+/// The name of the error model's extra input on a surrogate with the pinch-off gate: the gate's
+/// proximity e(p, U_B) in [0, 1] ([`super::StepsHead::gate_proximity`]), so that sigma_s can grow
+/// where the network switches regime (issue 59).
+pub const GATE_INPUT: &str = "gate_proximity";
+
 impl Surrogate {
-    /// The calibrated per-point uncertainty, when the model file has one.
+    /// The calibrated per-point uncertainty, when the model file has one: inputs the space's
+    /// dimensions (network order), and on a gated surrogate also [`GATE_INPUT`].
     pub fn error_model(&self) -> Option<&ErrorModel> {
-        self.info
-            .error_model
-            .as_ref()
-            .filter(|m| m.inputs.len() == self.dims.len())
+        let d = self.dims.len();
+        self.info.error_model.as_ref().filter(|m| {
+            m.inputs.len() == d
+                || (m.inputs.len() == d + 1 && m.inputs[d] == GATE_INPUT && self.has_gate())
+        })
+    }
+
+    /// Whether every network of the surrogate has the pinch-off gate.
+    pub fn has_gate(&self) -> bool {
+        match &self.predictor {
+            Predictor::Networks(nets) => !nets.is_empty() && nets.iter().all(|n| n.has_gate()),
+            Predictor::Polynomial(_) => false,
+        }
+    }
+
+    /// The members' mean gate proximity at z_p along z_U (and its de/dz_p, voltages x
+    /// n_params); false without a gate.
+    fn gate_feature(&self, zp: &[f64], zu: &[f64], e: &mut [f64], jac: Option<&mut [f64]>) -> bool {
+        let Predictor::Networks(nets) = &self.predictor else {
+            return false;
+        };
+        if !self.has_gate() {
+            return false;
+        }
+        let m = nets.len() as f64;
+        let np = self.n_params();
+        let mut ek = vec![0.0; zu.len()];
+        let mut jk = vec![0.0; if jac.is_some() { zu.len() * np } else { 0 }];
+        e.fill(0.0);
+        let mut jac = jac;
+        if let Some(j) = jac.as_deref_mut() {
+            j.fill(0.0);
+        }
+        for net in nets {
+            let with_jac = jac.is_some().then_some(&mut jk[..]);
+            net.gate_proximity(zp, zu, &mut ek, with_jac);
+            for (a, b) in e.iter_mut().zip(&ek) {
+                *a += b / m;
+            }
+            if let Some(j) = jac.as_deref_mut() {
+                for (a, b) in j.iter_mut().zip(&jk) {
+                    *a += b / m;
+                }
+            }
+        }
+        true
+    }
+
+    /// The error model's input row of data-set row i: its z (network order), and the gate's
+    /// proximity there when the model has [`GATE_INPUT`].
+    fn error_inputs(&self, set: &DataSet, i: usize, gated: bool) -> Vec<f64> {
+        let mut z = set.z_row(i);
+        if gated {
+            let np = self.n_params();
+            let mut e = [0.0];
+            self.gate_feature(&z[..np], &z[np..np + 1], &mut e, None);
+            z.push(e[0]);
+        }
+        z
     }
 
     /// `per-point` (a calibrated error model: sigma_s(p, U_B)) or `constant` (sigma_p), as
@@ -28,12 +89,16 @@ impl Surrogate {
     }
 
     /// The relative uncertainty of every row of a data set (read with this model's space):
-    /// sigma_s(z) of the error model, or the constant sigma_p without one.
+    /// sigma_s(z) of the error model (with the gate's proximity on a gated surrogate), or the
+    /// constant sigma_p without one.
     pub fn sigma_set(&self, set: &DataSet) -> Vec<f64> {
         match self.error_model() {
-            Some(m) => (0..set.len())
-                .map(|i| m.sigma(&set.z_row(i), None))
-                .collect(),
+            Some(m) => {
+                let gated = m.inputs.len() > self.dims.len();
+                (0..set.len())
+                    .map(|i| m.sigma(&self.error_inputs(set, i, gated), None))
+                    .collect()
+            }
             None => vec![self.sigma_p(); set.len()],
         }
     }
@@ -68,21 +133,43 @@ impl Surrogate {
             dz.push(dzj);
         }
         z.push(0.0);
-        let mut g = vec![0.0; np];
+        // On a gated surrogate the gate's proximity e_k is the last input, with de_k/dz_p.
+        let gated = m.inputs.len() > self.dims.len();
+        let nv = u.z.len();
+        let mut e = vec![0.0; if gated { nv } else { 0 }];
+        let mut je = vec![0.0; if gated && jac.is_some() { nv * np } else { 0 }];
+        if gated {
+            let want = jac.is_some().then_some(&mut je[..]);
+            self.gate_feature(&z[..np], &u.z, &mut e, want);
+            z.push(0.0);
+        }
+        let mut g = vec![0.0; z.len()];
         match jac {
             Some(jac) => {
                 for (k, &zu) in u.z.iter().enumerate() {
                     z[np] = zu;
+                    if gated {
+                        z[np + 1] = e[k];
+                    }
                     let s = m.sigma(&z, Some(&mut g));
                     var[k] = s * s;
                     for j in 0..np {
-                        jac[k * np + j] = g[j] * dz[j];
+                        // d sigma^2/dz_j through z_j itself and through e_k(z_p).
+                        let via_gate = if gated {
+                            g[np + 1] * je[k * np + j]
+                        } else {
+                            0.0
+                        };
+                        jac[k * np + j] = (g[j] + via_gate) * dz[j];
                     }
                 }
             }
             None => {
                 for (k, &zu) in u.z.iter().enumerate() {
                     z[np] = zu;
+                    if gated {
+                        z[np + 1] = e[k];
+                    }
                     var[k] = m.sigma(&z, None).powi(2);
                 }
             }
@@ -113,8 +200,14 @@ impl Surrogate {
             .zip(&set.c12_pf)
             .map(|(p, t)| (p - t) / t)
             .collect();
-        let z: Vec<f64> = (0..set.len()).flat_map(|i| set.z_row(i)).collect();
-        let names = self.dims.iter().map(|d| d.name.clone()).collect();
+        let gated = self.has_gate();
+        let z: Vec<f64> = (0..set.len())
+            .flat_map(|i| self.error_inputs(set, i, gated))
+            .collect();
+        let mut names: Vec<String> = self.dims.iter().map(|d| d.name.clone()).collect();
+        if gated {
+            names.push(GATE_INPUT.to_string());
+        }
         ErrorModel::fit(names, &z, &rel, DataInfo::of(set))
     }
 }

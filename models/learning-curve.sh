@@ -1,0 +1,89 @@
+#!/usr/bin/env bash
+# Issue 59, item 3: held-out accuracy against CPU-hours of generation, for rows added uniformly
+# and for rows chosen by `generate --where` (active learning), from the 54 000 training rows up.
+#
+#   bash models/learning-curve.sh ARM K
+#
+# ARM is `uniform` (data/training/uniform-400000: `generate --n 12000 --offset 400000`) or
+# `active` (data/training/active-500000: `generate --where` on 120 000 candidates from offset
+# 500000, the top 10% solved; data/training/README.md has both commands). The arm's first K rows
+# (`ok`, in index order) join data/training/train.csv (only its columns up to `status`: the
+# older rows have no regime columns), the recipe RECIPE (default `split-gate` with the default
+# model's widths and weight decay) is trained on them with the same test set and seed, and one
+# JSON line is appended to models/learning-curves.jsonl:
+#   arm, k, the arm's CPU seconds for those K rows (CPU_PER_ROW_S of the arm, below, times K),
+#   the figures of `evaluate --json` on data/training/heldout-300000.csv and heldout.csv
+#   (sigma, q90, q99, coverage, and the pocket / no-pocket split of the former).
+# K = 0 trains on train.csv alone. A (ARM, K, RECIPE) already in the file is skipped.
+# The models go to models/learning-curve/ (not committed: about 0.7 MB each); about 15 min a
+# point on the 2-core machine.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+ARM=${1:?usage: learning-curve.sh ARM K}
+K=${2:?usage: learning-curve.sh ARM K}
+RECIPE=${RECIPE:-split-gate}
+case "$ARM" in
+  uniform) DIR=data/training/uniform-400000 ;;
+  active) DIR=data/training/active-500000 ;;
+  *) echo "learning-curve.sh: ARM must be uniform or active, not '$ARM'" >&2; exit 2 ;;
+esac
+[[ "$K" =~ ^[0-9]+$ ]] || { echo "learning-curve.sh: K must be a count of rows, not '$K'" >&2; exit 2; }
+OUT=models/learning-curves.jsonl
+if [ -f "$OUT" ] && grep -q "\"arm\": \"$ARM\", \"k\": $K, \"recipe\": \"$RECIPE\"" "$OUT"; then
+  echo "learning-curve.sh: $ARM $K $RECIPE is in $OUT already"; exit 0
+fi
+[ -f data/training/train.csv ] || bash data/training/make.sh
+cargo build --release -q
+B=target/release/hpge-cv
+mkdir -p models/learning-curve
+SET=models/learning-curve/train-$ARM-$K.csv
+python3 - "$DIR/rows.csv" "$K" "$SET" <<'EOF'
+import csv, sys
+rows_file, k, out = sys.argv[1], int(sys.argv[2]), sys.argv[3]
+with open("data/training/train.csv") as f:
+    base = list(csv.reader(f))
+header = base[0]
+added = []
+if k > 0:
+    with open(rows_file) as f:
+        r = csv.DictReader(f)
+        ok = sorted((row for row in r if row["status"] == "ok"), key=lambda row: int(row["index"]))
+    if len(ok) < k:
+        sys.exit(f"learning-curve.sh: {rows_file} has {len(ok)} ok rows, fewer than K = {k}")
+    added = [[row[h] for h in header] for row in ok[:k]]
+with open(out, "w", newline="") as f:
+    w = csv.writer(f, lineterminator="\n")
+    w.writerows(base)
+    w.writerows(added)
+EOF
+MODEL=models/learning-curve/$RECIPE-$ARM-$K.safetensors
+SHIPPED=models/super-siegfried-rz-$RECIPE-t256-256-256-hd128-wd0.01.safetensors
+if [ "$K" -eq 0 ] && [ -f "$SHIPPED" ] && cmp -s "$SET" data/training/train.csv; then
+  # The 54 000 rows alone with the same recipe, seed and test set: the committed model is this
+  # point (models/train.sh trained it with the same arguments).
+  cp "$SHIPPED" "$MODEL"
+else
+  $B train --data "$SET" --test data/training/test.csv --space spaces/super-siegfried-rz.toml \
+    --detector detectors/super-siegfried-k1.toml --recipe "$RECIPE" --seed 0 --out "$MODEL" \
+    --trunk 256,256,256 --head 128 --weight-decay 0.01 --force
+  $B calibrate --model "$MODEL" --data data/training/calibration.csv --out "$MODEL" --force
+fi
+$B evaluate --model "$MODEL" --data data/training/heldout-300000.csv --json > "${MODEL%.safetensors}.h300000.json"
+$B evaluate --model "$MODEL" --data data/training/heldout.csv --json > "${MODEL%.safetensors}.heldout.json"
+CPU=0
+if [ "$K" -gt 0 ]; then CPU=$(python3 -c "import json; print(json.load(open('$DIR/cpu.json'))['cpu_per_row_s'] * $K)"); fi
+python3 - "$ARM" "$K" "$RECIPE" "$CPU" "${MODEL%.safetensors}" >> "$OUT" <<'EOF'
+import json, sys
+arm, k, recipe, cpu, stem = sys.argv[1], int(sys.argv[2]), sys.argv[3], float(sys.argv[4]), sys.argv[5]
+def figs(f):
+    d = json.load(open(f))
+    out = {key: d[key] for key in ("n", "rel_sigma", "abs_rel_q90", "abs_rel_q99", "coverage_2sigma")}
+    for r in d.get("regimes") or []:
+        out[r["group"]] = {key: r[key] for key in ("n", "rel_sigma", "abs_rel_q90", "abs_rel_q99")}
+    return out
+print(json.dumps({"arm": arm, "k": k, "recipe": recipe, "cpu_s": cpu,
+                  "heldout_300000": figs(stem + ".h300000.json"),
+                  "heldout": figs(stem + ".heldout.json"),
+                  "program_version": json.load(open(stem + ".h300000.json")).get("program_version")}))
+EOF
+tail -n 1 "$OUT"
