@@ -22,6 +22,11 @@ pub struct CalibrateOptions {
     /// The calibrated model file (default: --model itself, rewritten in place).
     #[cfg_attr(feature = "clap", arg(long, value_name = "FILE"))]
     pub out: Option<PathBuf>,
+    /// On a surrogate with the pinch-off gate (recipe split-gate), leave the gate's proximity
+    /// out of the error model's inputs: sigma_s then does not grow at the network's switch
+    /// (with it, the main job's sampler mixed too slowly to converge: models/README.md).
+    #[cfg_attr(feature = "clap", arg(long))]
+    pub no_gate_input: bool,
 }
 
 impl CalibrateOptions {
@@ -54,7 +59,7 @@ impl CalibrateOptions {
                 });
             }
         }
-        let em = model.fit_error_model(&data)?;
+        let em = model.fit_error_model_with(&data, !self.no_gate_input)?;
         model.info.error_model = Some(em.clone());
         model.save(self.out_file())?;
         Ok(em)

@@ -456,6 +456,7 @@ fn the_polynomial_writes_no_curves_and_evaluates() {
             model: job.out.clone(),
             data: own.clone(),
             out: Some(cal_out.clone()),
+            no_gate_input: false,
         }
         .run()
         .unwrap_err();
@@ -471,6 +472,7 @@ fn the_polynomial_writes_no_curves_and_evaluates() {
         model: job.out.clone(),
         data: fresh.clone(),
         out: Some(cal_out.clone()),
+        no_gate_input: false,
     };
     let em = cal.run().unwrap();
     assert!(em.calibration.n > 150, "{}", em.calibration.n);

@@ -284,6 +284,13 @@ fn a_gated_surrogate_feeds_the_gate_proximity_to_sigma_s() {
             );
         }
     }
+    // Calibrated on rows: the gate's proximity is an input unless left out.
+    let (dir, _, _, _, _, test_set) = super::tests::synthetic_sets("gate-input");
+    let with = m.fit_error_model(&test_set).unwrap();
+    assert_eq!(with.inputs.last().unwrap(), super::uncertainty::GATE_INPUT);
+    let without = m.fit_error_model_with(&test_set, false).unwrap();
+    assert_eq!(without.inputs.len(), 4);
+    let _ = std::fs::remove_dir_all(&dir);
     // The same error model on a steps network without the gate: not used (sigma_p instead).
     let mut plain_recipe = Recipe::named("tiny-steps").unwrap();
     plain_recipe.architecture.gate = false;

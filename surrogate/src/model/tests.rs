@@ -200,7 +200,9 @@ fn a_steps_network_falls_with_the_bias_everywhere() {
 
 /// A fresh folder with 600 training and 150 test rows of [`synthetic_c12`]: (folder, space,
 /// training file, test file, both sets as read).
-fn synthetic_sets(name: &str) -> (PathBuf, ParameterSpace, PathBuf, PathBuf, DataSet, DataSet) {
+pub(super) fn synthetic_sets(
+    name: &str,
+) -> (PathBuf, ParameterSpace, PathBuf, PathBuf, DataSet, DataSet) {
     let dir = std::env::temp_dir().join(format!("hpge-surrogate-{name}-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let sp = space();

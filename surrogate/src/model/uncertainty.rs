@@ -194,13 +194,22 @@ impl Surrogate {
     /// # Errors
     /// As [`ErrorModel::fit`].
     pub fn fit_error_model(&self, set: &DataSet) -> Result<ErrorModel> {
+        self.fit_error_model_with(set, true)
+    }
+
+    /// [`Surrogate::fit_error_model`], with the gate's proximity among the inputs only when
+    /// `gate_input` (and the surrogate has the gate).
+    ///
+    /// # Errors
+    /// As [`ErrorModel::fit`].
+    pub fn fit_error_model_with(&self, set: &DataSet, gate_input: bool) -> Result<ErrorModel> {
         let pred = self.predict_set(set);
         let rel: Vec<f64> = pred
             .iter()
             .zip(&set.c12_pf)
             .map(|(p, t)| (p - t) / t)
             .collect();
-        let gated = self.has_gate();
+        let gated = gate_input && self.has_gate();
         let z: Vec<f64> = (0..set.len())
             .flat_map(|i| self.error_inputs(set, i, gated))
             .collect();
