@@ -138,6 +138,36 @@ fn bad_calibration_sets_are_errors() {
     assert!(e.to_string().contains("row 1"), "{e}");
 }
 
+/// `jac` (voltages x 3, from `curve_variance_into`) against central differences of sigma_s^2
+/// in each of the 3 parameters: |fd - jac| < rel max(|fd|, floor).
+fn assert_variance_jacobian(
+    m: &Surrogate,
+    p: [f64; 3],
+    u: &crate::model::Voltages,
+    jac: &[f64],
+    rel: f64,
+    floor: f64,
+) {
+    let nv = u.z.len();
+    for k in 0..3 {
+        let h = 1e-6 * (1.0 + p[k].abs());
+        let (mut a, mut b) = (p, p);
+        a[k] += h;
+        b[k] -= h;
+        let (mut va, mut vb) = (vec![0.0; nv], vec![0.0; nv]);
+        m.curve_variance_into(&a, u, &mut va, None).unwrap();
+        m.curve_variance_into(&b, u, &mut vb, None).unwrap();
+        for q in 0..nv {
+            let fd = (va[q] - vb[q]) / (2.0 * h);
+            assert!(
+                (fd - jac[q * 3 + k]).abs() < rel * fd.abs().max(floor),
+                "{q} {k}: {fd} vs {}",
+                jac[q * 3 + k]
+            );
+        }
+    }
+}
+
 fn calibrated() -> Surrogate {
     let recipe = Recipe::named("tiny").unwrap();
     let arch = recipe.architecture.clone();
@@ -166,22 +196,7 @@ fn the_curve_variance_has_the_right_jacobian_and_falls_back_to_sigma_p() {
     m.curve_variance_into(&p, &u, &mut v0, None).unwrap();
     assert_eq!(v, v0);
     assert!(v[0] != v[2], "per point: {v:?}");
-    for k in 0..3 {
-        let h = 1e-6 * (1.0 + p[k].abs());
-        let (mut a, mut b) = (p, p);
-        a[k] += h;
-        b[k] -= h;
-        let (mut va, mut vb) = ([0.0; 3], [0.0; 3]);
-        m.curve_variance_into(&a, &u, &mut va, None).unwrap();
-        m.curve_variance_into(&b, &u, &mut vb, None).unwrap();
-        for q in 0..3 {
-            let fd = (va[q] - vb[q]) / (2.0 * h);
-            assert!(
-                (fd - j[q * 3 + k]).abs() < 1e-6 * fd.abs().max(1e-14),
-                "{q} {k}: {fd}"
-            );
-        }
-    }
+    assert_variance_jacobian(&m, p, &u, &j, 1e-6, 1e-14);
     // Outside the domain: the domain guard's error.
     assert!(
         m.curve_variance_into(&[9.0, 0.4, 0.0], &u, &mut v, None)
@@ -267,23 +282,7 @@ fn a_gated_surrogate_feeds_the_gate_proximity_to_sigma_s() {
         v.iter().zip(&vb0).any(|(a, b)| a > &(1.5 * b)),
         "{v:?} vs {vb0:?}"
     );
-    for k in 0..3 {
-        let h = 1e-6 * (1.0 + p[k].abs());
-        let (mut a, mut b) = (p, p);
-        a[k] += h;
-        b[k] -= h;
-        let (mut va, mut vb) = ([0.0; 4], [0.0; 4]);
-        m.curve_variance_into(&a, &u, &mut va, None).unwrap();
-        m.curve_variance_into(&b, &u, &mut vb, None).unwrap();
-        for q in 0..4 {
-            let fd = (va[q] - vb[q]) / (2.0 * h);
-            assert!(
-                (fd - j[q * 3 + k]).abs() < 1e-5 * fd.abs().max(1e-12),
-                "{q} {k}: {fd} vs {}",
-                j[q * 3 + k]
-            );
-        }
-    }
+    assert_variance_jacobian(&m, p, &u, &j, 1e-5, 1e-12);
     // Calibrated on rows: the gate's proximity is an input unless left out.
     let (dir, _, _, _, _, test_set) = super::tests::synthetic_sets("gate-input");
     let with = m.fit_error_model(&test_set).unwrap();
