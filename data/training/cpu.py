@@ -9,7 +9,8 @@ over the rows they wrote. The `seconds` column of the rows is wall time, which o
 cores inflates; this is the processor time the rows cost. Run it now and then while the run
 goes, and last just before stopping it: the rows a process wrote after the last call are not
 counted. ROWS_AT_START: the rows the folder had when the process started, for a first call
-made after it wrote some (default: the rows now). Prints the record.
+made after it wrote some (default: where the last recorded segment ended, or for a run's first
+process the rows now). Prints the record.
 """
 import json
 import os
@@ -52,7 +53,11 @@ def main():
     if segs and segs[-1]["process"] == key:
         seg = segs[-1]
     else:
-        at_start = int(sys.argv[2]) if len(sys.argv) == 3 else rows
+        # A resumed run: it started where the last recorded segment ended (rows written after
+        # that segment's last call are then counted here, without their CPU time: call this
+        # just before stopping a run).
+        default = segs[-1]["rows"] if segs else rows
+        at_start = int(sys.argv[2]) if len(sys.argv) == 3 else default
         seg = {"process": key, "rows_at_start": at_start}
         segs.append(seg)
     seg["rows"] = rows

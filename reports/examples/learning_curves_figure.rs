@@ -1,6 +1,7 @@
 //! Issue 59's learning curves: held-out accuracy against the CPU-hours of generation spent on
 //! rows beyond the 54 000 training rows, rows added uniformly against rows chosen by
-//! `generate --where` (active learning), from `models/learning-curves.jsonl`
+//! `generate --where` (active learning) and rows at low bias only, from
+//! `models/learning-curves.jsonl`
 //! (`models/learning-curve.sh` appends one line per trained point).
 //!
 //! `cargo run --release -p hpge-reports --example learning_curves_figure -- JSONL OUT_STEM`
@@ -39,6 +40,24 @@ fn read(path: &PathBuf) -> Result<Series, Box<dyn std::error::Error>> {
             field("heldout_300000")?,
             field("heldout")?,
         ));
+    }
+    // An arm without its own point at 0 CPU-hours (e.g. `low-bias`) starts from the same
+    // recipe's 54 000-row model, which every arm shares.
+    let bases: BTreeMap<String, (f64, serde_json::Value, serde_json::Value)> = series
+        .iter()
+        .flat_map(|((_, recipe), points)| {
+            points
+                .iter()
+                .filter(|p| p.0 == 0.0)
+                .map(move |p| (recipe.clone(), p.clone()))
+        })
+        .collect();
+    for ((_, recipe), points) in series.iter_mut() {
+        if !points.iter().any(|p| p.0 == 0.0)
+            && let Some(base) = bases.get(recipe)
+        {
+            points.push(base.clone());
+        }
     }
     for points in series.values_mut() {
         points.sort_by(|a, b| a.0.total_cmp(&b.0));
@@ -87,7 +106,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             y_desc: what.into(),
             curves,
             y_from_zero: true,
-            legend: Corner::UpperLeft,
+            legend: Corner::LowerRight,
             footnotes: vec![format!(
                 "{} {}: {jsonl} (models/learning-curve.sh); issue 59, item 3",
                 hpge_reports::PROGRAM,

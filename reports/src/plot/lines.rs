@@ -184,6 +184,12 @@ fn draw<DB: DrawingBackend>(
         }
         let mut labelled = false;
         for s in segments.into_iter().filter(|s| !s.is_empty()) {
+            // A segment of one point draws no line: a dot shows it.
+            if let [p] = s.as_slice() {
+                chart
+                    .draw_series(std::iter::once(Circle::new(*p, 5, color.filled())))
+                    .map_err(err)?;
+            }
             let series = chart.draw_series(LineSeries::new(s, style)).map_err(err)?;
             if !labelled {
                 series.label(c.label.clone()).legend(move |(x, y)| {
