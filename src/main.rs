@@ -4,6 +4,24 @@
 //! exits with code 2 (bad input); it never panics on user input. A fit that did not converge
 //! exits with code 3, a fit whose exact-solver check fails after refinement with code 4.
 
+/// `println!` for what a command prints on stdout, returning (`?`) a
+/// [`cli::stdout::StdoutError`] instead of panicking when stdout cannot be written.
+macro_rules! outln {
+    () => {
+        $crate::cli::stdout::write_fmt(format_args!("\n"))?
+    };
+    ($($arg:tt)*) => {
+        $crate::cli::stdout::write_fmt(format_args!("{}\n", format_args!($($arg)*)))?
+    };
+}
+
+/// `print!` as [`outln!`] is `println!`.
+macro_rules! out {
+    ($($arg:tt)*) => {
+        $crate::cli::stdout::write_fmt(format_args!($($arg)*))?
+    };
+}
+
 mod cli;
 mod report;
 
@@ -16,6 +34,14 @@ fn main() -> ExitCode {
     let args = cli::Cli::parse();
     match cli::run(args) {
         Ok(()) => ExitCode::SUCCESS,
+        // The reader of stdout has gone (`| head`): nothing more to say, and no one to say it to.
+        Err(err)
+            if err
+                .downcast_ref::<cli::stdout::StdoutError>()
+                .is_some_and(cli::stdout::StdoutError::broken_pipe) =>
+        {
+            ExitCode::SUCCESS
+        }
         Err(err) if err.downcast_ref::<cli::Unconverged>().is_some() => {
             eprintln!("error: {}", message(&err));
             ExitCode::from(3)

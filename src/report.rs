@@ -50,7 +50,7 @@ pub fn run(a: &ReportArgs) -> Result<()> {
         ReportKind::Coverage(c) => {
             let files = hpge_reports::plot::redraw_coverage(&c.dir)?;
             for f in files {
-                println!("{}", f.display());
+                outln!("{}", f.display());
             }
             Ok(())
         }
@@ -71,9 +71,9 @@ fn status(a: &StatusArgs) -> Result<()> {
         }
         None => None,
     };
-    print!("{table}");
+    out!("{table}");
     if let Some((file, new)) = written {
-        std::fs::write(file, new)
+        hpge_files::write(file, new)
             .map_err(|e| anyhow::anyhow!("{}: cannot write: {e}", file.display()))?;
         eprintln!("status table written into {}", file.display());
     }
@@ -119,7 +119,7 @@ pub fn paper(a: &PaperOptions) -> Result<()> {
         r.figures_dir.display(),
         r.readme.display()
     );
-    println!(
+    outln!(
         "report paper: {} figures ({} files) in {:.1} s; see {}",
         r.figures,
         r.files,

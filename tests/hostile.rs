@@ -45,6 +45,16 @@ struct Case {
     once: Vec<String>,
     #[serde(default)]
     absent: Vec<String>,
+    /// Files that must hold the same bytes after the run as before (inputs never overwritten).
+    #[serde(default)]
+    unchanged: Vec<String>,
+    /// Where stdout goes: "full" (`/dev/full`: every write fails with ENOSPC) or "closed" (a
+    /// pipe whose reader has gone: every write fails with EPIPE); captured otherwise.
+    #[serde(default)]
+    stdout: Option<String>,
+    /// Hard links (existing, new) made in the case's folder after `files`.
+    #[serde(default)]
+    link: Vec<[String; 2]>,
     #[serde(default)]
     memory_kib: Option<u64>,
     /// Environment variables removed for the run.
@@ -82,6 +92,12 @@ struct FileSpec {
     /// Raw bytes in hex instead of text (binary garbage).
     #[serde(default)]
     hex: Option<String>,
+}
+
+/// The binary the cases run: this build's, or `HPGE_HOSTILE_BIN` (e.g. a build of the code
+/// before a fix, to check that a new case fails there).
+fn binary() -> String {
+    std::env::var("HPGE_HOSTILE_BIN").unwrap_or_else(|_| env!("CARGO_BIN_EXE_hpge-cv").to_string())
 }
 
 fn root() -> PathBuf {
@@ -150,11 +166,14 @@ fn run_case(c: &Case) -> Vec<String> {
     for d in &c.folders {
         std::fs::create_dir_all(tmp.join(d)).unwrap();
     }
+    for [from, to] in &c.link {
+        std::fs::hard_link(tmp.join(from), tmp.join(to)).unwrap();
+    }
     let args: Vec<String> = c.args.iter().map(|a| sh_quote(&expand(a, &tmp))).collect();
     let script = format!(
         "ulimit -v {}; exec {} {}",
         c.memory_kib.unwrap_or(DEFAULT_MEMORY_KIB),
-        sh_quote(env!("CARGO_BIN_EXE_hpge-cv")),
+        sh_quote(&binary()),
         args.join(" ")
     );
     let start = std::time::Instant::now();
@@ -166,7 +185,31 @@ fn run_case(c: &Case) -> Vec<String> {
     for k in &c.unset {
         cmd.env_remove(k);
     }
-    let out = cmd.output().unwrap();
+    let before: Vec<(PathBuf, Option<Vec<u8>>)> = c
+        .unchanged
+        .iter()
+        .map(|f| {
+            let p = PathBuf::from(expand(f, &tmp));
+            let bytes = std::fs::read(&p).ok();
+            (p, bytes)
+        })
+        .collect();
+    let out = match c.stdout.as_deref() {
+        None => cmd.output().unwrap(),
+        Some("full") => {
+            cmd.stdout(std::fs::File::create("/dev/full").unwrap());
+            cmd.output().unwrap()
+        }
+        Some("closed") => {
+            cmd.stdout(std::process::Stdio::piped())
+                .stderr(std::process::Stdio::piped());
+            let mut child = cmd.spawn().unwrap();
+            // The only reader of the pipe goes away before the command writes anything.
+            drop(child.stdout.take());
+            child.wait_with_output().unwrap()
+        }
+        Some(other) => panic!("{}: stdout = {other:?}: use \"full\" or \"closed\"", c.name),
+    };
     let seconds = start.elapsed().as_secs_f64();
     let err = String::from_utf8_lossy(&out.stderr).into_owned();
     let mut fails = Vec::new();
@@ -210,6 +253,16 @@ fn run_case(c: &Case) -> Vec<String> {
         let k = err.matches(n.as_str()).count();
         if k != 1 {
             fails.push(format!("`{n}` {k} times in stderr, expected once"));
+        }
+    }
+    for (p, bytes) in &before {
+        if bytes.is_none() {
+            fails.push(format!("{}: no such file before the run", p.display()));
+        } else if std::fs::read(p).ok() != *bytes {
+            fails.push(format!(
+                "{} was changed (an input overwritten)",
+                p.display()
+            ));
         }
     }
     for a in &c.absent {
@@ -324,8 +377,17 @@ fn every_group_case_has_its_own_test() {
 /// Every case without a test of its own, two at a time (CI has 2 cores).
 #[test]
 fn the_rest_of_the_table() {
-    let cases: Vec<Case> = table().into_iter().filter(|c| c.group == 0).collect();
-    assert!(cases.len() >= 30, "the broad set has {} cases", cases.len());
+    // `HPGE_HOSTILE_ONLY=PREFIX`: only the cases whose name starts with it.
+    let only = std::env::var("HPGE_HOSTILE_ONLY").unwrap_or_default();
+    let cases: Vec<Case> = table()
+        .into_iter()
+        .filter(|c| c.group == 0 && c.name.starts_with(&only))
+        .collect();
+    assert!(
+        !only.is_empty() || cases.len() >= 30,
+        "the broad set has {} cases",
+        cases.len()
+    );
     let next = Mutex::new(cases.iter());
     let failures = Mutex::new(Vec::new());
     std::thread::scope(|s| {

@@ -111,7 +111,51 @@ fn merge_refuses_an_out_inside_a_shard_folder() {
     let merged = d.join("merged.csv");
     ok(&run(&["merge", "--out", s(&merged), s(&s0), s(&s1)]));
     assert_eq!(std::fs::read_to_string(&merged).unwrap().lines().count(), 3);
-    assert!(!d.join("merged.csv.tmp").exists());
+    assert_no_temporaries(&d);
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// No temporary file (`.NAME.PID-N.tmp`, issue 66) left in `dir`.
+fn assert_no_temporaries(dir: &Path) {
+    let left: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.contains(".tmp"))
+        .collect();
+    assert!(
+        left.is_empty(),
+        "temporaries left in {}: {left:?}",
+        dir.display()
+    );
+}
+
+/// Issue 66, cause 2: the sidecar is never the merged rows' own file, and a sidecar that cannot
+/// be written leaves no merged CSV behind.
+#[test]
+fn merge_sidecar_never_replaces_the_rows_and_fails_together_with_them() {
+    let d = temp("merge-sidecar");
+    let space = bias_space(&d, "[1000.0, 3000.0]");
+    let (s0, s1) = (d.join("s0"), d.join("s1"));
+    ok(&generate(&space, "2", &s0, &["--shard", "0/2"]));
+    ok(&generate(&space, "2", &s1, &["--shard", "1/2"]));
+    // `--out all.json`: the rows stay in all.json, the sidecar goes to all.json.json.
+    let json_out = d.join("all.json");
+    ok(&run(&["merge", "--out", s(&json_out), s(&s0), s(&s1)]));
+    let rows = std::fs::read_to_string(&json_out).unwrap();
+    assert_eq!(rows.lines().count(), 3, "{rows}");
+    assert!(rows.starts_with("index,"), "{rows}");
+    let side = std::fs::read_to_string(d.join("all.json.json")).unwrap();
+    assert!(side.contains("\"fingerprint\""), "{side}");
+    // A sidecar that cannot be written (a folder in its place): no all.csv left either.
+    let csv = d.join("two.csv");
+    std::fs::create_dir_all(d.join("two.json")).unwrap();
+    let o = run(&["merge", "--out", s(&csv), s(&s0), s(&s1)]);
+    bad(&o, &["two.json"]);
+    assert!(
+        !csv.exists(),
+        "the merged rows were left without their sidecar"
+    );
+    assert_no_temporaries(&d);
     let _ = std::fs::remove_dir_all(&d);
 }
 
@@ -351,7 +395,7 @@ fn model_files_are_written_like_every_other_output() {
         format!("{:o}", mode(&other)),
         "model file mode"
     );
-    assert!(!d.join("poly.safetensors.tmp").exists());
+    assert_no_temporaries(&d);
     let _ = std::fs::remove_dir_all(&d);
 }
 
@@ -447,5 +491,151 @@ fn evaluate_and_train_refuse_duplicated_indices() {
             "lines 3 and 7",
         ],
     );
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// Issue 66, cause 12: a model file with a NaN weight is refused at load (it predicted NaN with
+/// exit code 0), naming the file and the tensor.
+#[test]
+fn a_model_with_a_nan_weight_is_refused_at_load() {
+    let d = temp("nan-weight");
+    let shipped =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("models/super-siegfried-rz-split.safetensors");
+    let mut bytes = std::fs::read(&shipped).unwrap();
+    // safetensors: an 8-byte little-endian header length, the JSON header, then the data.
+    let n = u64::from_le_bytes(bytes[..8].try_into().unwrap()) as usize;
+    let header: serde_json::Value = serde_json::from_slice(&bytes[8..8 + n]).unwrap();
+    let (name, tensor) = header
+        .as_object()
+        .unwrap()
+        .iter()
+        .find(|(k, v)| *k != "__metadata__" && v["dtype"] == "F32")
+        .unwrap();
+    let start = 8 + n + tensor["data_offsets"][0].as_u64().unwrap() as usize;
+    bytes[start..start + 4].copy_from_slice(&f32::NAN.to_le_bytes());
+    let model = d.join("nan.safetensors");
+    std::fs::write(&model, &bytes).unwrap();
+    let o = run(&[
+        "predict",
+        "--model",
+        s(&model),
+        "--voltages",
+        "100",
+        "--params",
+        "d_li_mm=2.6,y1_bot=0.6,y2_bot=0.6,y3_bot=0.5,y4_bot=0.0,y1_top=0.5,y2_top=0.5,y3_top=0.4,y4_top=0.0",
+    ]);
+    bad(&o, &[s(&model), name.as_str(), "NaN", "finite"]);
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// A tmpfs mounted at a folder, unmounted when dropped.
+struct Tmpfs(PathBuf);
+
+impl Tmpfs {
+    /// Mounts a tmpfs of `kib` KiB at `dir`; None where that is not allowed (without root).
+    fn mount(dir: &Path, kib: u64) -> Option<Self> {
+        std::fs::create_dir_all(dir).unwrap();
+        let done = Command::new("mount")
+            .args([
+                "-t",
+                "tmpfs",
+                "-o",
+                &format!("size={kib}k"),
+                "tmpfs",
+                s(dir),
+            ])
+            .stderr(std::process::Stdio::null())
+            .status()
+            .is_ok_and(|st| st.success());
+        done.then(|| Tmpfs(dir.to_path_buf()))
+    }
+}
+
+impl Drop for Tmpfs {
+    fn drop(&mut self) {
+        let _ = Command::new("umount").arg(&self.0).status();
+    }
+}
+
+/// Issue 66, cause 3: on a full disk (a small tmpfs, filled up) no command leaves an empty or
+/// partial file under the name asked for, nor a temporary. Skipped where no tmpfs can be mounted
+/// (without root).
+#[test]
+fn a_full_disk_leaves_no_partial_output() {
+    use std::io::Write as _;
+    let d = temp("full-disk");
+    let disk = d.join("disk");
+    let Some(_mounted) = Tmpfs::mount(&disk, 256) else {
+        eprintln!("skipped: cannot mount a tmpfs here (needs root)");
+        return;
+    };
+    // Fill it: what is left is inodes (empty files can still be made) but no bytes.
+    {
+        let mut f = std::fs::File::create(disk.join("filler")).unwrap();
+        let block = vec![0u8; 4096];
+        while f.write_all(&block).is_ok() {}
+        let _ = f.flush();
+    }
+    let at = |name: &str| disk.join(name).to_str().unwrap().to_string();
+    let cases: Vec<Vec<String>> = vec![
+        vec![
+            "simulate",
+            "--detector",
+            COAX,
+            "--voltages",
+            "1000",
+            "--out",
+            at("cv.csv").as_str(),
+        ],
+        vec![
+            "field",
+            "--detector",
+            COAX,
+            "--voltage",
+            "1000",
+            "--phi",
+            "0",
+            "--z",
+            "5",
+            "--out",
+            at("e.csv").as_str(),
+        ],
+        vec![
+            "detector",
+            "--detector",
+            COAX,
+            "--plot",
+            at("x.png").as_str(),
+        ],
+        vec![
+            "detector",
+            "--detector",
+            COAX,
+            "--plot",
+            at("x.svg").as_str(),
+        ],
+        vec![
+            "measure",
+            "--raw",
+            "data/super-siegfried-k1/raw",
+            "--out",
+            at("m.csv").as_str(),
+        ],
+    ]
+    .into_iter()
+    .map(|v| v.into_iter().map(String::from).collect())
+    .collect();
+    for args in &cases {
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let o = run(&args);
+        bad(&o, &["No space left on device"]);
+        let left: Vec<String> = std::fs::read_dir(&disk)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .filter(|n| n != "filler")
+            .collect();
+        assert!(left.is_empty(), "{args:?} left {left:?}");
+    }
+    drop(_mounted);
     let _ = std::fs::remove_dir_all(&d);
 }

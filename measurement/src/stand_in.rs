@@ -168,12 +168,23 @@ pub fn draw_mismatch(
         .zip(z)
         .map(|(&c, z)| {
             let d = c + (rel * c + abs_pf) * z;
-            if d > 0.0 {
+            if d > 0.0 && d <= crate::formats::curve::MAX_PF {
                 Ok(d)
             } else {
+                // Named by the flags that set the mismatch (issue 66: an absolute mismatch was
+                // reported as `mismatch_rel`).
+                let flags = match (rel > 0.0, abs_pf > 0.0) {
+                    (true, false) => format!("--mismatch-rel {rel}"),
+                    (false, true) => format!("--mismatch-abs-pf {abs_pf:e}"),
+                    _ => format!("--mismatch-rel {rel} --mismatch-abs-pf {abs_pf:e}"),
+                };
                 Err(Error::setting(
-                    "mismatch_rel",
-                    format!("the drawn c12 {d} pF (from {c} pF) is not positive"),
+                    flags,
+                    format!(
+                        "gives a drawn c12 of {d:e} pF (from {c} pF, z = {z:.3}), outside (0, \
+                         {:e}] pF: the mismatch is too large for this curve",
+                        crate::formats::curve::MAX_PF
+                    ),
                 ))
             }
         })

@@ -182,3 +182,62 @@ mod tests {
         assert!(parse_r_range("0:1").is_err());
     }
 }
+
+/// The input files of a [`DetectorInput`] as (flag, path).
+pub fn detector_inputs(input: &DetectorInput) -> Vec<(&'static str, &std::path::Path)> {
+    let mut v = vec![("--detector", input.detector.as_path())];
+    if let Some(i) = &input.impurity {
+        v.push(("--impurity", i.as_path()));
+    }
+    v
+}
+
+/// Refuses, before any work, an output that would write over one of the command's inputs or
+/// into an input folder (the same path once `.`, `..` and links are resolved, or the same file
+/// through a hard link: [`hpge_files::overlaps`]), and two outputs on the same file. `outputs`
+/// and `inputs` are (flag, path); the one check of every command that writes files (issue 66).
+pub fn check_outputs<O: AsRef<std::path::Path>>(
+    outputs: &[(&str, O)],
+    inputs: &[(&str, &std::path::Path)],
+) -> Result<()> {
+    for (k, (flag, out)) in outputs.iter().enumerate() {
+        let out = out.as_ref();
+        if let Some((input_flag, input)) = hpge_files::first_overlap(out, inputs) {
+            anyhow::bail!(
+                "{flag} {}: {} the input {input_flag} {}; writing there would destroy the input: \
+                 choose another output path",
+                out.display(),
+                if input.is_dir() { "lies inside" } else { "is" },
+                input.display()
+            );
+        }
+        if let Some((other, _)) = outputs[..k]
+            .iter()
+            .find(|(_, o)| hpge_files::overlaps(out, o.as_ref()) && !o.as_ref().is_dir())
+        {
+            anyhow::bail!(
+                "{flag} {}: {other} names the same file; give each output its own path",
+                out.display()
+            );
+        }
+    }
+    Ok(())
+}
+
+/// Puts a command's staged outputs under their names ([`hpge_files::Staged::commit`]), naming
+/// the file that could not be renamed.
+pub fn commit(outputs: hpge_files::Staged) -> Result<()> {
+    outputs
+        .commit()
+        .map_err(|(file, e)| anyhow::anyhow!("{}: cannot write the file: {e}", file.display()))
+}
+
+/// `x` as `{}` writes it, or in exponent form where that would be long (`1e300`, not 301
+/// digits; issue 66).
+pub fn short(x: f64) -> String {
+    if x != 0.0 && x.is_finite() && !(1e-4..1e15).contains(&x.abs()) {
+        format!("{x:e}")
+    } else {
+        format!("{x}")
+    }
+}

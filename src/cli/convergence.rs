@@ -88,14 +88,20 @@ pub fn run(a: &ConvergenceArgs) -> Result<()> {
             "parameters": det.parameters.iter().collect::<std::collections::BTreeMap<_, _>>(),
             "version": env!("CARGO_PKG_VERSION"),
         });
-        println!("{v}");
+        outln!("{v}");
     } else {
-        println!(
+        outln!(
             "{:>10} {:>12} {:>10} {:>14} {:>11} {:>14} {:>8}",
-            "grid", "spacing (mm)", "nodes", "c12 (pF)", "+- (pF)", "vs finest", "s"
+            "grid",
+            "spacing (mm)",
+            "nodes",
+            "c12 (pF)",
+            "+- (pF)",
+            "vs finest",
+            "s"
         );
         for r in &rows {
-            println!(
+            outln!(
                 "{:>10} {:>12.3} {:>10} {:>14.6} {:>11.2e} {:>13.3}% {:>8.2}",
                 if r.adaptive {
                     "adaptive".to_string()
@@ -110,7 +116,7 @@ pub fn run(a: &ConvergenceArgs) -> Result<()> {
                 r.seconds
             );
         }
-        println!(
+        outln!(
             "adaptive: tolerance {:.2}% of c12; estimates are max |c12(h) - c12(2h)| over two coarsenings (an upper bound for order >= 1)",
             100.0 * settings.grid.tolerance
         );

@@ -17,6 +17,8 @@ pub fn run(input: &DetectorInput, plots: &[PathBuf], as_json: bool) -> Result<()
     for p in plots {
         plot::check_output(p, "--plot")?;
     }
+    let outputs: Vec<(&str, &Path)> = plots.iter().map(|p| ("--plot", p.as_path())).collect();
+    super::args::check_outputs(&outputs, &super::args::detector_inputs(input))?;
     let det = load_detector(input)?;
     show(&det, plots, as_json)
 }
@@ -36,21 +38,49 @@ pub fn from_legend(
     for p in plots {
         plot::check_output(p, "--plot")?;
     }
+    let mut outputs: Vec<(&str, &Path)> = plots.iter().map(|p| ("--plot", p.as_path())).collect();
+    if let Some(o) = out {
+        outputs.insert(0, ("--out", o));
+    }
+    let mut inputs = vec![("--from-legend", record)];
+    if let Some(i) = impurity {
+        inputs.push(("--impurity", i));
+    }
+    super::args::check_outputs(&outputs, &inputs)?;
+    for (flag, v) in [
+        ("--n-plus-thickness", options.n_plus_thickness_mm),
+        ("--can-gap", options.can_gap_mm),
+    ] {
+        if !(v.is_finite() && (0.0..=1000.0).contains(&v)) {
+            anyhow::bail!(
+                "{flag} {}: must be a number of mm from 0 to 1000",
+                super::args::short(v)
+            );
+        }
+    }
     let overrides = super::args::param_overrides(params)?;
     let diode = legend::read_file(record, options)?;
     let text = legend::to_toml(&diode, record, options);
-    let file = match out {
-        Some(path) => {
-            std::fs::write(path, &text)
-                .with_context(|| format!("--out {}: cannot write the file", path.display()))?;
-            eprintln!("wrote {}", path.display());
-            path.to_path_buf()
-        }
-        None => {
-            print!("{text}");
-            record.with_extension("toml")
-        }
-    };
+    // The description is checked before it is written or printed: a conversion the detector
+    // format refuses (e.g. an n+ layer thicker than the crystal) leaves no file behind and
+    // names the flags that shaped it.
+    let file = out.map_or_else(|| record.with_extension("toml"), Path::to_path_buf);
+    let mut det = Detector::from_toml_str(&text, &file, &overrides).with_context(|| {
+        format!(
+            "the description converted from {} (with --n-plus-thickness {} mm, --can-gap {} mm){}",
+            record.display(),
+            super::args::short(options.n_plus_thickness_mm),
+            super::args::short(options.can_gap_mm),
+            if out.is_some() { ", not written" } else { "" }
+        )
+    })?;
+    let mut staged = hpge_files::Staged::new();
+    match out {
+        Some(path) => staged
+            .write(path, text.as_bytes())
+            .with_context(|| format!("--out {}: cannot write the file", path.display()))?,
+        None => out!("{text}"),
+    }
     for n in &diode.notes {
         eprintln!("note: {n}");
     }
@@ -58,15 +88,26 @@ pub fn from_legend(
         Some(u) => eprintln!("the record's characterization: depletion voltage {u} V"),
         None => eprintln!("the record's characterization gives no depletion voltage"),
     }
-    let mut det = Detector::from_toml_str(&text, &file, &overrides)
-        .with_context(|| format!("the description converted from {}", record.display()))?;
     if let Some(path) = impurity {
         det.set_impurity_file(path)?;
     }
     if out.is_none() && plots.is_empty() && !as_json {
         return Ok(());
     }
-    show(&det, plots, as_json)
+    // Checked and drawn first: the description is written only when every step succeeded.
+    hpge_solver::grid::Grid::check_initial_size(&det, &det.grid.clone().unwrap_or_default())?;
+    for p in plots {
+        plot::cross_section(&det, p)?;
+    }
+    super::args::commit(staged)?;
+    if let Some(path) = out {
+        eprintln!("wrote {}", path.display());
+    }
+    show(&det, &[], as_json)?;
+    for p in plots {
+        eprintln!("wrote {}", p.display());
+    }
+    Ok(())
 }
 
 fn show(det: &Detector, plots: &[PathBuf], as_json: bool) -> Result<()> {
@@ -78,25 +119,25 @@ fn show(det: &Detector, plots: &[PathBuf], as_json: bool) -> Result<()> {
         eprintln!("wrote {}", p.display());
     }
     if as_json {
-        println!("{}", summary_json(det));
+        outln!("{}", summary_json(det));
     } else {
-        print_summary(det);
+        print_summary(det)?;
     }
     Ok(())
 }
 
-fn print_summary(det: &Detector) {
+fn print_summary(det: &Detector) -> Result<()> {
     let w = &det.world;
-    println!("detector  {} ({})", det.name, det.file.display());
+    outln!("detector  {} ({})", det.name, det.file.display());
     if !det.parameters.is_empty() {
         let p: Vec<String> = det
             .parameters
             .iter()
             .map(|(k, v)| format!("{k} = {v}"))
             .collect();
-        println!("parameters  {}", p.join(", "));
+        outln!("parameters  {}", p.join(", "));
     }
-    println!(
+    outln!(
         "world  r in [0, {}] mm, z in [{}, {}] mm, medium {} (eps_r {}); r_max {:?}, z_min {:?}, z_max {:?}",
         w.r_max_mm,
         w.z_min_mm,
@@ -109,7 +150,7 @@ fn print_summary(det: &Detector) {
     );
     let sc = &det.semiconductor;
     let b = sc.geometry.bbox();
-    println!(
+    outln!(
         "semiconductor  {} ({}, eps_r {}), r in [{}, {}] mm, z in [{}, {}] mm",
         sc.name,
         sc.material.name,
@@ -119,14 +160,14 @@ fn print_summary(det: &Detector) {
         b.z_min_mm,
         b.z_max_mm
     );
-    println!(
+    outln!(
         "impurity  model \"{}\" from {}",
         det.impurity().name(),
         sc.impurity_file().display()
     );
     for c in &det.contacts {
         let b = c.geometry.bbox();
-        println!(
+        outln!(
             "contact {}  {}: potential {}, {}, r in [{}, {}] mm, z in [{}, {}] mm",
             c.id,
             c.name,
@@ -143,8 +184,9 @@ fn print_summary(det: &Detector) {
         );
     }
     for p in &det.passives {
-        println!("passive  {}: {:?}, {}", p.name, p.kind, p.material.name);
+        outln!("passive  {}: {:?}, {}", p.name, p.kind, p.material.name);
     }
+    Ok(())
 }
 
 fn summary_json(det: &Detector) -> serde_json::Value {

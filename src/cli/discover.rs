@@ -55,7 +55,7 @@ impl<F: Fn(&Status) + Sync> Progress for Printer<F> {
 pub fn run(a: &DiscoverArgs) -> Result<()> {
     if a.list {
         for e in catalogue() {
-            println!(
+            outln!(
                 "{:<18} {}\n{:<18} signature: {}",
                 e.name(),
                 e.description(),
@@ -98,23 +98,26 @@ pub fn run(a: &DiscoverArgs) -> Result<()> {
     )?;
     bar.finish_and_clear();
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&d.summary)?);
+        outln!("{}", serde_json::to_string_pretty(&d.summary)?);
     } else {
-        print_summary(&d, &out);
+        print_summary(&d, &out)?;
     }
     Ok(())
 }
 
 /// The short summary on stdout.
-fn print_summary(d: &Discovery, out: &Path) {
+fn print_summary(d: &Discovery, out: &Path) -> Result<()> {
     let s = &d.summary;
-    println!("{}", s.verdict);
-    println!(
+    outln!("{}", s.verdict);
+    outln!(
         "before ({}): chi2/ndf {:.2}, max |pull| {:.2}, ppc p {:.3}",
-        s.before.model, s.before.chi2_ndf, s.before.max_pull, s.before.ppc_p
+        s.before.model,
+        s.before.chi2_ndf,
+        s.before.max_pull,
+        s.before.ppc_p
     );
     if s.chosen.is_some() {
-        println!(
+        outln!(
             "after ({}): chi2/ndf {:.2}, max |pull| {:.2}, ppc p {:.3}; delta elpd {:.1} +- {:.1}",
             s.after.model,
             s.after.chi2_ndf,
@@ -125,10 +128,14 @@ fn print_summary(d: &Discovery, out: &Path) {
         );
     }
     for c in &s.candidates {
-        println!(
+        outln!(
             "  {:<18} ln B {:>8.2}  delta chi2 {:>8.2}  ({})",
-            c.name, c.score, c.delta_chi2, c.predictor
+            c.name,
+            c.score,
+            c.delta_chi2,
+            c.predictor
         );
     }
-    println!("{:.1} s; outputs in {}", s.seconds, out.display());
+    outln!("{:.1} s; outputs in {}", s.seconds, out.display());
+    Ok(())
 }

@@ -50,6 +50,15 @@ pub struct FieldArgs {
 
 /// Runs `field`.
 pub fn run(a: &FieldArgs) -> Result<()> {
+    let mut outputs = Vec::new();
+    if let Some(p) = &a.out {
+        outputs.push(("--out", p.clone()));
+        outputs.push(("--out's sidecar", super::sidecar::path(p)));
+    }
+    if let Some(p) = &a.plot {
+        outputs.push(("--plot", p.clone()));
+    }
+    super::args::check_outputs(&outputs, &super::args::detector_inputs(&a.input))?;
     if let Some(p) = &a.plot {
         plot::check_output(p, "--plot")?;
     }
@@ -109,16 +118,22 @@ pub fn run(a: &FieldArgs) -> Result<()> {
         a.phi,
         a.z
     );
+    // The CSV and its sidecar under their names only once the figure is drawn too.
+    let mut staged = hpge_files::Staged::new();
     if let Some(path) = &a.out {
         let ctx = || format!("--out {}: cannot write the file", path.display());
-        let mut f = std::io::BufWriter::new(std::fs::File::create(path).with_context(ctx)?);
-        writeln!(f, "r_mm,e_V_per_cm,status").with_context(ctx)?;
-        for ((r, e), s) in line.r_mm.iter().zip(&v_cm).zip(&line.status) {
-            let e = e.map_or(String::new(), |e| e.to_string());
-            writeln!(f, "{r},{e},{}", s.as_str()).with_context(ctx)?;
-        }
-        f.flush().with_context(ctx)?;
-        super::sidecar::write(
+        staged
+            .write_with(path, |f| -> std::io::Result<()> {
+                writeln!(f, "r_mm,e_V_per_cm,status")?;
+                for ((r, e), s) in line.r_mm.iter().zip(&v_cm).zip(&line.status) {
+                    let e = e.map_or(String::new(), |e| e.to_string());
+                    writeln!(f, "{r},{e},{}", s.as_str())?;
+                }
+                Ok(())
+            })
+            .with_context(ctx)?;
+        super::sidecar::stage(
+            &mut staged,
             path,
             super::args::with_detector_provenance(
                 json!({
@@ -157,6 +172,7 @@ pub fn run(a: &FieldArgs) -> Result<()> {
         };
         plot::line_figure(&fig, path)?;
     }
+    super::args::commit(staged)?;
     if a.json {
         let v = super::args::with_detector_provenance(
             json!({
@@ -171,16 +187,19 @@ pub fn run(a: &FieldArgs) -> Result<()> {
             }),
             &det,
         );
-        println!("{v}");
+        outln!("{v}");
     } else {
-        println!(
+        outln!(
             "|E| at phi = {} deg, z = {} mm, U_B = {} V ({})",
-            a.phi, a.z, a.voltage, det.name
+            a.phi,
+            a.z,
+            a.voltage,
+            det.name
         );
-        println!("{:>10} {:>14} {:>11}", "r (mm)", "|E| (V/cm)", "status");
+        outln!("{:>10} {:>14} {:>11}", "r (mm)", "|E| (V/cm)", "status");
         for ((r, e), s) in line.r_mm.iter().zip(&v_cm).zip(&line.status) {
             let e = e.map_or("-".to_string(), |e| format!("{e:.1}"));
-            println!("{r:>10.3} {e:>14} {:>11}", s.as_str());
+            outln!("{r:>10.3} {e:>14} {:>11}", s.as_str());
         }
     }
     Ok(())

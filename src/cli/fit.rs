@@ -218,9 +218,9 @@ pub fn run(o: &FitOptions, print_json: bool, allow_unconverged: bool) -> Result<
     let run = run_fit(o, &display)?;
     let sm = &run.fit.summary;
     if print_json {
-        println!("{}", serde_json::to_string(&run.summary_json)?);
+        outln!("{}", serde_json::to_string(&run.summary_json)?);
     } else {
-        print!("{}", summary_text(&run.fit, &run.out));
+        out!("{}", summary_text(&run.fit, &run.out));
     }
     if !sm.converged {
         let msg = unconverged_text(sm);
@@ -305,7 +305,13 @@ impl FitObserver for ReportDisplay {
         self.0.round_done(r);
     }
     fn finished(&self, run: &FitRun) {
-        print!("{}", summary_text(&run.fit, &run.out));
+        // An observer cannot fail the report: a stdout that cannot be written is a warning.
+        if let Err(e) =
+            super::stdout::write_fmt(format_args!("{}", summary_text(&run.fit, &run.out)))
+            && !e.broken_pipe()
+        {
+            eprintln!("warning: {e}");
+        }
         if !run.fit.summary.converged {
             eprintln!(
                 "warning: the fit did not converge ({})",

@@ -77,7 +77,7 @@ pub fn generate(o: &GenerateOptions) -> Result<()> {
     for (i, status) in &report.failed {
         eprintln!("sample {i}: {status}");
     }
-    println!(
+    outln!(
         "{}: {} rows ({} from before, {} now in {seconds:.1} s, {:.2} samples/s), {} failed solves",
         o.out.join("rows.csv").display(),
         report.total,
@@ -92,7 +92,7 @@ pub fn generate(o: &GenerateOptions) -> Result<()> {
 /// Merges shard folders.
 pub fn merge_shards(dirs: &[PathBuf], out: &Path) -> Result<()> {
     let r = merge(dirs, out)?;
-    println!(
+    outln!(
         "{}: {} rows from {} shards ({} failed solves)",
         out.display(),
         r.rows,
@@ -128,7 +128,7 @@ pub fn label(o: &LabelOptions) -> Result<()> {
     for (i, reason) in &report.failed {
         eprintln!("row {i}: {reason}");
     }
-    println!(
+    outln!(
         "{}: {} rows ({} from before, {} solved and {} copied now in {:.1} s), {} failed solves{}",
         o.out.join("rows.csv").display(),
         report.total,

@@ -63,20 +63,24 @@ pub fn run(input: &DetectorInput, at: &[(f64, f64)], json: bool) -> Result<()> {
             version: env!("CARGO_PKG_VERSION"),
             points,
         };
-        println!("{}", serde_json::to_string(&out)?);
+        outln!("{}", serde_json::to_string(&out)?);
     } else {
-        println!(
+        outln!(
             "impurity model \"{}\" from {}",
             model.name(),
             det.semiconductor.impurity_file().display()
         );
-        println!(
+        outln!(
             "{:>10} {:>10} {:>14} {:>14} {:>14}",
-            "r_mm", "z_mm", "y", "x", "zeta_cm3"
+            "r_mm",
+            "z_mm",
+            "y",
+            "x",
+            "zeta_cm3"
         );
         let opt = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.8}"));
         for p in &points {
-            println!(
+            outln!(
                 "{:>10} {:>10} {:>14} {:>14} {:>14.6e}{}",
                 p.r_mm,
                 p.z_mm,

@@ -17,12 +17,23 @@ use serde_json::json;
 /// Runs the measurement pipeline and writes the curve, its covariance, a JSON report and the
 /// figures.
 pub fn run(o: &MeasureOptions, plot: Option<&PathBuf>, json: bool) -> Result<()> {
-    if let Some(dir) = plot
-        && !dir.is_dir()
-    {
-        std::fs::create_dir_all(dir)
-            .with_context(|| format!("--plot {}: cannot create the folder", dir.display()))?;
+    let report_path = o.out.with_extension("measure.json");
+    let mut outputs = vec![
+        ("--out", o.out.clone()),
+        (
+            "--out's covariance",
+            hpge_measurement::covariance_path(&o.out),
+        ),
+        ("--out's report", report_path.clone()),
+    ];
+    if let Some(dir) = plot {
+        outputs.push(("--plot", dir.clone()));
     }
+    let mut inputs = vec![("--raw", o.raw.as_path())];
+    if let Some(s) = &o.settings {
+        inputs.push(("--settings", s.as_path()));
+    }
+    super::args::check_outputs(&outputs, &inputs)?;
     let (settings, settings_source) = o.measure_settings()?;
     let run = read_raw_dir(&o.raw, settings.voltages_v.as_deref())?;
     for p in &run.problems {
@@ -51,6 +62,17 @@ pub fn run(o: &MeasureOptions, plot: Option<&PathBuf>, json: bool) -> Result<()>
             p.message
         );
     }
+    // Every output removed again if a later one fails: all of them, or none.
+    let mut staged = hpge_files::Staged::new();
+    if let Some(dir) = plot {
+        staged
+            .make_folder(dir)
+            .with_context(|| format!("--plot {}: cannot create the folder", dir.display()))?;
+    }
+    staged.adopt(&o.out);
+    if m.curve.covariance_pf2.is_some() {
+        staged.adopt(&hpge_measurement::covariance_path(&o.out));
+    }
     write_curve(&o.out, &m.curve)?;
     let mut report = report_json(&m, &o.raw, &settings_source, &run.problems);
     if let Some(obj) = report.as_object_mut() {
@@ -74,21 +96,27 @@ pub fn run(o: &MeasureOptions, plot: Option<&PathBuf>, json: bool) -> Result<()>
                 .into(),
         );
     }
-    let report_path = o.out.with_extension("measure.json");
-    std::fs::write(&report_path, format!("{report:#}\n"))
+    staged
+        .write(&report_path, format!("{report:#}\n").as_bytes())
         .with_context(|| format!("{}: cannot write the report", report_path.display()))?;
     if let Some(dir) = plot {
         plot::measurement(&m, &run.sets, dir)?;
     }
+    super::args::commit(staged)?;
     if json {
-        println!("{report}");
+        outln!("{report}");
     } else {
-        println!(
+        outln!(
             "{:>8} {:>11} {:>9} {:>8} {:>7} {:>11}",
-            "U_B (V)", "c12 (pF)", "sigma", "stat", "pulses", "failed fits"
+            "U_B (V)",
+            "c12 (pF)",
+            "sigma",
+            "stat",
+            "pulses",
+            "failed fits"
         );
         for (p, s) in m.points.iter().zip(&m.curve.sigma_pf) {
-            println!(
+            outln!(
                 "{:>8} {:>11.4} {:>9.4} {:>8.1e} {:>7} {:>11}",
                 p.bias_v,
                 p.c12_pf,
@@ -99,13 +127,13 @@ pub fn run(o: &MeasureOptions, plot: Option<&PathBuf>, json: bool) -> Result<()>
             );
         }
         match m.depletion_voltage_v {
-            Some(v) => println!(
+            Some(v) => outln!(
                 "full-depletion voltage (-dc12/dU_B = {} pF/V): {v:.0} V",
                 settings.depletion_slope_pf_per_v
             ),
-            None => println!("-dc12/dU_B does not fall to the threshold within the curve"),
+            None => outln!("-dc12/dU_B does not fall to the threshold within the curve"),
         }
-        println!(
+        outln!(
             "wrote {} (+ .covariance.csv, .measure.json); {} problem(s)",
             o.out.display(),
             run.problems.len() + m.problems.len()
@@ -165,6 +193,10 @@ fn report_json(
 /// again when a later step fails, so a failure leaves no empty or partial folder behind.
 pub fn synthesize(o: &SynthOptions) -> Result<()> {
     o.validate()?;
+    super::args::check_outputs(
+        &[("--out", o.out.as_path())],
+        &[("--curve", o.curve.as_path())],
+    )?;
     let settings = o.settings();
     settings.validate().map_err(|e| match &e {
         hpge_measurement::Error::Setting { key, message } if key == "pulser_pulses" => {
@@ -186,19 +218,38 @@ pub fn synthesize(o: &SynthOptions) -> Result<()> {
             )
         })?,
     };
-    let made = !o.out.exists();
-    std::fs::create_dir_all(&o.out)
-        .with_context(|| format!("--out {}: cannot create the folder", o.out.display()))?;
-    let written = write_synthetic(o, &settings, &volts, &c12, ufd, &draws);
-    if written.is_err() && made {
-        let _ = std::fs::remove_dir_all(&o.out);
+    if o.out.exists() {
+        write_synthetic(o, &o.out, &settings, &volts, &c12, ufd, &draws)?;
+    } else {
+        // A new folder is filled under a temporary name beside it and renamed when complete: a
+        // killed or failed run leaves no partial raw folder that `measure` would read as a
+        // short curve (issue 66).
+        let tmp = hpge_files::temp_beside(&o.out);
+        let written = std::fs::create_dir_all(&tmp)
+            .with_context(|| format!("--out {}: cannot create the folder", o.out.display()))
+            .and_then(|()| write_synthetic(o, &tmp, &settings, &volts, &c12, ufd, &draws))
+            .and_then(|()| {
+                std::fs::rename(&tmp, &o.out)
+                    .with_context(|| format!("--out {}: cannot create the folder", o.out.display()))
+            });
+        if written.is_err() {
+            let _ = std::fs::remove_dir_all(&tmp);
+        }
+        written?;
     }
-    written
+    outln!(
+        "wrote {} pulse files to {} (seed {}, U_fd {ufd:.0} V)",
+        volts.len(),
+        o.out.display(),
+        o.seed
+    );
+    Ok(())
 }
 
-/// The files of [`synthesize`] into the existing folder `o.out`.
+/// The files of [`synthesize`] into the existing folder `dir` (`o.out` or its temporary).
 fn write_synthetic(
     o: &SynthOptions,
+    dir: &Path,
     settings: &hpge_measurement::SynthSettings,
     volts: &[f64],
     c12: &[f64],
@@ -213,22 +264,23 @@ fn write_synthetic(
     );
     for (k, (&u, &c)) in volts.iter().zip(&draws.detector_pf).enumerate() {
         let v = synthesize_voltage(u, c, ufd, settings, voltage_seed(o.seed, k))?;
-        let name = o.out.join(format!("U{:04}V.npy", u.round() as i64));
+        let file = format!("U{:04}V.npy", u.round() as i64);
+        let name = dir.join(&file);
         let set = PulseSet {
-            source: name.clone(),
+            source: o.out.join(&file),
             ..v.set
         };
         write_pulses(&name, &set, true)?;
         bar.inc(1);
     }
     bar.finish_and_clear();
-    let toml_path = o.out.join("measurement.toml");
+    let toml_path = dir.join("measurement.toml");
     let list = volts
         .iter()
         .map(|v| format!("{v}"))
         .collect::<Vec<_>>()
         .join(", ");
-    std::fs::write(
+    hpge_files::write(
         &toml_path,
         format!(
             "# Written by hpge-cv {} synthesize (seed {}); the default circuit and uncertainties.\nvoltages_V = [{list}]\n",
@@ -255,14 +307,8 @@ fn write_synthetic(
         "c12_expected_measured_pF": draws.expected_measured_pf(),
         "version": env!("CARGO_PKG_VERSION"),
     });
-    let truth_path = o.out.join("truth.json");
-    std::fs::write(&truth_path, format!("{truth:#}\n"))
+    let truth_path = dir.join("truth.json");
+    hpge_files::write(&truth_path, format!("{truth:#}\n"))
         .with_context(|| format!("{}: cannot write", truth_path.display()))?;
-    println!(
-        "wrote {} pulse files to {} (seed {}, U_fd {ufd:.0} V)",
-        volts.len(),
-        o.out.display(),
-        o.seed
-    );
     Ok(())
 }

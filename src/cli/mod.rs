@@ -16,6 +16,7 @@ mod replace;
 mod sensitivity;
 mod sidecar;
 mod simulate;
+pub(crate) mod stdout;
 mod surrogate;
 mod validate;
 mod validate_discovery;
@@ -398,6 +399,25 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Merge(a) => generate::merge_shards(&a.dirs, &a.out),
         Command::Label(o) => generate::label(&o),
         Command::Train(a) => {
+            let j = &a.job;
+            let curves = hpge_surrogate::job::curves_path(&j.out);
+            let mut outputs = vec![
+                ("--out", j.out.clone()),
+                ("--out's learning curves", curves.clone()),
+                ("--out's learning curves", curves.with_extension("json")),
+            ];
+            if let Some(p) = &a.plot {
+                outputs.push(("--plot", p.clone()));
+            }
+            let mut inputs = vec![
+                ("--data", j.data.as_path()),
+                ("--test", j.test.as_path()),
+                ("--space", j.space.as_path()),
+            ];
+            if let Some(d) = &j.detector {
+                inputs.push(("--detector", d.as_path()));
+            }
+            args::check_outputs(&outputs, &inputs)?;
             replace::check_train(&a.job, a.force)?;
             surrogate::train(&a.job, a.plot.as_deref(), false)
         }
@@ -422,6 +442,11 @@ pub fn run(cli: Cli) -> Result<()> {
         },
         Command::Evaluate(a) => surrogate::evaluate(&a.options, a.json, a.plot.as_deref()),
         Command::Calibrate(a) => {
+            // The model itself may be the output (calibrated in place); the rows may not.
+            args::check_outputs(
+                &[("--out", a.options.out_file().as_path())],
+                &[("--data", a.options.data.as_path())],
+            )?;
             replace::check_calibrate(&a.options, a.force)?;
             surrogate::calibrate(&a.options)
         }

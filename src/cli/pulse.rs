@@ -60,6 +60,19 @@ pub struct PulseArgs {
 
 /// Runs `pulse`.
 pub fn run(a: &PulseArgs) -> Result<()> {
+    let mut outputs = Vec::new();
+    if let Some(p) = &a.out {
+        outputs.push(("--out", p.clone()));
+        outputs.push(("--out's sidecar", super::sidecar::path(p)));
+    }
+    if let Some(p) = &a.plot {
+        outputs.push(("--plot", p.clone()));
+    }
+    let mut inputs = super::args::detector_inputs(&a.input);
+    if let Some(d) = &a.drift_parameters {
+        inputs.push(("--drift-parameters", d.as_path()));
+    }
+    super::args::check_outputs(&outputs, &inputs)?;
     if let Some(p) = &a.plot {
         plot::check_output(p, "--plot")?;
     }
@@ -128,12 +141,15 @@ pub fn run(a: &PulseArgs) -> Result<()> {
         drift_file: a.drift_parameters.as_deref(),
         normalised: a.normalise,
     };
+    // The CSV and its sidecar under their names only once the figure is drawn too.
+    let mut staged = hpge_files::Staged::new();
     if let Some(path) = &a.out {
-        write_csv(path, &p, &provenance)?;
+        write_csv(&mut staged, path, &p, &provenance)?;
     }
     if let Some(path) = &a.plot {
         plot::line_figure(&pulse_figure(&p, &provenance), path)?;
     }
+    super::args::commit(staged)?;
     let rise = rise_time_10_90_ns(&p.t_ns, &p.signals[k_ref].charge);
     if a.json {
         let v = super::args::with_detector_provenance(
@@ -155,9 +171,9 @@ pub fn run(a: &PulseArgs) -> Result<()> {
             }),
             &det,
         );
-        println!("{v}");
+        outln!("{v}");
     } else {
-        print_summary(&det, &p, &provenance, rise, divisor);
+        print_summary(&det, &p, &provenance, rise, divisor)?;
     }
     Ok(())
 }
@@ -213,15 +229,16 @@ fn print_summary(
     prov: &Provenance<'_>,
     rise: Option<f64>,
     divisor: Option<f64>,
-) {
+) -> Result<()> {
     let (r, phi, z) = prov.at;
-    println!(
+    outln!(
         "pulse at r = {r} mm, phi = {phi} deg, z = {z} mm; U_B = {} V ({})",
-        prov.voltage_v, det.name
+        prov.voltage_v,
+        det.name
     );
     for d in [&p.electron, &p.hole] {
         let end = d.path.last().map_or([f64::NAN; 3], |s| s.x_mm);
-        println!(
+        outln!(
             "  {:8} {} after {:.1} ns, at r = {:.2} mm, z = {:.2} mm",
             d.carrier.as_str(),
             d.stop.describe(det),
@@ -230,7 +247,7 @@ fn print_summary(
             end[2]
         );
     }
-    println!("collection time {:.1} ns", p.collection_time_ns);
+    outln!("collection time {:.1} ns", p.collection_time_ns);
     let unit = if divisor.is_some() {
         "normalised"
     } else {
@@ -241,32 +258,42 @@ fn print_summary(
         .iter()
         .map(|s| format!("{} {:+.4}", s.name, s.charge.last().unwrap_or(&0.0)))
         .collect();
-    println!("end charges ({unit}): {}", ends.join(", "));
+    outln!("end charges ({unit}): {}", ends.join(", "));
     if let Some(t) = rise {
-        println!(
+        outln!(
             "10-90% rise time of {}: {t:.1} ns",
             det.contacts[reference_contact(det)].name
         );
     }
+    Ok(())
 }
 
-fn write_csv(path: &Path, p: &Pulse, prov: &Provenance<'_>) -> Result<()> {
+fn write_csv(
+    staged: &mut hpge_files::Staged,
+    path: &Path,
+    p: &Pulse,
+    prov: &Provenance<'_>,
+) -> Result<()> {
     let ctx = || format!("--out {}: cannot write the file", path.display());
-    let mut f = std::io::BufWriter::new(std::fs::File::create(path).with_context(ctx)?);
     let head: Vec<String> = prov
         .det
         .contacts
         .iter()
         .map(|c| format!("q{}", c.id))
         .collect();
-    writeln!(f, "t_ns,{}", head.join(",")).with_context(ctx)?;
-    for (i, t) in p.t_ns.iter().enumerate() {
-        let row: Vec<String> = p.signals.iter().map(|s| s.charge[i].to_string()).collect();
-        writeln!(f, "{t},{}", row.join(",")).with_context(ctx)?;
-    }
-    f.flush().with_context(ctx)?;
+    staged
+        .write_with(path, |f| -> std::io::Result<()> {
+            writeln!(f, "t_ns,{}", head.join(","))?;
+            for (i, t) in p.t_ns.iter().enumerate() {
+                let row: Vec<String> = p.signals.iter().map(|s| s.charge[i].to_string()).collect();
+                writeln!(f, "{t},{}", row.join(","))?;
+            }
+            Ok(())
+        })
+        .with_context(ctx)?;
     let (r, phi, z) = prov.at;
-    super::sidecar::write(
+    super::sidecar::stage(
+        staged,
         path,
         super::args::with_detector_provenance(
             json!({

@@ -40,6 +40,11 @@ pub fn run(o: &SensitivityOptions<'_>) -> Result<()> {
     if let Some(p) = o.plot {
         plot::check_output(p, "--plot")?;
     }
+    let outputs: Vec<(&str, &std::path::Path)> = [("--out", o.out), ("--plot", o.plot)]
+        .into_iter()
+        .filter_map(|(f, p)| p.map(|p| (f, p.as_path())))
+        .collect();
+    super::args::check_outputs(&outputs, &super::args::detector_inputs(o.input))?;
     let det = load_detector(o.input)?;
     det.check_bias_contact()?;
     let settings = o.grid.apply(&o.settings, &det)?;
@@ -57,13 +62,18 @@ pub fn run(o: &SensitivityOptions<'_>) -> Result<()> {
     })?;
     bar.finish_and_clear();
     let seconds = start.elapsed().as_secs_f64();
+    // The CSV under its name only once the figure is drawn too.
+    let mut staged = hpge_files::Staged::new();
     if let Some(path) = o.out {
-        let mut f = std::fs::File::create(path)
-            .with_context(|| format!("--out {}: cannot create the file", path.display()))?;
-        writeln!(f, "zeta_cm3,c12_pF,fully_depleted")?;
-        for p in &points {
-            writeln!(f, "{:e},{},{}", p.zeta_cm3, p.c12_pf, p.fully_depleted)?;
-        }
+        staged
+            .write_with(path, |f| -> std::io::Result<()> {
+                writeln!(f, "zeta_cm3,c12_pF,fully_depleted")?;
+                for p in &points {
+                    writeln!(f, "{:e},{},{}", p.zeta_cm3, p.c12_pf, p.fully_depleted)?;
+                }
+                Ok(())
+            })
+            .with_context(|| format!("--out {}: cannot write the file", path.display()))?;
     }
     if let Some(path) = o.plot {
         plot::sensitivity(
@@ -74,6 +84,7 @@ pub fn run(o: &SensitivityOptions<'_>) -> Result<()> {
             path,
         )?;
     }
+    super::args::commit(staged)?;
     if o.json {
         let v = json!({
             "zeta_cm3": points.iter().map(|p| p.zeta_cm3).collect::<Vec<_>>(),
@@ -88,19 +99,23 @@ pub fn run(o: &SensitivityOptions<'_>) -> Result<()> {
             "parameters": det.parameters.iter().collect::<std::collections::BTreeMap<_, _>>(),
             "version": env!("CARGO_PKG_VERSION"),
         });
-        println!("{v}");
+        outln!("{v}");
     } else {
-        println!(
+        outln!(
             "{:>14} {:>12} {:>8}",
-            "zeta (cm^-3)", "c12 (pF)", "depleted"
+            "zeta (cm^-3)",
+            "c12 (pF)",
+            "depleted"
         );
         for p in &points {
-            println!(
+            outln!(
                 "{:>14.4e} {:>12.5} {:>8}",
-                p.zeta_cm3, p.c12_pf, p.fully_depleted
+                p.zeta_cm3,
+                p.c12_pf,
+                p.fully_depleted
             );
         }
-        println!(
+        outln!(
             "{} densities at {} V in {seconds:.2} s",
             points.len(),
             o.voltage_v

@@ -40,17 +40,23 @@ pub fn common(csv: &Path) -> serde_json::Map<String, serde_json::Value> {
     o
 }
 
-/// Writes the sidecar of `csv`: [`common`] plus the entries of `fields` (an object).
-pub fn write(csv: &Path, fields: serde_json::Value) -> Result<PathBuf> {
+/// Stages the sidecar of `csv` in `outputs` (written under its name when the command's outputs
+/// are committed): [`common`] plus the entries of `fields` (an object).
+pub fn stage(
+    outputs: &mut hpge_files::Staged,
+    csv: &Path,
+    fields: serde_json::Value,
+) -> Result<PathBuf> {
     let mut o = common(csv);
     if let serde_json::Value::Object(m) = fields {
         o.extend(m);
     }
     let file = path(csv);
-    std::fs::write(
-        &file,
-        serde_json::to_string_pretty(&serde_json::Value::Object(o))? + "\n",
-    )
-    .with_context(|| format!("{}: cannot write the CSV's JSON sidecar", file.display()))?;
+    outputs
+        .write(
+            &file,
+            (serde_json::to_string_pretty(&serde_json::Value::Object(o))? + "\n").as_bytes(),
+        )
+        .with_context(|| format!("{}: cannot write the CSV's JSON sidecar", file.display()))?;
     Ok(file)
 }

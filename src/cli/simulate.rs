@@ -1,7 +1,7 @@
 //! `hpge-cv simulate` and `hpge-cv capacitance`: field solves from the command line.
 
 use std::io::Write;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 use hpge_reports::plot;
@@ -33,6 +33,16 @@ pub struct SimulateOptions<'a> {
 
 /// Runs a C-V curve and writes what was asked for.
 pub fn run(o: &SimulateOptions<'_>) -> Result<()> {
+    let outputs: Vec<(&str, &Path)> = [
+        ("--out", o.out),
+        ("--plot", o.plot),
+        ("--field-plot", o.field_plot),
+        ("--depletion-plot", o.depletion_plot),
+    ]
+    .into_iter()
+    .filter_map(|(f, p)| p.map(|p| (f, p.as_path())))
+    .collect();
+    super::args::check_outputs(&outputs, &super::args::detector_inputs(o.input))?;
     if let Some(p) = o.plot {
         plot::check_output(p, "--plot")?;
     }
@@ -151,8 +161,12 @@ pub fn run(o: &SimulateOptions<'_>) -> Result<()> {
         eprintln!("note: the detector is not fully depleted at any listed voltage");
     }
     let seconds = start.elapsed().as_secs_f64();
+    // The CSV under its name only once every figure is drawn too.
+    let mut staged = hpge_files::Staged::new();
     if let Some(path) = o.out {
-        write_csv(path, &curve)?;
+        staged
+            .write_with(path, |f| write_csv(f, &curve))
+            .with_context(|| format!("--out {}: cannot write the file", path.display()))?;
     }
     if let Some(path) = o.plot {
         plot::cv_curve(&curve, &det, path)?;
@@ -169,6 +183,7 @@ pub fn run(o: &SimulateOptions<'_>) -> Result<()> {
                 .collect::<std::result::Result<Vec<_>, _>>()?;
         plot::depletion_map(&det, &states, path)?;
     }
+    super::args::commit(staged)?;
     let pinch_off_v = curve_pinch_off_voltage(&det, &curve, &settings)?;
     let last = curve.points.last().map_or((0, 0), |p| p.grid);
     if o.json {
@@ -202,21 +217,30 @@ pub fn run(o: &SimulateOptions<'_>) -> Result<()> {
             }),
             &det,
         );
-        println!("{v}");
+        outln!("{v}");
     } else {
-        println!(
+        outln!(
             "{:>10} {:>12} {:>10} {:>8} {:>11}",
-            "U_B (V)", "c12 (pF)", "+- (pF)", "depleted", "grid"
+            "U_B (V)",
+            "c12 (pF)",
+            "+- (pF)",
+            "depleted",
+            "grid"
         );
         for p in &curve.points {
-            println!(
+            outln!(
                 "{:>10} {:>12.5} {:>10.2e} {:>8} {:>5}x{:<5}",
-                p.voltage_v, p.c12_pf, p.c12_err_pf, p.fully_depleted, p.grid.0, p.grid.1
+                p.voltage_v,
+                p.c12_pf,
+                p.c12_err_pf,
+                p.fully_depleted,
+                p.grid.0,
+                p.grid.1
             );
         }
         for p in curve.points.iter().filter(|p| !p.pockets.is_empty()) {
             for k in &p.pockets {
-                println!(
+                outln!(
                     "  {:>6} V: pocket of trapped {}s at {:.1} V, {:.3} cm^3, centre (r, z) = ({:.1}, {:.1}) mm",
                     p.voltage_v,
                     k.carrier.as_str(),
@@ -228,13 +252,13 @@ pub fn run(o: &SimulateOptions<'_>) -> Result<()> {
             }
         }
         if let Some(v) = pinch_off_v {
-            println!("pinch-off voltage {v:.1} V (a pocket of trapped carriers forms)");
+            outln!("pinch-off voltage {v:.1} V (a pocket of trapped carriers forms)");
         }
         match curve.depletion_voltage_v {
-            Some(v) => println!("full-depletion voltage {v:.1} V"),
-            None => println!("not fully depleted at any listed bias"),
+            Some(v) => outln!("full-depletion voltage {v:.1} V"),
+            None => outln!("not fully depleted at any listed bias"),
         }
-        println!(
+        outln!(
             "{} points in {seconds:.2} s ({} on {}{})",
             curve.points.len(),
             settings.method.as_str(),
@@ -277,9 +301,7 @@ pub(super) fn backend_json(settings: &FieldSettings) -> Result<serde_json::Value
     }))
 }
 
-fn write_csv(path: &std::path::Path, curve: &CvCurve) -> Result<()> {
-    let mut f = std::fs::File::create(path)
-        .with_context(|| format!("--out {}: cannot create the file", path.display()))?;
+fn write_csv(f: &mut impl Write, curve: &CvCurve) -> std::io::Result<()> {
     writeln!(f, "voltage_V,c12_pF,fully_depleted,c12_err_pF")?;
     for p in &curve.points {
         writeln!(
@@ -327,12 +349,12 @@ pub fn capacitance(
             "detector": det.file.display().to_string(),
             "version": env!("CARGO_PKG_VERSION"),
         });
-        println!("{v}");
+        outln!("{v}");
     } else {
-        println!("Maxwell capacitance matrix C* (pF, Q = C* U) at U_B = {voltage} V:");
-        print!("{:>28}", "");
+        outln!("Maxwell capacitance matrix C* (pF, Q = C* U) at U_B = {voltage} V:");
+        out!("{:>28}", "");
         for k in &det.contacts {
-            print!(
+            out!(
                 " {:>14}",
                 format!("{} ({})", k.id, k.name)
                     .chars()
@@ -340,9 +362,9 @@ pub fn capacitance(
                     .collect::<String>()
             );
         }
-        println!();
+        outln!();
         for (i, k) in det.contacts.iter().enumerate() {
-            print!(
+            out!(
                 "{:>28}",
                 format!("{} ({})", k.id, k.name)
                     .chars()
@@ -350,11 +372,11 @@ pub fn capacitance(
                     .collect::<String>()
             );
             for j in 0..det.contacts.len() {
-                print!(" {:>14.5}", c.energy_pf[i][j]);
+                out!(" {:>14.5}", c.energy_pf[i][j]);
             }
-            println!();
+            outln!();
         }
-        println!(
+        outln!(
             "c12 = -C*_12 = {:.5} pF (estimated error {:.2e} pF, {} adaptive passes); fully depleted: {}",
             p.c12_pf,
             p.accuracy.c12_err_pf,

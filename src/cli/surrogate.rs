@@ -3,6 +3,7 @@
 
 use std::path::Path;
 
+use super::args::check_outputs;
 use anyhow::{Context, Result};
 use hpge_surrogate::Surrogate;
 use hpge_surrogate::job::{
@@ -103,9 +104,12 @@ impl TrainProgress<'_> {
 /// Trains, evaluates on the test set and writes the model file and its learning curves.
 pub fn train(job: &TrainJob, plot: Option<&Path>, quiet: bool) -> Result<()> {
     job.check_out().map_err(|e| anyhow::anyhow!("--out {e}"))?;
-    let made_plot_dir = plot.filter(|d| !d.exists());
+    // The --plot folder (and the folders above it) made here, and the model file and learning
+    // curves the run writes, are removed again if a later step fails: all or nothing.
+    let mut staged = hpge_files::Staged::new();
     if let Some(dir) = plot {
-        std::fs::create_dir_all(dir)
+        staged
+            .make_folder(dir)
             .with_context(|| format!("--plot {}: cannot create the folder", dir.display()))?;
     }
     let mut progress = TrainProgress {
@@ -113,17 +117,12 @@ pub fn train(job: &TrainJob, plot: Option<&Path>, quiet: bool) -> Result<()> {
         quiet,
         bar: None,
     };
-    let outcome = match job.run(&mut |e| progress.event(e)) {
-        Ok(o) => o,
-        Err(e) => {
-            // No empty --plot folder left behind by a run that failed (the folder is removed
-            // only if this run made it and it is still empty).
-            if let Some(dir) = made_plot_dir {
-                let _ = std::fs::remove_dir(dir);
-            }
-            return Err(e.into());
-        }
-    };
+    let outcome = job.run(&mut |e| progress.event(e))?;
+    staged.adopt(&job.out);
+    if let Some(file) = &outcome.curves_file {
+        staged.adopt(file);
+        staged.adopt(&file.with_extension("json"));
+    }
     let model = &outcome.model;
     if let Some(dir) = plot {
         if !outcome.curves.is_empty() {
@@ -149,6 +148,7 @@ pub fn train(job: &TrainJob, plot: Option<&Path>, quiet: bool) -> Result<()> {
             )?;
         }
     }
+    super::args::commit(staged)?;
     let f = &model.info.test_figures;
     if !quiet {
         eprintln!(
@@ -191,14 +191,22 @@ pub fn calibrate(o: &CalibrateOptions) -> Result<()> {
 
 /// Accuracy of a model on a data set of its space.
 pub fn evaluate(o: &EvaluateOptions, json: bool, plot: Option<&Path>) -> Result<()> {
-    let model = Surrogate::load(&o.model)?;
     if let Some(dir) = plot {
-        std::fs::create_dir_all(dir)
-            .with_context(|| format!("--plot {}: cannot create the folder", dir.display()))?;
+        check_outputs(
+            &[("--plot", dir)],
+            &[("--model", o.model.as_path()), ("--data", o.data.as_path())],
+        )?;
     }
+    let model = Surrogate::load(&o.model)?;
     let data = read_for_model(&model, &o.model, &o.data)?;
     let ev = Evaluation::new(&model, &data, o.worst);
+    // The --plot folder made only once the inputs are read, and removed again (with the figures
+    // drawn so far) if a figure fails.
     if let Some(dir) = plot {
+        let mut staged = hpge_files::Staged::new();
+        staged
+            .make_folder(dir)
+            .with_context(|| format!("--plot {}: cannot create the folder", dir.display()))?;
         hpge_reports::plot::surrogate_errors(
             &ev.predictions,
             &data.c12_pf,
@@ -206,13 +214,14 @@ pub fn evaluate(o: &EvaluateOptions, json: bool, plot: Option<&Path>) -> Result<
             "evaluated",
             dir,
         )?;
+        super::args::commit(staged)?;
     }
     if json {
-        println!("{}", serde_json::to_string(&ev.json(&o.model, &o.data))?);
+        outln!("{}", serde_json::to_string(&ev.json(&o.model, &o.data))?);
         return Ok(());
     }
     let f = &ev.figures;
-    println!(
+    outln!(
         "model {} (recipe {}), data {}: {} samples ({} without c12 left out)",
         o.model.display(),
         model.info.recipe_name,
@@ -220,13 +229,13 @@ pub fn evaluate(o: &EvaluateOptions, json: bool, plot: Option<&Path>) -> Result<
         f.n,
         data.excluded
     );
-    println!(
+    outln!(
         "relative error (c_p - c_s)/c_s: Gaussian sigma {:.4}%, mean {:+.4}%, rms {:.4}%",
         100.0 * f.rel_sigma,
         100.0 * f.rel_mean,
         100.0 * f.rel_rms
     );
-    println!(
+    outln!(
         "|relative error| quantiles: 50% {:.4}%  90% {:.4}%  99% {:.4}%  99.9% {:.4}%  max {:.4}%",
         100.0 * f.abs_rel_q50,
         100.0 * f.abs_rel_q90,
@@ -234,12 +243,12 @@ pub fn evaluate(o: &EvaluateOptions, json: bool, plot: Option<&Path>) -> Result<
         100.0 * f.abs_rel_q999,
         100.0 * f.abs_rel_max
     );
-    println!(
+    outln!(
         "absolute error rms {:.4} pF; sigma_p of the model {:.4}%",
         f.abs_rms_pf,
         100.0 * model.sigma_p()
     );
-    println!(
+    outln!(
         "predicted uncertainty ({}): {:.1}% of the samples within 1 sigma, {:.1}% within 2",
         if ev.sigma_kind == "per-point" {
             "the calibrated per-point sigma_s"
@@ -249,7 +258,7 @@ pub fn evaluate(o: &EvaluateOptions, json: bool, plot: Option<&Path>) -> Result<
         100.0 * ev.coverage.0,
         100.0 * ev.coverage.1
     );
-    println!(
+    outln!(
         "edges: |relative error| of the rows in the lowest / highest {:.0}% of each input's u \
          (support: where >= {} training rows lie beyond{})",
         100.0 * hpge_surrogate::job::EDGE_FRACTION,
@@ -260,11 +269,19 @@ pub fn evaluate(o: &EvaluateOptions, json: bool, plot: Option<&Path>) -> Result<
             ", estimated from the training-row count"
         }
     );
-    println!(
+    outln!(
         "  {:<10} {:>6} {:>9} {:>9} {:>9} | {:>6} {:>9} {:>9} {:>9} | support",
-        "input", "n low", "median", "q90", "max", "n high", "median", "q90", "max"
+        "input",
+        "n low",
+        "median",
+        "q90",
+        "max",
+        "n high",
+        "median",
+        "q90",
+        "max"
     );
-    println!(
+    outln!(
         "  {:<10} {:>6} {:>8.4}% {:>8.4}% {:>8.4}% | {:>6} {:>8.4}% {:>8.4}% {:>8.4}% | all rows",
         "(all)",
         f.n,
@@ -277,7 +294,7 @@ pub fn evaluate(o: &EvaluateOptions, json: bool, plot: Option<&Path>) -> Result<
         100.0 * f.abs_rel_max
     );
     for e in &ev.edges {
-        println!(
+        outln!(
             "  {:<10} {:>6} {:>8.4}% {:>8.4}% {:>8.4}% | {:>6} {:>8.4}% {:>8.4}% {:>8.4}% | [{:.6}, {:.6}]",
             e.name,
             e.low.n,
@@ -293,16 +310,22 @@ pub fn evaluate(o: &EvaluateOptions, json: bool, plot: Option<&Path>) -> Result<
         );
     }
     if !ev.bias_bands.is_empty() {
-        println!(
+        outln!(
             "by bias: the rows in each band of U_B (Gaussian sigma, |relative error| quantiles, \
              fraction within 2 predicted sigma)"
         );
-        println!(
+        outln!(
             "  {:>15} {:>6} {:>9} {:>9} {:>9} {:>9} {:>9}",
-            "U_B (V)", "n", "sigma", "median", "q90", "q99", "in 2 sig"
+            "U_B (V)",
+            "n",
+            "sigma",
+            "median",
+            "q90",
+            "q99",
+            "in 2 sig"
         );
         for b in &ev.bias_bands {
-            println!(
+            outln!(
                 "  {:>7.0}-{:<7.0} {:>6} {:>8.3}% {:>8.3}% {:>8.3}% {:>8.3}% {:>8.1}%",
                 b.range_v[0],
                 b.range_v[1],
@@ -316,16 +339,22 @@ pub fn evaluate(o: &EvaluateOptions, json: bool, plot: Option<&Path>) -> Result<
         }
     }
     if !ev.regimes.is_empty() {
-        println!(
+        outln!(
             "by depletion regime (the data set's regime columns): Gaussian sigma, |relative \
              error| quantiles, fraction within 2 predicted sigma"
         );
-        println!(
+        outln!(
             "  {:>12} {:>6} {:>9} {:>9} {:>9} {:>9} {:>9}  rows",
-            "group", "n", "sigma", "median", "q90", "q99", "in 2 sig"
+            "group",
+            "n",
+            "sigma",
+            "median",
+            "q90",
+            "q99",
+            "in 2 sig"
         );
         for g in &ev.regimes {
-            println!(
+            outln!(
                 "  {:>12} {:>6} {:>8.3}% {:>8.3}% {:>8.3}% {:>8.3}% {:>8.1}%  {}",
                 g.group,
                 g.n,
@@ -338,14 +367,14 @@ pub fn evaluate(o: &EvaluateOptions, json: bool, plot: Option<&Path>) -> Result<
             );
         }
     }
-    println!("worst samples:");
+    outln!("worst samples:");
     for w in &ev.worst {
         let inputs: Vec<String> = w
             .inputs
             .iter()
             .map(|(n, v)| format!("{n}={v:.4}"))
             .collect();
-        println!(
+        outln!(
             "  #{:<7} c_s {:9.4} pF  c_p {:9.4} pF  rel {:+.3}%  {}",
             w.index,
             w.c12_solver_pf,
@@ -420,7 +449,7 @@ pub fn predict(o: &PredictOptions, json: bool) -> Result<()> {
             sigma_kind,
             program_version: env!("CARGO_PKG_VERSION"),
         };
-        println!("{}", serde_json::to_string(&j)?);
+        outln!("{}", serde_json::to_string(&j)?);
         return Ok(());
     }
     // The table on stdout is a plain CSV (`predict ... > c.csv` loads with pandas as it is);
@@ -445,7 +474,7 @@ pub fn predict(o: &PredictOptions, json: bool) -> Result<()> {
             header += &format!(",dc12/d{name}");
         }
     }
-    println!("{header}");
+    outln!("{header}");
     for k in 0..n {
         let mut line = format!("{},{:.6},{:.6}", voltages[k], c[k], sigma[k]);
         if ensemble {
@@ -456,7 +485,7 @@ pub fn predict(o: &PredictOptions, json: bool) -> Result<()> {
                 line += &format!(",{x:.6e}");
             }
         }
-        println!("{line}");
+        outln!("{line}");
     }
     Ok(())
 }

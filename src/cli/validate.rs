@@ -129,7 +129,7 @@ pub fn coverage(o: &CoverageOptions, as_json: bool, force: bool) -> Result<()> {
     let report = match outcome {
         CoverageOutcome::Done(r) => *r,
         CoverageOutcome::Partial { done, total } => {
-            println!(
+            outln!(
                 "shard {}/{} done; {done} of {total} truths of the study in {}: the report is \
                  written when every shard has run (run any shard, or the study without --shard, \
                  again then)",
@@ -161,35 +161,34 @@ pub fn coverage(o: &CoverageOptions, as_json: bool, force: bool) -> Result<()> {
         );
     }
     let path = out.join("coverage.json");
-    std::fs::write(&path, serde_json::to_string_pretty(&json)? + "\n")
+    hpge_files::write(&path, serde_json::to_string_pretty(&json)? + "\n")
         .with_context(|| format!("cannot write {}", path.display()))?;
     let path = out.join("ranks.csv");
-    let mut w = std::io::BufWriter::new(
-        std::fs::File::create(&path)
-            .with_context(|| format!("cannot create {}", path.display()))?,
-    );
     let names: Vec<&str> = report.parameters.iter().map(|p| p.name.as_str()).collect();
-    writeln!(w, "truth,{}", names.join(","))?;
-    for i in 0..report.n_truths {
-        let r: Vec<String> = report
-            .parameters
-            .iter()
-            .map(|p| p.ranks[i].to_string())
-            .collect();
-        writeln!(w, "{i},{}", r.join(","))?;
-    }
-    w.flush()?;
+    hpge_files::write_with(&path, |w| -> std::io::Result<()> {
+        writeln!(w, "truth,{}", names.join(","))?;
+        for i in 0..report.n_truths {
+            let r: Vec<String> = report
+                .parameters
+                .iter()
+                .map(|p| p.ranks[i].to_string())
+                .collect();
+            writeln!(w, "{i},{}", r.join(","))?;
+        }
+        Ok(())
+    })
+    .with_context(|| format!("cannot write {}", path.display()))?;
     hpge_reports::plot::coverage_figures(
         &out.join("figures"),
         &report,
         &hpge_reports::plot::coverage_title(&o.prior.display().to_string(), o.data_from().as_str()),
     )?;
     if as_json {
-        println!("{}", brief_json(&report));
+        outln!("{}", brief_json(&report));
         eprintln!("outputs in {}", out.display());
     } else {
-        print_report(&report, true);
-        println!("outputs in {}", out.display());
+        print_report(&report, true)?;
+        outln!("outputs in {}", out.display());
     }
     if !report.pass {
         std::process::exit(1);
@@ -315,10 +314,10 @@ fn coverage_progress(
             obj.insert("done".into(), done.into());
             obj.insert("total".into(), settings.n_truths.into());
         }
-        println!("{j}");
+        outln!("{j}");
         return Ok(());
     }
-    println!(
+    outln!(
         "progress of the study in {}: {done} of {} truths done (nothing run here; the bands \
          below are those of the truths done, and the study's verdict is the one at {})",
         out.display(),
@@ -326,7 +325,7 @@ fn coverage_progress(
         settings.n_truths
     );
     if let Some(r) = &report {
-        print_report(r, false);
+        print_report(r, false)?;
     }
     Ok(())
 }
@@ -356,10 +355,10 @@ fn brief_json(report: &CoverageReport) -> serde_json::Value {
 
 /// The report as text: the counts, the exact checks and a table of the parameters; `ran`: this
 /// process ran the study (else the truths done so far were only read).
-fn print_report(report: &CoverageReport, ran: bool) {
+fn print_report(report: &CoverageReport, ran: bool) -> Result<()> {
     let verdict = if report.pass { "PASS" } else { "FAIL" };
     if ran {
-        println!(
+        outln!(
             "{} truths ({} skipped, {} fits unconverged, {} taken back from an earlier run) in {:.0} s ({:.0} s of truths' work): {verdict}",
             report.n_truths,
             report.skipped,
@@ -369,35 +368,53 @@ fn print_report(report: &CoverageReport, ran: bool) {
             report.truth_seconds,
         );
     } else {
-        println!(
+        outln!(
             "{} truths ({} skipped, {} fits unconverged; {:.0} s of truths' work): so far {verdict}",
-            report.n_truths, report.skipped, report.unconverged, report.truth_seconds,
+            report.n_truths,
+            report.skipped,
+            report.unconverged,
+            report.truth_seconds,
         );
     }
     if let Some(u) = &report.unconverged_sampler {
-        println!(
+        outln!(
             "unconverged fits recording their sampler: {} ({} at the draw cap, {} at the clock); smallest ESS {:.0}, largest R-hat {:.4}",
-            u.recorded, u.max_draws, u.max_seconds, u.ess_min, u.rhat_max
+            u.recorded,
+            u.max_draws,
+            u.max_seconds,
+            u.ess_min,
+            u.rhat_max
         );
     }
     if let Some(c) = &report.exact_check {
-        println!(
+        outln!(
             "exact check of the fits: {} passed, {} failed after refinement; {:.2} rounds per fit on average, at most {}",
-            c.passed, c.failed, c.rounds_mean, c.rounds_max
+            c.passed,
+            c.failed,
+            c.rounds_mean,
+            c.rounds_max
         );
         if let Some(t) = c.seconds_split {
-            println!(
+            outln!(
                 "their wall time over the {} fits that record it: {:.0} s sampling, {:.0} s exact solves, {:.0} s error models",
-                c.split_truths, t.sampling, t.exact, t.error_model
+                c.split_truths,
+                t.sampling,
+                t.exact,
+                t.error_model
             );
         }
     }
-    println!(
+    outln!(
         "{:<10} {:>8} {:>10} {:>17} {:>10} {:>17}",
-        "parameter", "KS p", "cov 68.3%", "99% expected", "cov 95.5%", "99% expected"
+        "parameter",
+        "KS p",
+        "cov 68.3%",
+        "99% expected",
+        "cov 95.5%",
+        "99% expected"
     );
     for p in &report.parameters {
-        println!(
+        outln!(
             "{:<10} {:>8.3} {:>10.3} [{:.3}, {:.3}] {:>10.3} [{:.3}, {:.3}]",
             p.name,
             p.ks_p,
@@ -410,8 +427,9 @@ fn print_report(report: &CoverageReport, ran: bool) {
         );
     }
     for s in &report.subsets {
-        println!("{}", subset_line(s));
+        outln!("{}", subset_line(s));
     }
+    Ok(())
 }
 
 /// One line on a subset of the truths: its size, its verdict with its own bands and, where it

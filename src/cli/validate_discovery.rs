@@ -3,7 +3,7 @@
 //! checks that it names the hidden effect (none in the null case) and that the fit after adding
 //! it has chi^2/ndf consistent with 1.
 
-use std::io::Write as _;
+use std::fmt::Write as _;
 use std::sync::Arc;
 
 use anyhow::{Context, Result};
@@ -112,8 +112,12 @@ pub fn run(a: &DiscoveryArgs) -> Result<()> {
         let seed = o.seed + i as u64;
         let data = simulate_hidden(h, &s.exact, &start, &volts, seed)?;
         let csv = dir.join("cv.csv");
+        // The curve, its sidecar and the truth together, or none of them.
+        let mut staged = hpge_files::Staged::new();
+        staged.adopt(&csv);
         write_curve(&csv, &data)?;
-        super::sidecar::write(
+        super::sidecar::stage(
+            &mut staged,
             &csv,
             serde_json::json!({
                 "provenance": format!(
@@ -127,10 +131,11 @@ pub fn run(a: &DiscoveryArgs) -> Result<()> {
                 "truth": "truth.json",
             }),
         )?;
-        std::fs::write(
-            dir.join("truth.json"),
-            serde_json::to_string_pretty(h)? + "\n",
+        staged.write(
+            &dir.join("truth.json"),
+            (serde_json::to_string_pretty(h)? + "\n").as_bytes(),
         )?;
+        super::args::commit(staged)?;
         let (bar, sampling) = progress_printer(false);
         let printer = Printer::new(bar.clone(), sampling);
         let mut settings = settings.clone();
@@ -168,11 +173,11 @@ pub fn run(a: &DiscoveryArgs) -> Result<()> {
         outcomes,
         seconds: t0.elapsed().as_secs_f64(),
     };
-    std::fs::write(
+    hpge_files::write(
         o.out.join("summary.json"),
         serde_json::to_string_pretty(&study)? + "\n",
     )?;
-    let mut md = std::fs::File::create(o.out.join("summary.md"))?;
+    let mut md = String::new();
     writeln!(
         md,
         "# Hidden-effect tests of model discovery\n\n`hpge-cv validate discovery --seed {} --out {}` ({:.0} s). Pass: {}.\n",
@@ -207,8 +212,9 @@ pub fn run(a: &DiscoveryArgs) -> Result<()> {
             scores.join(", ")
         )?;
     }
+    hpge_files::write(o.out.join("summary.md"), md)?;
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&study)?);
+        outln!("{}", serde_json::to_string_pretty(&study)?);
     }
     eprintln!("outputs in {}", o.out.display());
     if !study.pass {

@@ -85,7 +85,12 @@ impl Checkpoint {
             }
         }
         let keep: Vec<PathBuf> = (0..saved.len()).map(|k| cp.path(k)).collect();
-        for f in files.iter().filter(|f| !keep.contains(f)) {
+        // Only what a fit writes here (`round-N.json` and the temporaries they are written
+        // through) is removed; any other file is left alone (issue 66).
+        for f in files
+            .iter()
+            .filter(|f| !keep.contains(f) && is_round_file(f))
+        {
             std::fs::remove_file(f).map_err(|source| Error::Io {
                 file: f.clone(),
                 action: "cannot remove a file of another run",
@@ -115,6 +120,24 @@ impl Checkpoint {
         })?;
         write_whole(&self.path(r.round.round), &text)
     }
+}
+
+/// Whether `f` is a file a fit writes into its rounds folder: `round-N.json`, a temporary of
+/// one (`.round-N.json.PID-K.tmp`, [`hpge_files::temp_beside`]) or an older version's
+/// `round-N.json.tmp`.
+fn is_round_file(f: &Path) -> bool {
+    if !f.is_file() {
+        return false;
+    }
+    let Some(name) = f.file_name().and_then(|n| n.to_str()) else {
+        return false;
+    };
+    let name = name.strip_prefix('.').unwrap_or(name);
+    let Some(rest) = name.strip_prefix("round-") else {
+        return false;
+    };
+    let digits = rest.chars().take_while(char::is_ascii_digit).count();
+    digits > 0 && rest[digits..].starts_with(".json")
 }
 
 /// The files in folder `dir`, which is made first if it does not exist (a checkpoint folder:
@@ -162,18 +185,48 @@ pub fn remove_stale(dir: &Path, stale: impl Fn(Option<&str>) -> bool) -> Result<
     Ok(())
 }
 
-/// Writes `text` to `path` whole or not at all: to `path.json.tmp` first, then renamed into
-/// place, so a kill never leaves a file cut short under the real name.
+/// Writes `text` to `path` whole or not at all ([`hpge_files::write`]: a temporary renamed into
+/// place), so a kill never leaves a file cut short under the real name.
 ///
 /// # Errors
 /// [`Error::Io`] naming the file.
 pub fn write_whole(path: &Path, text: &str) -> Result<()> {
-    let tmp = path.with_extension("json.tmp");
-    std::fs::write(&tmp, text)
-        .and_then(|()| std::fs::rename(&tmp, path))
-        .map_err(|source| Error::Io {
-            file: path.to_path_buf(),
-            action: "cannot write the file",
-            source,
-        })
+    hpge_files::write(path, text.as_bytes()).map_err(|source| Error::Io {
+        file: path.to_path_buf(),
+        action: "cannot write the file",
+        source,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Issue 66, cause 6: opening the rounds folder removes the rounds of another run and the
+    /// temporaries a kill left, never a file a fit does not write.
+    #[test]
+    fn open_removes_only_what_a_fit_writes() {
+        let out = std::env::temp_dir().join(format!("hpge-rounds-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&out);
+        let dir = out.join(ROUNDS_DIR);
+        std::fs::create_dir_all(dir.join("mine")).expect("folder");
+        for f in [
+            "notes.txt",
+            "round-0.json",
+            ".round-1.json.77-0.tmp",
+            "round-2.json.tmp",
+            "rounded.json",
+        ] {
+            std::fs::write(dir.join(f), "{\"fingerprint\": \"other\"}").expect("write");
+        }
+        let (_, saved) = Checkpoint::open(&out, "this".into()).expect("open");
+        assert!(saved.is_empty());
+        let mut left: Vec<String> = std::fs::read_dir(&dir)
+            .expect("list")
+            .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+            .collect();
+        left.sort();
+        assert_eq!(left, ["mine", "notes.txt", "rounded.json"]);
+        let _ = std::fs::remove_dir_all(&out);
+    }
 }

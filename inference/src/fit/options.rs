@@ -259,7 +259,7 @@ impl FitOptions {
     }
 
     /// Checks the numbers a user gives, naming the flag: `--max-seconds` and `--ess` must be
-    /// positive and finite, `--exact-draws` at least 1 (unless `--no-exact-check`),
+    /// positive and finite, `--exact-draws` at least 2 (unless `--no-exact-check`),
     /// `--refine-rounds` at least 1, and the sampler and likelihood known names.
     ///
     /// # Errors
@@ -289,12 +289,14 @@ impl FitOptions {
                 message: "at least 1 round (the plain surrogate's); 1 means no refinement".into(),
             });
         }
-        if self.exact_draws == 0 && !self.no_exact_check {
+        // One draw has no spread: its "shift in sd" would be 0/0 and its Pareto k-hat NaN, a
+        // check that passes on nothing (issue 66).
+        if self.exact_draws < 2 && !self.no_exact_check {
             return Err(Error::BadOption {
-                option: "--exact-draws 0".into(),
-                message:
-                    "the exact-solver check needs at least 1 draw; pass --no-exact-check to skip it"
-                        .into(),
+                option: format!("--exact-draws {}", self.exact_draws),
+                message: "the exact-solver check needs at least 2 draws (its Pareto k-hat at \
+                          least 21); pass --no-exact-check to skip it"
+                    .into(),
             });
         }
         Ok(())

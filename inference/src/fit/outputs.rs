@@ -5,7 +5,6 @@
 //! provenance (program version, inputs with hashes, sampler, seed, likelihood) is in
 //! `summary.json` (`program_version`, `inputs`, `settings`, `likelihood`).
 
-use std::io::Write as _;
 use std::path::Path;
 
 use super::Fit;
@@ -13,14 +12,9 @@ use super::truth::TruthRecord;
 use super::zeta::ZetaAtMode;
 use crate::{Error, Result};
 
-/// Writes `lines` (already newline-terminated) to `path`.
+/// Writes `text` (lines already newline-terminated) to `path`, whole or not at all.
 fn write_text(path: &Path, text: &str) -> Result<()> {
-    let mut f = std::fs::File::create(path).map_err(|source| Error::Io {
-        file: path.to_path_buf(),
-        action: "cannot create the file",
-        source,
-    })?;
-    f.write_all(text.as_bytes()).map_err(|source| Error::Io {
+    hpge_files::write(path, text.as_bytes()).map_err(|source| Error::Io {
         file: path.to_path_buf(),
         action: "cannot write the file",
         source,

@@ -52,6 +52,25 @@ pub fn read_truth(path: &Path, prior: &Prior) -> Result<Vec<Option<f64>>> {
             ),
         });
     }
+    // Checked here, before any sampling: a value the fit's outputs cannot place (NaN, or outside
+    // where the prior and the model live) is refused naming the file and the parameter.
+    for p in &prior.parameters {
+        let Some(&v) = table.get(&p.name) else {
+            continue;
+        };
+        let [lo, hi] = p.support;
+        if !v.is_finite() || v < lo || v > hi {
+            return Err(Error::Invalid {
+                file: path.to_path_buf(),
+                key: p.name.clone(),
+                message: format!(
+                    "{v}: a truth must be a finite number inside the parameter's support \
+                     [{lo}, {hi}] (the prior {}'s domain)",
+                    prior.name
+                ),
+            });
+        }
+    }
     Ok(names.iter().map(|n| table.get(n).copied()).collect())
 }
 

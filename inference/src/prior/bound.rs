@@ -121,10 +121,24 @@ impl Prior {
                     }
                     dom
                 }
-                PriorDistribution::TruncatedNormal { lo, hi, .. } => {
+                PriorDistribution::TruncatedNormal { mean, sd, lo, hi } => {
                     let (a, b) = (lo.unwrap_or(dom[0]), hi.unwrap_or(dom[1]));
                     if a < dom[0] || b > dom[1] {
                         return Err(outside("truncation", a, b));
+                    }
+                    // A normal whose mass on [a, b] is nil has no density there: every draw
+                    // from the prior would have zero posterior density (issue 66).
+                    let x = PriorDistribution::TruncatedNormal { mean, sd, lo, hi };
+                    if !x.ln_pdf(0.5 * (a + b), [a, b]).is_finite() {
+                        return Err(Error::invalid(
+                            file,
+                            key.clone(),
+                            format!(
+                                "truncated-normal({mean}, {sd}) has no mass on [{a}, {b}] (the \
+                                 mean is {:.0} sd away): no value there has a prior density",
+                                ((mean - 0.5 * (a + b)).abs() - 0.5 * (b - a)) / sd
+                            ),
+                        ));
                     }
                     [a, b]
                 }

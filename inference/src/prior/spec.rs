@@ -78,6 +78,18 @@ impl PriorSpec {
             if p.name.is_empty() {
                 return Err(bad(key, "empty name".into()));
             }
+            // The name becomes a column of samples.csv: nothing that breaks a CSV header
+            // (issue 66).
+            if p.name
+                .chars()
+                .any(|c| c == ',' || c == '"' || c.is_control())
+            {
+                return Err(bad(
+                    format!("parameters[{i}] ({:?})", p.name),
+                    "the name may not hold a comma, a quote or a line break (it is a CSV column)"
+                        .into(),
+                ));
+            }
             if self.parameters[..i].iter().any(|q| q.name == p.name) {
                 return Err(bad(key, "the name is used twice".into()));
             }

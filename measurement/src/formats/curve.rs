@@ -11,6 +11,19 @@ use crate::types::CvData;
 /// The header of a curve file.
 const HEADER: [&str; 3] = ["voltage_V", "c12_pF", "sigma_pF"];
 
+/// `x` as written by `{}`, or in exponent form where that would be long (1e300, not 300 digits).
+fn short(x: f64) -> String {
+    if x != 0.0 && !(1e-4..1e15).contains(&x.abs()) {
+        format!("{x:e}")
+    } else {
+        format!("{x}")
+    }
+}
+
+/// The largest capacitance or uncertainty (pF) a measured curve may hold: 1 uF, far beyond any
+/// detector, far below where squares overflow (issue 66).
+pub(crate) const MAX_PF: f64 = 1e6;
+
 /// Relative tolerance of the covariance symmetry, against sqrt(c_ii c_jj).
 const SYMMETRY_TOLERANCE: f64 = 1e-9;
 
@@ -101,18 +114,27 @@ pub fn read_curve(csv: &Path, covariance: Option<&Path>) -> Result<CvData> {
                 ),
             ));
         }
-        if c <= 0.0 {
+        if c <= 0.0 || c > MAX_PF {
             return Err(Error::invalid(
                 csv,
                 "c12_pF",
-                format!("line {}: c12 = {c} pF, must be above 0", row.line),
+                format!(
+                    "line {}: c12 = {} pF, must be above 0 and at most {MAX_PF:e} pF (beyond \
+                     any detector's capacitance; a fit's likelihood would overflow)",
+                    row.line,
+                    short(c)
+                ),
             ));
         }
-        if s <= 0.0 {
+        if s <= 0.0 || s > MAX_PF {
             return Err(Error::invalid(
                 csv,
                 "sigma_pF",
-                format!("line {}: sigma = {s} pF, must be above 0", row.line),
+                format!(
+                    "line {}: sigma = {} pF, must be above 0 and at most {MAX_PF:e} pF",
+                    row.line,
+                    short(s)
+                ),
             ));
         }
         voltage_v.push(v);
@@ -217,7 +239,7 @@ pub fn write_curve_with_comments(csv: &Path, data: &CvData, comments: &[String])
 }
 
 /// The sibling covariance file of a curve: `<stem>.covariance.csv`.
-fn covariance_path(csv: &Path) -> PathBuf {
+pub fn covariance_path(csv: &Path) -> PathBuf {
     let mut name = csv
         .file_stem()
         .map_or_else(OsString::new, |s| s.to_os_string());

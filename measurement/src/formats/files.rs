@@ -20,9 +20,10 @@ pub(crate) fn read_text(file: &Path) -> Result<String> {
     })
 }
 
-/// Writes a file, naming it in the error.
+/// Writes a file whole or not at all (a temporary renamed onto it: [`hpge_files::write`]),
+/// naming it in the error.
 pub(crate) fn write_file(file: &Path, contents: &[u8]) -> Result<()> {
-    std::fs::write(file, contents).map_err(|source| Error::Io {
+    hpge_files::write(file, contents).map_err(|source| Error::Io {
         file: file.to_path_buf(),
         action: "cannot write the file",
         source,

@@ -16,7 +16,7 @@
 //!
 //! Every error names the file and, where it applies, the key, column, line or pulse at fault.
 
-mod curve;
+pub(crate) mod curve;
 mod files;
 mod lh5;
 mod npy;
@@ -25,7 +25,9 @@ mod sidecar;
 
 use std::path::Path;
 
-pub use curve::{read_curve, read_model_curve, write_curve, write_curve_with_comments};
+pub use curve::{
+    covariance_path, read_curve, read_model_curve, write_curve, write_curve_with_comments,
+};
 pub use lh5::read_lh5_pulses;
 pub use npy::{read_pulses, write_pulses};
 pub use raw_dir::{PulseFormat, RawProblem, RawRun, read_pulse_file, read_raw_dir};

@@ -38,7 +38,7 @@ pub fn write_residuals(path: &Path, d: &Discovery) -> Result<()> {
             after.check.residuals[k]
         );
     }
-    std::fs::write(path, f).map_err(Error::io(path, "cannot write"))
+    hpge_files::write(path, f).map_err(Error::io(path, "cannot write"))
 }
 
 /// Writes a discovery's outputs into `out`: `discovery.json`, `residuals.csv`, `report.md` and
@@ -53,7 +53,7 @@ pub fn write_outputs(
     no_plots: bool,
 ) -> Result<()> {
     let json = out.join("discovery.json");
-    std::fs::write(&json, serde_json::to_string_pretty(&d.summary)? + "\n")
+    hpge_files::write(&json, serde_json::to_string_pretty(&d.summary)? + "\n")
         .map_err(Error::io(&json, "cannot write"))?;
     write_residuals(&out.join("residuals.csv"), d)?;
     let figures = if no_plots {

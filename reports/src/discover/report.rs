@@ -174,6 +174,6 @@ pub fn write_report(path: &Path, d: &Discovery, figures: &[PathBuf]) -> Result<(
         "\nFiles: `discovery.json` (everything above), `residuals.csv` (per voltage: data, both \
          models at their modes, sigma, residuals)."
     );
-    std::fs::write(path, m).map_err(Error::io(path, "cannot write"))?;
+    hpge_files::write(path, m).map_err(Error::io(path, "cannot write"))?;
     Ok(())
 }

@@ -69,11 +69,43 @@ pub fn run_fit(o: &FitOptions, observer: &dyn FitObserver) -> Result<FitRun> {
         job.warnings.push(w);
     }
     let truth = match &o.truth {
-        Some(p) => Some(read_truth(p, &job.prior)?),
+        Some(p) => Some(read_truth(p, &job.prior).map_err(|e| Error::from(e).context("--truth"))?),
         None => None,
     };
     job.posterior()?;
     let out = o.out_dir();
+    // No output of the fit over one of its inputs (issue 66).
+    let mut inputs: Vec<(&str, &Path)> = vec![
+        ("--data", o.data.as_path()),
+        ("--model", o.model.as_path()),
+        ("--prior", o.prior.as_path()),
+        ("--detector", o.detector.as_path()),
+    ];
+    if let Some(t) = &o.truth {
+        inputs.push(("--truth", t.as_path()));
+    }
+    for name in [
+        "summary.json",
+        "samples.csv",
+        "predictive.csv",
+        "zeta-mode.csv",
+        "report.md",
+        outputs::ERROR_MODEL_FILE,
+        "figures",
+        "rounds",
+    ] {
+        if let Some((flag, input)) = hpge_files::first_overlap(&out.join(name), &inputs) {
+            return Err(Error::Output {
+                flag: "--out".into(),
+                file: out.clone(),
+                message: format!(
+                    "the fit's {name} there would be written over the input {flag} {}; choose \
+                     another folder",
+                    input.display()
+                ),
+            });
+        }
+    }
     // A folder holding another run's fit is refused unless `--force` (issue 69).
     if let Some(w) = crate::replace::check_replace(
         &out.join("summary.json"),
@@ -126,6 +158,20 @@ pub fn run_fit(o: &FitOptions, observer: &dyn FitObserver) -> Result<FitRun> {
         });
         (refined.fit, file)
     };
+    // The outputs of this run, each written whole; if a later one fails, those written before
+    // it are removed again (issue 66): summary.json, written last, marks a complete fit. The
+    // rounds (OUT/rounds/) stay, for a rerun to take back.
+    let mut staged = hpge_files::Staged::new();
+    for name in [
+        outputs::ERROR_MODEL_FILE,
+        "samples.csv",
+        "predictive.csv",
+        "zeta-mode.csv",
+        "report.md",
+        "summary.json",
+    ] {
+        staged.adopt(&out.join(name));
+    }
     if let Some(file) = &correction {
         outputs::write_error_model(&out.join(outputs::ERROR_MODEL_FILE), file)?;
     }
@@ -136,6 +182,11 @@ pub fn run_fit(o: &FitOptions, observer: &dyn FitObserver) -> Result<FitRun> {
         obj.insert("run".into(), o.run_args().into());
     }
     outputs::write_summary(&out.join("summary.json"), &summary_json)?;
+    staged.commit().map_err(|(file, source)| Error::Io {
+        file,
+        action: "cannot write",
+        source,
+    })?;
     Ok(FitRun {
         job,
         fit,

@@ -348,7 +348,7 @@ pub fn write_report(
         r,
         "Files: `samples.csv` (chain, draw, parameters, ln posterior), `summary.json`, `predictive.csv` (c_p - c_m bands per voltage), `zeta-mode.csv` (zeta at the global mode, the posterior's 68.3% and 95.5% bands, the truth where given), `figures/`; after refinement `error-model.json` (the error model's exact curves and hyperparameters) and `rounds/` (each round's check and exact curves, what a restarted fit takes back)."
     );
-    std::fs::write(path, r).map_err(Error::io(path, "cannot write"))
+    hpge_files::write(path, r).map_err(Error::io(path, "cannot write"))
 }
 
 #[cfg(test)]

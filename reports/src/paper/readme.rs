@@ -127,7 +127,7 @@ pub fn write(ctx: &Ctx, total_s: f64) -> Result<PathBuf> {
     }
     writeln!(t, "| **total** | **{total_s:.1}** |")?;
     let readme = ctx.out.join("README.md");
-    std::fs::write(&readme, t).map_err(Error::io(&readme, "cannot write"))?;
+    hpge_files::write(&readme, t).map_err(Error::io(&readme, "cannot write"))?;
     let j = json!({
         "program": crate::provenance::PROGRAM,
         "version": crate::provenance::VERSION,
@@ -141,7 +141,7 @@ pub fn write(ctx: &Ctx, total_s: f64) -> Result<PathBuf> {
         "numbers": ctx.numbers,
     });
     let path = ctx.out.join("report.json");
-    std::fs::write(&path, serde_json::to_string_pretty(&j)? + "\n")
+    hpge_files::write(&path, serde_json::to_string_pretty(&j)? + "\n")
         .map_err(Error::io(&path, "cannot write"))?;
     Ok(readme)
 }

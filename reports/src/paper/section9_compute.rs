@@ -4,7 +4,6 @@
 //! model with d_Li = 3 mm and the global modes of the B_Z and B_RZ fits; ADL drift with its
 //! published 78 K parameters.
 
-use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
 use super::models::{ModeDetectors, NamedModel, manufacturer};
@@ -309,9 +308,7 @@ fn figures(out: &Path, inputs: &Section9Inputs, res: &[ModelResult]) -> Result<V
 }
 
 fn write_text(path: &Path, text: &str) -> Result<PathBuf> {
-    let mut f = std::fs::File::create(path).map_err(Error::io(path, "cannot create the file"))?;
-    f.write_all(text.as_bytes())
-        .map_err(Error::io(path, "cannot write the file"))?;
+    hpge_files::write(path, text).map_err(Error::io(path, "cannot write the file"))?;
     Ok(path.to_path_buf())
 }
 

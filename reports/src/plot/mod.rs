@@ -6,7 +6,7 @@
 //! and log-axis labels that most figures share, `colormap` the colours of signed densities.
 
 #[macro_use]
-mod render;
+pub(crate) mod render;
 
 mod colormap;
 mod convergence;

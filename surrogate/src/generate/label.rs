@@ -314,7 +314,7 @@ pub fn label(
         });
     } else {
         let text = serde_json::to_string_pretty(&info).unwrap_or_default();
-        std::fs::write(&info_path, text + "\n").map_err(io(&info_path, "cannot write"))?;
+        hpge_files::write(&info_path, text + "\n").map_err(io(&info_path, "cannot write"))?;
     }
     let (existing, _) = if rows_path.exists() {
         read_rows(&rows_path, &info.header, true)?
@@ -427,9 +427,7 @@ pub fn label(
             text.push_str(line);
             text.push('\n');
         }
-        let tmp = out.join("rows.csv.tmp");
-        std::fs::write(&tmp, text).map_err(io(&tmp, "cannot write"))?;
-        std::fs::rename(&tmp, &rows_path).map_err(io(&rows_path, "cannot replace"))?;
+        hpge_files::write(&rows_path, text).map_err(io(&rows_path, "cannot replace"))?;
         report.sorted = true;
     }
     Ok(report)

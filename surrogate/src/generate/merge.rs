@@ -31,6 +31,7 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<MergeReport> {
         return Err(arg("no shard folders given".into()));
     }
     check_out_outside(dirs, out)?;
+    check_out_outside(dirs, &sidecar_path(out))?;
     let mut first: Option<RunInfo> = None;
     let mut seen_k = Vec::new();
     let mut rows: BTreeMap<u64, String> = BTreeMap::new();
@@ -102,35 +103,24 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<MergeReport> {
             source: e,
         }
     };
-    // Written beside `out` and renamed into place: an interrupted or failed write leaves no
-    // partial file under the name asked for.
-    let tmp = temp_beside(out);
-    let written = (|| -> std::io::Result<usize> {
-        let mut f = std::io::BufWriter::new(std::fs::File::create(&tmp)?);
-        writeln!(f, "{}", info.header)?;
-        let mut failed = 0;
-        let status = status_column(&info.header);
-        for line in rows.values() {
-            if solve_failed(status, line) {
-                failed += 1;
+    // Both files written to temporaries beside them and renamed into place together: an
+    // interrupted or failed write leaves neither under the names asked for (issue 66).
+    let side = sidecar_path(out);
+    let mut staged = hpge_files::Staged::new();
+    let mut failed = 0;
+    staged
+        .write_with(out, |f| -> std::io::Result<()> {
+            writeln!(f, "{}", info.header)?;
+            let status = status_column(&info.header);
+            for line in rows.values() {
+                if solve_failed(status, line) {
+                    failed += 1;
+                }
+                writeln!(f, "{line}")?;
             }
-            writeln!(f, "{line}")?;
-        }
-        f.into_inner().map_err(|e| e.into_error())?.sync_all()?;
-        Ok(failed)
-    })();
-    let failed = match written {
-        Ok(n) => n,
-        Err(e) => {
-            let _ = std::fs::remove_file(&tmp);
-            return Err(io("cannot write")(e));
-        }
-    };
-    if let Err(e) = std::fs::rename(&tmp, out) {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(io("cannot write")(e));
-    }
-    let side = out.with_extension("json");
+            Ok(())
+        })
+        .map_err(io("cannot write"))?;
     let text = serde_json::to_string_pretty(&serde_json::json!({
         "fingerprint": fp,
         "header": info.header,
@@ -140,10 +130,17 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<MergeReport> {
         "version": env!("CARGO_PKG_VERSION"),
     }))
     .unwrap_or_default();
-    std::fs::write(&side, text + "\n").map_err(|e| Error::Io {
-        file: side.clone(),
+    staged
+        .write(&side, (text + "\n").as_bytes())
+        .map_err(|e| Error::Io {
+            file: side.clone(),
+            action: "cannot write",
+            source: e,
+        })?;
+    staged.commit().map_err(|(file, source)| Error::Io {
+        file,
         action: "cannot write",
-        source: e,
+        source,
     })?;
     Ok(MergeReport {
         rows: rows.len(),
@@ -152,11 +149,17 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<MergeReport> {
     })
 }
 
-/// `<file>.tmp` beside `file`.
-fn temp_beside(file: &Path) -> PathBuf {
-    let mut name = file.as_os_str().to_os_string();
-    name.push(".tmp");
-    PathBuf::from(name)
+/// The merge's sidecar: `<stem>.json` beside the merged CSV, `<name>.json` when the CSV's own
+/// name ends in `.json` (never the merged rows' own file).
+pub fn sidecar_path(out: &Path) -> PathBuf {
+    let p = out.with_extension("json");
+    if p == out {
+        let mut name = out.as_os_str().to_os_string();
+        name.push(".json");
+        PathBuf::from(name)
+    } else {
+        p
+    }
 }
 
 /// Refuses an output inside one of the shard folders: `--out s1/rows.csv` would overwrite the
@@ -164,16 +167,8 @@ fn temp_beside(file: &Path) -> PathBuf {
 /// as part of the shard by a later `generate` or `merge`. Compared after resolving `.`, `..` and
 /// links, so `./s1/../s1/rows.csv` is caught as well.
 fn check_out_outside(dirs: &[PathBuf], out: &Path) -> Result<()> {
-    let parent = match out.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    };
-    let Ok(parent) = parent.canonicalize() else {
-        // A folder that does not exist is no shard folder; creating the file will say so.
-        return Ok(());
-    };
     for d in dirs {
-        if d.canonicalize().is_ok_and(|d| d == parent) {
+        if hpge_files::overlaps(out, d) {
             return Err(Error::Argument {
                 name: "--out".into(),
                 message: format!(

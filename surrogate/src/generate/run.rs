@@ -237,7 +237,7 @@ pub fn run(
         });
     } else {
         let text = serde_json::to_string_pretty(&info).unwrap_or_default();
-        std::fs::write(&info_path, text + "\n").map_err(io(&info_path, "cannot write"))?;
+        hpge_files::write(&info_path, text + "\n").map_err(io(&info_path, "cannot write"))?;
     }
     let (existing, repaired) = if rows_path.exists() {
         read_rows(&rows_path, &info.header, true)?
@@ -274,9 +274,7 @@ pub fn run(
                 text.push('\n');
             }
         }
-        let tmp = out.join("rows.csv.tmp");
-        std::fs::write(&tmp, text).map_err(io(&tmp, "cannot write"))?;
-        std::fs::rename(&tmp, &rows_path).map_err(io(&rows_path, "cannot replace"))?;
+        hpge_files::write(&rows_path, text).map_err(io(&rows_path, "cannot replace"))?;
         done.retain(|i| !drop.contains(i));
         repaired |= partial
             .iter()

@@ -149,6 +149,9 @@ pub struct Sample {
     pub seconds: f64,
 }
 
+/// The most rows one `generate` run makes (`--n`).
+pub const MAX_ROWS: u64 = 100_000_000;
+
 impl Generator {
     /// Sets up a run; checks the arguments against the space, the detector and the sequence.
     #[allow(clippy::too_many_arguments)]
@@ -170,6 +173,18 @@ impl Generator {
             return Err(arg(
                 "--n",
                 "the number of samples must be at least 1".into(),
+            ));
+        }
+        // Bounded before anything grows with it (the run's work list, its index set): far
+        // above any set the solver can make (each row takes seconds of CPU), far below what
+        // would exhaust the memory (issue 66).
+        if n > MAX_ROWS {
+            return Err(arg(
+                "--n",
+                format!(
+                    "{n}: at most {MAX_ROWS} rows per run (each takes seconds of CPU); split a \
+                     larger set into runs with --offset"
+                ),
             ));
         }
         let sequence = Sequence::new(kind, space.sampled_dim(), seed);

@@ -2,7 +2,6 @@
 //! checkpoints of finished ensemble members (`NAME.partial/member-M.safetensors` with
 //! `member-M.curves.csv`), from which an interrupted run resumes.
 
-use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
 use crate::model::{EpochRecord, Member, ModelInfo, Predictor, Recipe, Surrogate};
@@ -28,7 +27,6 @@ pub fn write_curves(path: &Path, curves: &[EpochRecord], model: &Path) -> Result
         file: path.into(),
         source,
     };
-    let mut f = std::fs::File::create(path).map_err(failed)?;
     let mut text =
         String::from("member,epoch,cycle,lr,train_loss,test_loss,test_rel_rms,seconds\n");
     for r in curves {
@@ -37,7 +35,7 @@ pub fn write_curves(path: &Path, curves: &[EpochRecord], model: &Path) -> Result
             r.member, r.epoch, r.cycle, r.lr, r.train_loss, r.test_loss, r.test_rel_rms, r.seconds
         );
     }
-    f.write_all(text.as_bytes()).map_err(failed)?;
+    hpge_files::write(path, text.as_bytes()).map_err(failed)?;
     let sidecar = path.with_extension("json");
     let meta = serde_json::json!({
         "program": "hpge-cv",
@@ -46,7 +44,7 @@ pub fn write_curves(path: &Path, curves: &[EpochRecord], model: &Path) -> Result
         "model": model.display().to_string(),
         "csv": path.file_name().map(|n| n.to_string_lossy().into_owned()),
     });
-    std::fs::write(&sidecar, format!("{meta:#}\n")).map_err(|source| Error::RunFile {
+    hpge_files::write(&sidecar, format!("{meta:#}\n").as_bytes()).map_err(|source| Error::RunFile {
         action: "cannot write the learning curves' sidecar",
         file: sidecar.clone(),
         source,

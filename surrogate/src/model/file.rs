@@ -174,6 +174,18 @@ impl Surrogate {
                     .map(|c| f64::from_le_bytes(c.try_into().expect("8 bytes")))
                     .collect(),
             };
+            // A weight that is not a number would make every prediction NaN (issue 66).
+            let data: Vec<f64> = data;
+            if let Some(k) = data.iter().position(|v| !v.is_finite()) {
+                return Err(bad(
+                    name,
+                    format!(
+                        "element {k} is {}: a model's weights must be finite numbers (a \
+                         training that diverged, or a damaged file)",
+                        data[k]
+                    ),
+                ));
+            }
             Ok((t.shape().to_vec(), data))
         };
         let n_params = info.space.dim().saturating_sub(1);
@@ -260,12 +272,5 @@ impl Surrogate {
 /// model, and the file gets the permissions of every other output (0666 less the umask, 0644
 /// usually; safetensors' own `serialize_to_file` goes through a temporary file created 0600).
 fn write_replacing(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    let mut name = path.as_os_str().to_os_string();
-    name.push(".tmp");
-    let tmp = std::path::PathBuf::from(name);
-    let written = std::fs::write(&tmp, bytes).and_then(|()| std::fs::rename(&tmp, path));
-    if written.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    written
+    hpge_files::write(path, bytes)
 }

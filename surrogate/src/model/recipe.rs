@@ -136,6 +136,18 @@ pub const RECIPES: [&str; 11] = [
 /// q99 in the prototype comparison of `reports/surrogate.md`).
 pub const STEPS: usize = 16;
 
+/// The widest layer `--trunk` and `--head` accept.
+pub const MAX_WIDTH: usize = 16_384;
+
+/// The most weights one network of a reshaped recipe may have (the paper's has about 0.1
+/// million).
+pub const MAX_WEIGHTS: u128 = 20_000_000;
+
+/// Widths as the flags take them: `256,256`.
+fn join(w: &[usize]) -> String {
+    w.iter().map(usize::to_string).collect::<Vec<_>>().join(",")
+}
+
 impl Recipe {
     /// The recipe called `name` (one of [`RECIPES`]).
     pub fn named(name: &str) -> Result<Self> {
@@ -448,6 +460,23 @@ impl Recipe {
         head: Option<Vec<usize>>,
         members: Option<usize>,
     ) -> Result<Self> {
+        // The flags' own widths checked here, naming the flag (not the recipe), and bounded
+        // before any network is allocated (issue 66).
+        for (flag, widths) in [("--trunk", &trunk), ("--head", &head)] {
+            let Some(w) = widths else { continue };
+            if w.is_empty() && flag == "--head" {
+                return Err(Error::Argument {
+                    name: flag.into(),
+                    message: "no layers: the head needs at least one".into(),
+                });
+            }
+            if let Some(&bad) = w.iter().find(|&&x| x == 0 || x > MAX_WIDTH) {
+                return Err(Error::Argument {
+                    name: format!("{flag} {}", join(w)),
+                    message: format!("a layer width of {bad}: each must be 1 to {MAX_WIDTH}"),
+                });
+            }
+        }
         if let Some(t) = trunk {
             self.architecture.trunk = t;
         }
@@ -463,8 +492,38 @@ impl Recipe {
             }
             self.members = m;
         }
+        let weights = self.approximate_weights();
+        if weights > MAX_WEIGHTS {
+            return Err(Error::Argument {
+                name: format!(
+                    "--trunk {} --head {}",
+                    join(&self.architecture.trunk),
+                    join(&self.architecture.head)
+                ),
+                message: format!(
+                    "a network of about {weights} weights; at most {MAX_WEIGHTS} (consecutive \
+                     widths multiply)"
+                ),
+            });
+        }
         self.validate()?;
         Ok(self)
+    }
+
+    /// About how many weights one member has (the model's few inputs counted as 16).
+    fn approximate_weights(&self) -> u128 {
+        let mut prev: u128 = 16;
+        let mut n: u128 = 0;
+        for &w in &self.architecture.trunk {
+            n += prev * w as u128 + w as u128;
+            prev = w as u128;
+        }
+        prev += 1;
+        for &w in &self.architecture.head {
+            n += prev * w as u128 + w as u128;
+            prev = w as u128;
+        }
+        n + prev
     }
 
     /// This recipe with decoupled weight decay (AdamW) of `weight_decay` per unit learning rate

@@ -177,11 +177,21 @@ impl ParameterSpace {
                     ),
                 ));
             }
-            if d.name.trim().is_empty() || d.name.contains(',') {
+            // The name becomes a column of rows.csv: nothing that breaks a CSV header (a comma,
+            // a quote, a line break or another control character; issue 66).
+            if d.name.trim().is_empty()
+                || d.name
+                    .chars()
+                    .any(|c| c == ',' || c == '"' || c.is_control())
+            {
                 return Err(bad(
                     k,
                     "name",
-                    "must be non-empty and without commas".into(),
+                    format!(
+                        "{:?}: must be non-empty and without commas, quotes or line breaks (it \
+                         is a CSV column)",
+                        d.name
+                    ),
                 ));
             }
             if self.dimensions[..k].iter().any(|e| e.name == d.name) {
