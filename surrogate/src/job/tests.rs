@@ -269,7 +269,7 @@ fn the_recipes_widths_and_members_can_be_replaced() {
                 head: Some(vec![4, 0]),
                 ..job.clone()
             },
-            "recipe",
+            "--head 4,0",
         ),
         (
             TrainJob {
