@@ -150,39 +150,6 @@ pub fn with_detector_provenance(mut v: serde_json::Value, det: &Detector) -> ser
     v
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn points() {
-        assert_eq!(parse_point("20,35").unwrap(), (20.0, 35.0));
-        assert_eq!(parse_point(" 37.5 , -5 ").unwrap(), (37.5, -5.0));
-        assert!(parse_point("20").unwrap_err().contains("expected R,Z"));
-        assert!(parse_point("a,1").unwrap_err().contains("not a number"));
-        assert!(parse_point("-1,1").unwrap_err().contains("R must be >= 0"));
-        assert!(parse_point("1,nan").unwrap_err().contains("finite"));
-    }
-
-    #[test]
-    fn cylindrical_points_and_radius_ranges() {
-        assert_eq!(parse_cylindrical("37,30,35").unwrap(), (37.0, 30.0, 35.0));
-        assert!(parse_cylindrical("37,30").unwrap_err().contains("R,PHI,Z"));
-        assert!(parse_cylindrical("37,x,35").unwrap_err().contains("PHI"));
-        assert!(
-            parse_cylindrical("-1,0,35")
-                .unwrap_err()
-                .contains("R must be")
-        );
-        let r = parse_r_range("0:10:11").unwrap().0;
-        assert_eq!(r.len(), 11);
-        assert!((r[3] - 3.0).abs() < 1e-12);
-        assert!(parse_r_range("5:1:10").is_err());
-        assert!(parse_r_range("0:1:1").is_err());
-        assert!(parse_r_range("0:1").is_err());
-    }
-}
-
 /// The input files of a [`DetectorInput`] as (flag, path).
 pub fn detector_inputs(input: &DetectorInput) -> Vec<(&'static str, &std::path::Path)> {
     let mut v = vec![("--detector", input.detector.as_path())];
@@ -239,5 +206,38 @@ pub fn short(x: f64) -> String {
         format!("{x:e}")
     } else {
         format!("{x}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn points() {
+        assert_eq!(parse_point("20,35").unwrap(), (20.0, 35.0));
+        assert_eq!(parse_point(" 37.5 , -5 ").unwrap(), (37.5, -5.0));
+        assert!(parse_point("20").unwrap_err().contains("expected R,Z"));
+        assert!(parse_point("a,1").unwrap_err().contains("not a number"));
+        assert!(parse_point("-1,1").unwrap_err().contains("R must be >= 0"));
+        assert!(parse_point("1,nan").unwrap_err().contains("finite"));
+    }
+
+    #[test]
+    fn cylindrical_points_and_radius_ranges() {
+        assert_eq!(parse_cylindrical("37,30,35").unwrap(), (37.0, 30.0, 35.0));
+        assert!(parse_cylindrical("37,30").unwrap_err().contains("R,PHI,Z"));
+        assert!(parse_cylindrical("37,x,35").unwrap_err().contains("PHI"));
+        assert!(
+            parse_cylindrical("-1,0,35")
+                .unwrap_err()
+                .contains("R must be")
+        );
+        let r = parse_r_range("0:10:11").unwrap().0;
+        assert_eq!(r.len(), 11);
+        assert!((r[3] - 3.0).abs() < 1e-12);
+        assert!(parse_r_range("5:1:10").is_err());
+        assert!(parse_r_range("0:1:1").is_err());
+        assert!(parse_r_range("0:1").is_err());
     }
 }
