@@ -191,6 +191,23 @@ pub fn check_outputs<O: AsRef<std::path::Path>>(
     Ok(())
 }
 
+/// The outputs of a command with a CSV `--out` (and its sidecar) and a `--plot` figure, named
+/// by flag, for [`check_outputs`].
+pub fn csv_and_plot_outputs(
+    out: Option<&std::path::Path>,
+    plot: Option<&std::path::Path>,
+) -> Vec<(&'static str, std::path::PathBuf)> {
+    let mut outputs = Vec::new();
+    if let Some(p) = out {
+        outputs.push(("--out", p.to_path_buf()));
+        outputs.push(("--out's sidecar", super::sidecar::path(p)));
+    }
+    if let Some(p) = plot {
+        outputs.push(("--plot", p.to_path_buf()));
+    }
+    outputs
+}
+
 /// Puts a command's staged outputs under their names ([`hpge_files::Staged::commit`]), naming
 /// the file that could not be renamed.
 pub fn commit(outputs: hpge_files::Staged) -> Result<()> {

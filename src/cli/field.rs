@@ -50,14 +50,7 @@ pub struct FieldArgs {
 
 /// Runs `field`.
 pub fn run(a: &FieldArgs) -> Result<()> {
-    let mut outputs = Vec::new();
-    if let Some(p) = &a.out {
-        outputs.push(("--out", p.clone()));
-        outputs.push(("--out's sidecar", super::sidecar::path(p)));
-    }
-    if let Some(p) = &a.plot {
-        outputs.push(("--plot", p.clone()));
-    }
+    let outputs = super::args::csv_and_plot_outputs(a.out.as_deref(), a.plot.as_deref());
     super::args::check_outputs(&outputs, &super::args::detector_inputs(&a.input))?;
     if let Some(p) = &a.plot {
         plot::check_output(p, "--plot")?;

@@ -60,14 +60,7 @@ pub struct PulseArgs {
 
 /// Runs `pulse`.
 pub fn run(a: &PulseArgs) -> Result<()> {
-    let mut outputs = Vec::new();
-    if let Some(p) = &a.out {
-        outputs.push(("--out", p.clone()));
-        outputs.push(("--out's sidecar", super::sidecar::path(p)));
-    }
-    if let Some(p) = &a.plot {
-        outputs.push(("--plot", p.clone()));
-    }
+    let outputs = super::args::csv_and_plot_outputs(a.out.as_deref(), a.plot.as_deref());
     let mut inputs = super::args::detector_inputs(&a.input);
     if let Some(d) = &a.drift_parameters {
         inputs.push(("--drift-parameters", d.as_path()));
