@@ -226,14 +226,16 @@ fn coverage_stale(root: &Path, s: &Value, model: &str) -> Option<String> {
     if used != model {
         return Some(format!("made with {used}, not the default surrogate"));
     }
+    // Every reason, the settings' first (what the study tested), then the changed files.
+    let mut why: Vec<String> = settings_differ(s).into_iter().collect();
     for key in ["model", "data", "prior"] {
         if let (Some(file), Some(hash)) = (input(key), input(&format!("{key}_hash")))
             && hpge_inference::fit::file_hash(&root.join(file)) != hash
         {
-            return Some(format!("{file} has changed since"));
+            why.push(format!("{file} has changed since"));
         }
     }
-    settings_differ(s)
+    (!why.is_empty()).then(|| why.join("; "))
 }
 
 /// Where a coverage record's `settings` differ from the defaults of a study of its prior and
@@ -264,8 +266,12 @@ fn settings_differ(s: &Value) -> Option<String> {
         None
     } else {
         Some(format!(
-            "its settings are not today's defaults ({})",
-            paths.join(", ")
+            "its settings are not the main job's today ({})",
+            paths
+                .iter()
+                .map(|p| p.trim_start_matches("/fit/").trim_start_matches('/'))
+                .collect::<Vec<_>>()
+                .join(", ")
         ))
     }
 }
@@ -318,6 +324,17 @@ fn coverage_row(
     } else {
         format!("outside: {}", failing.join(", "))
     };
+    // Issue 60: a study passes only with at most 5% of its fits unconverged (records made before
+    // the rule have it in `unconverged`, not in `pass`).
+    let unconverged = s.get("unconverged").and_then(Value::as_u64).unwrap_or(0);
+    let converged_enough =
+        hpge_validation::studies::coverage::unconverged_ok(unconverged as usize, n as usize);
+    if !converged_enough {
+        detail.push_str(&format!(
+            "; {unconverged} of {n} fits unconverged, more than {:.0}%",
+            100.0 * hpge_validation::studies::coverage::MAX_UNCONVERGED_SHARE
+        ));
+    }
     detail.push_str(&subsets_note(&s));
     // A stale study's own verdict is moot: the cell says why it is stale (its record, linked,
     // has the rest).
@@ -325,18 +342,24 @@ fn coverage_row(
         Some(why) => format!("{n} truths, stale: {why}"),
         None => format!(
             "{n} truths, {} ({detail})",
-            if pass { "passes" } else { "fails" }
+            if pass && converged_enough {
+                "passes"
+            } else {
+                "fails"
+            }
         ),
     };
     Ok(StatusRow {
         what: what.into(),
         result,
         target: format!(
-            ">= {needed} truths; each parameter: rank KS p > 0.01, coverage in 99% bands"
+            ">= {needed} truths, >= 95% converged; each parameter: rank KS p > 0.01, coverage in 99% bands"
         ),
         // The acceptance's test per parameter (KS p > 0.01, stricter than the study's own
         // 0.01 / d) and the study's pass.
-        verdict: Verdict::of(pass && failing.is_empty() && n >= needed && stale.is_none()),
+        verdict: Verdict::of(
+            pass && converged_enough && failing.is_empty() && n >= needed && stale.is_none(),
+        ),
         source: rel,
     })
 }
@@ -634,10 +657,33 @@ mod tests {
         let mut lower = settings.clone();
         lower["fit"]["sample"]["ess_min"] = 200.0.into();
         let why = settings_differ(&record(&lower, "surrogate")).unwrap();
-        assert!(why.contains("/fit/sample/ess_min"), "{why}");
+        assert!(why.contains("sample/ess_min"), "{why}");
+        // Issue 60: a study tests the main job's pipeline; the likelihood and sampler targets of
+        // the studies made before 2026-12-06 (the paper's likelihood, ESS 300, 20 000 draws) are
+        // not the main job's, and the reason names each.
+        let mut old = settings.clone();
+        old["fit"]["noise"]["kind"] = "paper".into();
+        old["fit"]["sample"]["max_draws"] = 20_000.into();
+        let why = settings_differ(&record(&old, "surrogate")).unwrap();
+        assert!(why.contains("noise/kind"), "{why}");
+        assert!(why.contains("sample/max_draws"), "{why}");
+        assert!(why.contains("the main job's"), "{why}");
+        let main_job = serde_json::to_value(
+            hpge_inference::fit::FitOptions::default()
+                .settings()
+                .unwrap(),
+        )
+        .unwrap();
+        assert_eq!(settings["fit"]["noise"], main_job["noise"]);
+        for key in ["ess_min", "rhat_max", "max_draws", "chains", "sampler"] {
+            assert_eq!(
+                settings["fit"]["sample"][key], main_job["sample"][key],
+                "{key}"
+            );
+        }
         // The same settings as a study with exact data lack its pipeline (exact check, refinement).
         let why = settings_differ(&record(&settings, "exact")).unwrap();
-        assert!(why.contains("/pipeline"), "{why}");
+        assert!(why.contains("pipeline"), "{why}");
         assert!(settings_differ(&serde_json::json!({"n_truths": 200})).is_some());
     }
 

@@ -32,7 +32,7 @@ pub use exact_check::{
 pub use job::{EXACT_CHECK_TOLERANCE, FitFiles, FitJob, file_hash};
 pub use options::{
     DEFAULT_DATA, DEFAULT_DETECTOR, DEFAULT_EXACT_DRAWS, DEFAULT_MODEL, DEFAULT_PRIOR,
-    FIT_MAX_SECONDS, FitOptions, check_positive, noise_settings, sampler_kind,
+    FIT_LIKELIHOOD, FIT_MAX_SECONDS, FitOptions, check_positive, noise_settings, sampler_kind,
 };
 pub use predictive::thin_indices;
 pub use predictive::{Predictive, predictive};
