@@ -107,6 +107,20 @@ fn gpd_quantile(p: f64, k: f64, sigma: f64) -> f64 {
 /// leaves the tail unsmoothed with `k_hat = NaN`. Log ratios of `-inf` are zero weights; a NaN
 /// or `+inf` log ratio, or all of them `-inf`, gives NaN weights, `k_hat` and `ess`. Empty
 /// input gives no weights, `k_hat = NaN` and `ess = 0`.
+///
+/// ```
+/// use hpge_inference::summary::psis;
+/// // Equal ratios: uniform weights, k-hat 0, ESS = S.
+/// let flat = psis(&[0.3; 100]);
+/// assert_eq!(flat.k_hat, 0.0);
+/// assert!((flat.ess - 100.0).abs() < 1e-9);
+/// // Ratios with a Pareto tail of shape 1 (r = 1/u): k-hat far above 0.7, few effective draws.
+/// let heavy: Vec<f64> = (1..=400).map(|i| -((i as f64 - 0.5) / 400.0).ln()).collect();
+/// let p = psis(&heavy);
+/// assert!(p.k_hat > 0.7, "{}", p.k_hat);
+/// assert!(p.ess < 100.0);
+/// assert!((p.weights.iter().sum::<f64>() - 1.0).abs() < 1e-12);
+/// ```
 pub fn psis(log_ratios: &[f64]) -> Psis {
     let s = log_ratios.len();
     if s == 0 {

@@ -19,7 +19,7 @@ use super::coverage::{CoverageSettings, DataFrom, PipelineSettings};
 use crate::error::Result;
 
 /// The folder, under the working directory, that holds a coverage study's folder
-/// (`<prior>[-exact]`) when `--out` is not given.
+/// (`PRIOR[-exact]`) when `--out` is not given.
 pub const COVERAGE_OUT: &str = "coverage";
 /// Target bulk and tail ESS of each fit of a coverage study: the main job's
 /// ([`hpge_inference::sampler::DEFAULT_ESS_MIN`], 1000; issue 60: a study tests the pipeline the
@@ -84,8 +84,8 @@ pub struct CoverageOptions {
     pub mode_starts: usize,
     /// Output folder for coverage.json, ranks.csv, the figures and truths/ (each fitted truth,
     /// written as it finishes: the same command again resumes, more --truths extend the study)
-    /// [default: coverage/<prior>[-exact] in the working directory; the committed studies are
-    /// regenerated with --out reports/coverage/<prior>[-exact]].
+    /// [default: coverage/PRIOR[-exact] in the working directory; the committed studies are
+    /// regenerated with --out reports/coverage/PRIOR[-exact]].
     #[cfg_attr(feature = "clap", arg(long, value_name = "DIR"))]
     pub out: Option<PathBuf>,
     /// With --exact: fit each truth with the surrogate alone, without the exact check and
