@@ -114,6 +114,20 @@ fn fit_rows(root: &Path, name: &str, what: &str, main: bool) -> Result<Vec<Statu
         .cloned()
         .unwrap_or_default();
     let pass = flag(&s, &rel, "/exact_check/pass")?;
+    // Today's rule (issue 60), applied to the record whenever it was made: k-hat within the
+    // limit for its number of draws, or near-equal weights.
+    let draws = num(&s, &rel, "/exact_check/draws")? as usize;
+    let failed = s
+        .pointer("/exact_check/failed")
+        .and_then(Value::as_u64)
+        .unwrap_or(0) as usize;
+    let range = s
+        .pointer("/exact_check/log_ratio_range")
+        .and_then(Value::as_f64)
+        .unwrap_or(f64::NAN);
+    let limit = hpge_inference::fit::k_hat_limit(draws);
+    let near_equal = failed == 0 && range <= hpge_inference::fit::NEAR_EQUAL_LOG_RANGE;
+    let weights_ok = hpge_inference::fit::weights_reliable(k, draws, range, failed);
     let after = if rounds.is_empty() {
         String::new()
     } else {
@@ -125,9 +139,18 @@ fn fit_rows(root: &Path, name: &str, what: &str, main: bool) -> Result<Vec<Statu
     };
     let mut rows = vec![StatusRow {
         what: format!("{what}: exact-solver check"),
-        result: format!("k-hat {k:.2}, largest mean shift {shift:.2} sd{after}"),
-        target: format!("k-hat <= {K_HAT_LIMIT}, shift <= {SHIFT_LIMIT_SD} sd"),
-        verdict: Verdict::of(pass && k <= K_HAT_LIMIT && shift <= SHIFT_LIMIT_SD),
+        result: format!(
+            "k-hat {k:.2} (limit {limit:.2} for {draws} draws{}), largest mean shift {shift:.2} sd{after}",
+            if near_equal {
+                "; weights within 2x: near-equal"
+            } else {
+                ""
+            }
+        ),
+        target: format!(
+            "k-hat <= min({K_HAT_LIMIT}, 1 - 1/log10 draws) or weights within 2x; shift <= {SHIFT_LIMIT_SD} sd"
+        ),
+        verdict: Verdict::of(pass && weights_ok && shift <= SHIFT_LIMIT_SD),
         source: rel.clone(),
     }];
     if !rounds.is_empty() {

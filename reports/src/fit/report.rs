@@ -214,7 +214,7 @@ pub fn write_report(
         let _ = writeln!(r, "## Exact-solver check\n");
         let _ = writeln!(
             r,
-            "{} posterior draws re-weighted with the exact field solver{}, solved on {} ({} failed solves) in {:.1} s: Pareto k-hat {:.2} ({}), weights' ESS {:.0} (log ratios' sd {:.3}, range {:.3}); |c_exact - c_model| / c_exact at the global mode up to {:.2}%; chi^2 of the exact curve at the mode {:.1}. **{}** (pass: k-hat <= {}, every shift <= {} sd, and no exact ascent from a local mode ends more than {} above the mode's exact ln p).\n",
+            "{} posterior draws re-weighted with the exact field solver{}, solved on {} ({} failed solves) in {:.1} s: Pareto k-hat {:.2} ({}), weights' ESS {:.0} (log ratios' sd {:.3}, range {:.3}); |c_exact - c_model| / c_exact at the global mode up to {:.2}%; chi^2 of the exact curve at the mode {:.1}. **{}** (pass: k-hat <= {:.2}, the limit min(0.7, 1 - 1/log10 S) for these S draws, or every weight within a factor 2 of every other{}; every shift <= {} sd; and no exact ascent from a local mode ends more than {} above the mode's exact ln p).\n",
             c.draws,
             c.solver_tolerance
                 .map(|t| format!(" at a tolerance of {}% of c12", 100.0 * t))
@@ -236,7 +236,16 @@ pub fn write_report(
             100.0 * c.max_rel_diff_at_mode,
             c.chi2_exact_at_mode,
             if c.pass { "Pass" } else { "Fail" },
-            hpge_inference::fit::K_HAT_LIMIT,
+            if c.k_hat_limit.is_nan() {
+                hpge_inference::fit::K_HAT_LIMIT
+            } else {
+                c.k_hat_limit
+            },
+            if c.near_equal {
+                " (here: near-equal)"
+            } else {
+                ""
+            },
             hpge_inference::fit::SHIFT_LIMIT_SD,
             hpge_inference::fit::ASCENT_MARGIN
         );
