@@ -158,35 +158,42 @@ pub fn run_fit(o: &FitOptions, observer: &dyn FitObserver) -> Result<FitRun> {
         });
         (refined.fit, file)
     };
-    // The outputs of this run, each written whole; if a later one fails, those written before
-    // it are removed again (issue 66): summary.json, written last, marks a complete fit. The
-    // rounds (OUT/rounds/) stay, for a rerun to take back.
+    // The outputs of this run, each written under a temporary name and put in place together
+    // at the end (issue 66): a failing step or a kill leaves all of them or none. The rounds
+    // (OUT/rounds/) stay, for a rerun to take back.
     let mut staged = hpge_files::Staged::new();
-    for name in [
-        outputs::ERROR_MODEL_FILE,
-        "samples.csv",
-        "predictive.csv",
-        "zeta-mode.csv",
-        "report.md",
-        "summary.json",
-    ] {
-        staged.adopt(&out.join(name));
-    }
     if let Some(file) = &correction {
-        outputs::write_error_model(&out.join(outputs::ERROR_MODEL_FILE), file)?;
+        let path = staged.path(&out.join(outputs::ERROR_MODEL_FILE));
+        outputs::write_error_model(&path, file)?;
     }
     let records = truth.as_ref().map(|t| truth_records(&fit.summary, t));
-    write_outputs(o, &out, &job, &fit, truth.as_deref(), records.as_deref())?;
+    write_outputs(
+        o,
+        &out,
+        &mut staged,
+        &job,
+        &fit,
+        truth.as_deref(),
+        records.as_deref(),
+    )?;
     let mut summary_json = outputs::summary_json(&fit, records.as_deref())?;
     if let Some(obj) = summary_json.as_object_mut() {
         obj.insert("run".into(), o.run_args().into());
     }
-    outputs::write_summary(&out.join("summary.json"), &summary_json)?;
+    let path = staged.path(&out.join("summary.json"));
+    outputs::write_summary(&path, &summary_json)?;
     staged.commit().map_err(|(file, source)| Error::Io {
         file,
         action: "cannot write",
         source,
     })?;
+    // An error model of an earlier run in this folder that this run did not replace.
+    if correction.is_none() {
+        let stale = out.join(outputs::ERROR_MODEL_FILE);
+        if stale.is_file() {
+            std::fs::remove_file(&stale).map_err(Error::io(&stale, "cannot remove"))?;
+        }
+    }
     Ok(FitRun {
         job,
         fit,
@@ -234,33 +241,39 @@ pub fn describe_run(v: &serde_json::Value) -> String {
 pub fn write_outputs(
     o: &FitOptions,
     out: &Path,
+    staged: &mut hpge_files::Staged,
     s: &FitJob,
     fit: &Fit,
     truth: Option<&[Option<f64>]>,
     truth_records: Option<&[TruthRecord]>,
 ) -> Result<()> {
-    outputs::write_samples(&out.join("samples.csv"), fit)?;
-    outputs::write_predictive(&out.join("predictive.csv"), fit)?;
+    outputs::write_samples(&staged.path(&out.join("samples.csv")), fit)?;
+    outputs::write_predictive(&staged.path(&out.join("predictive.csv")), fit)?;
     let zeta = s.zeta_at_mode(fit, truth)?;
-    outputs::write_zeta(&out.join("zeta-mode.csv"), &zeta)?;
+    outputs::write_zeta(&staged.path(&out.join("zeta-mode.csv")), &zeta)?;
     let mut figures = Vec::new();
+    let final_figures = out.join("figures");
     if !o.no_plots {
         let names = s.prior.names();
         let pairs = default_pairs(&names);
         let truth_vals: Option<Vec<f64>> =
             truth.map(|t| t.iter().map(|v| v.unwrap_or(f64::NAN)).collect());
         let title = format!("{} fit", s.prior.name);
-        figures = plot::fit_figures(
-            &out.join("figures"),
-            fit,
-            &zeta,
-            &pairs,
-            truth_vals.as_deref(),
-            &title,
-        )?;
+        // Drawn into a temporary folder that replaces `figures/` whole (an earlier run's
+        // figures of other pairs do not stay beside this run's).
+        let dir = staged
+            .replacing_folder(&final_figures)
+            .map_err(Error::io(&final_figures, "cannot create the folder"))?;
+        figures = plot::fit_figures(&dir, fit, &zeta, &pairs, truth_vals.as_deref(), &title)?
+            .into_iter()
+            .map(|f| match f.strip_prefix(&dir) {
+                Ok(rel) => final_figures.join(rel),
+                Err(_) => f,
+            })
+            .collect();
     }
     write_report(
-        &out.join("report.md"),
+        &staged.path(&out.join("report.md")),
         o,
         out,
         s,
