@@ -2,9 +2,10 @@
 //! random moments (20 tries each, the moments drawn from a fixed seed) leave either a complete
 //! output or nothing, and a re-run with the same arguments gives the uninterrupted result.
 //!
-//! Each command runs once uninterrupted (the reference, which also times it), then 20 times
-//! killed after a drawn delay between 0 and 1.2 times the reference's wall time (a kill after
-//! the end is a whole run). After each kill the outputs must be all there and equal to the
+//! Each command runs once uninterrupted (the reference, which also times it and notes when its
+//! first file appears), then 20 times killed after a drawn delay: every other try between 0 and
+//! 1.2 times the reference's wall time (a kill after the end is a whole run), the others in its
+//! writing phase (from its first file to 1.1 times its wall time). After each kill the outputs must be all there and equal to the
 //! reference's, or none of them; `generate`'s rows (its resumable state) may be fewer but each
 //! whole and equal to the reference's row of that index. The run is then repeated and must
 //! give the reference's outputs and leave no temporary file behind.
@@ -64,6 +65,32 @@ fn run_whole(args: &[String]) -> Duration {
         String::from_utf8_lossy(&o.stderr)
     );
     t.elapsed()
+}
+
+/// Runs to the end like [`run_whole`], watching `folder`: returns the wall time and when the
+/// first file other than `not_outputs` (a temporary or an output) appeared in it (the start of
+/// the writing phase).
+fn run_watched(args: &[String], folder: &Path, not_outputs: &[&str]) -> (Duration, Duration) {
+    let t = Instant::now();
+    let mut child = command(args).stderr(Stdio::null()).spawn().unwrap();
+    let mut first = None;
+    loop {
+        if first.is_none()
+            && files(folder).keys().any(|p| {
+                let top = p.components().next().unwrap().as_os_str().to_string_lossy();
+                !not_outputs.contains(&top.as_ref())
+            })
+        {
+            first = Some(t.elapsed());
+        }
+        if let Some(status) = child.try_wait().unwrap() {
+            assert!(status.success(), "{args:?}: {status}");
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    let wall = t.elapsed();
+    (wall, first.unwrap_or(wall))
 }
 
 /// Starts the command, sends SIGTERM after `delay` (unless it ended before) and waits for it.
@@ -211,7 +238,11 @@ fn check(case: &Case) {
         }
     };
     let reference_dir = d.join("reference");
-    let wall = run_whole(&(case.args)(&reference_dir));
+    let (wall, writing) = run_watched(
+        &(case.args)(&reference_dir),
+        &at(&reference_dir),
+        case.not_outputs,
+    );
     let reference = outputs(&at(&reference_dir), case.not_outputs, case.rows);
     assert!(!reference.is_empty(), "{}: no outputs", case.name);
     let reference_rows = case
@@ -222,7 +253,14 @@ fn check(case: &Case) {
     for k in 0..TRIES {
         let folder = d.join(format!("try-{k}"));
         let args = (case.args)(&folder);
-        let delay = wall.mul_f64(1.2 * moments.next_unit());
+        // Every other try in the writing phase (from the first file written to the end, a
+        // little beyond), the others anywhere in the run.
+        let u = moments.next_unit();
+        let delay = if k % 2 == 0 {
+            wall.mul_f64(1.2 * u)
+        } else {
+            writing + (wall.mul_f64(1.1) - writing).mul_f64(u)
+        };
         run_killed(&args, delay);
         let out = at(&folder);
         let left = outputs(&out, case.not_outputs, case.rows);
@@ -293,9 +331,11 @@ fn check(case: &Case) {
         let _ = std::fs::remove_dir_all(&folder);
     }
     eprintln!(
-        "{}: {TRIES} kills over {:.2} s: {none} left nothing, {whole} the whole output",
+        "{}: {TRIES} kills over {:.2} s (writing from {:.2} s): {none} left nothing, {whole} the \
+         whole output",
         case.name,
-        1.2 * wall.as_secs_f64()
+        1.2 * wall.as_secs_f64(),
+        writing.as_secs_f64()
     );
     let _ = std::fs::remove_dir_all(&d);
 }

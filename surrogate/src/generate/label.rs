@@ -97,8 +97,47 @@ fn io<'a>(file: &'a Path, action: &'static str) -> impl Fn(std::io::Error) -> Er
     }
 }
 
+/// The largest file of rows `label` reads: 256 MiB (about a million rows of the paper's space,
+/// each of which takes seconds of CPU to label; split a larger set), checked before the file is
+/// read into memory, so that a wrong file (a device, a huge binary) is refused instead of
+/// exhausting the memory (issue 66, cause 7: bounds before allocation).
+pub const MAX_LABEL_INPUT_BYTES: u64 = 256 << 20;
+
+/// The bytes of `path`, refused when above [`MAX_LABEL_INPUT_BYTES`] (by its size where it has
+/// one, else after reading one byte more than the bound).
+fn read_bounded(path: &Path) -> Result<Vec<u8>> {
+    use std::io::Read as _;
+    let too_large = |size: String| Error::Invalid {
+        file: path.into(),
+        key: "rows".into(),
+        message: format!(
+            "{size}: at most {} MiB of rows are labelled in one run; split the file",
+            MAX_LABEL_INPUT_BYTES >> 20
+        ),
+    };
+    let file = std::fs::File::open(path).map_err(io(path, "cannot read the rows to label"))?;
+    let len = file
+        .metadata()
+        .map_err(io(path, "cannot read the rows to label"))?
+        .len();
+    if len > MAX_LABEL_INPUT_BYTES {
+        return Err(too_large(format!("{len} bytes")));
+    }
+    let mut bytes = Vec::new();
+    file.take(MAX_LABEL_INPUT_BYTES + 1)
+        .read_to_end(&mut bytes)
+        .map_err(io(path, "cannot read the rows to label"))?;
+    if bytes.len() as u64 > MAX_LABEL_INPUT_BYTES {
+        return Err(too_large(format!(
+            "more than {} MiB",
+            MAX_LABEL_INPUT_BYTES >> 20
+        )));
+    }
+    Ok(bytes)
+}
+
 fn read_input(path: &Path, exact: &ExactSolver) -> Result<(Input, String)> {
-    let bytes = std::fs::read(path).map_err(io(path, "cannot read the rows to label"))?;
+    let bytes = read_bounded(path)?;
     let hash = format!("{:016x}", fnv1a(&bytes));
     let text = String::from_utf8(bytes).map_err(|_| Error::Invalid {
         file: path.into(),
