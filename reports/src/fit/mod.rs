@@ -73,6 +73,15 @@ pub fn run_fit(o: &FitOptions, observer: &dyn FitObserver) -> Result<FitRun> {
         None => None,
     };
     job.posterior()?;
+    if !o.no_exact_check && o.exact_draws < hpge_inference::summary::PSIS_MIN_DRAWS {
+        job.warnings.push(format!(
+            "--exact-draws {}: PSIS estimates its Pareto k-hat from {} draws or more; with fewer \
+             k-hat is undefined and the exact check cannot pass (it still reports each mean's \
+             shift)",
+            o.exact_draws,
+            hpge_inference::summary::PSIS_MIN_DRAWS
+        ));
+    }
     let out = o.out_dir();
     // No output of the fit over one of its inputs (issue 66).
     let mut inputs: Vec<(&str, &Path)> = vec![
@@ -369,11 +378,14 @@ pub fn summary_text(fit: &Fit, out: &Path) -> String {
             );
         }
     }
+    if let Some(why) = &s.exact_check_skipped {
+        let _ = writeln!(t, "exact check not run: {why}");
+    }
     if let Some(c) = &s.exact_check {
         let rounds = s.refinement.as_ref().map_or(1, Vec::len);
         let _ = writeln!(
             t,
-            "exact check{} ({} draws on {}, {:.1} s): Pareto k {:.2} (weights' ESS {:.0}, log ratios' sd {:.3}), largest mean shift {:.2} sd, |c_exact - c_model|/c at the mode <= {:.2}%: {}",
+            "exact check{} ({} draws on {}, {:.1} s): Pareto k {} (weights' ESS {:.0}, log ratios' sd {:.3}), largest mean shift {:.2} sd, |c_exact - c_model|/c at the mode <= {:.2}%: {}",
             if rounds > 1 {
                 format!(
                     " after {} rounds of refinement (the surrogate corrected by {} exact curves)",
@@ -389,7 +401,14 @@ pub fn summary_text(fit: &Fit, out: &Path) -> String {
             c.draws,
             grids_text(c),
             c.seconds,
-            c.pareto_k,
+            if c.pareto_k.is_nan() {
+                format!(
+                    "undefined (PSIS needs at least {} draws)",
+                    hpge_inference::summary::PSIS_MIN_DRAWS
+                )
+            } else {
+                format!("{:.2}", c.pareto_k)
+            },
             c.ess,
             c.log_ratio_sd,
             c.max_abs_shift_sd,
