@@ -290,7 +290,30 @@ pub fn label(
     progress: impl Fn(usize, usize) + Sync,
 ) -> Result<LabelReport> {
     let (input, input_hash) = read_input(input_path, exact)?;
+    let made = !out.exists();
     std::fs::create_dir_all(out).map_err(io(out, "cannot create the output folder"))?;
+    let r = label_into(exact, input_path, out, threads, progress, input, input_hash);
+    // A folder this run made and that holds no row when it fails (a full disk before the first
+    // row, issue 66) is removed again: nothing to resume, nothing left behind.
+    if r.is_err() && made {
+        let rows = std::fs::read_to_string(out.join("rows.csv")).unwrap_or_default();
+        if rows.lines().nth(1).is_none() {
+            let _ = std::fs::remove_dir_all(out);
+        }
+    }
+    r
+}
+
+/// [`label`] into the existing folder `out`, the input read.
+fn label_into(
+    exact: &ExactSolver,
+    input_path: &Path,
+    out: &Path,
+    threads: Option<usize>,
+    progress: impl Fn(usize, usize) + Sync,
+    input: Input,
+    input_hash: String,
+) -> Result<LabelReport> {
     let _lock = super::lock::FolderLock::acquire_named(out, "label.lock")?;
     let space_text = toml::to_string(&exact.space).unwrap_or_default();
     let settings_text = toml::to_string(&exact.settings).unwrap_or_default();
