@@ -19,6 +19,7 @@
 #   arm, k, the arm's CPU seconds for those K rows (CPU_PER_ROW_S of the arm, below, times K),
 #   the figures of `evaluate --json` on data/training/heldout-300000.csv and heldout.csv
 #   (sigma, q90, q99, coverage, and the pocket / no-pocket split of the former).
+# SEED (default 0): the training seed; a seed other than 0 is in the tag and the line.
 # K = 0 trains on train.csv alone. A (ARM, K, RECIPE) already in the file is skipped.
 # The models go to models/learning-curve/ (not committed: about 0.7 MB each); about 15 min a
 # point on the 2-core machine.
@@ -27,6 +28,7 @@ cd "$(dirname "$0")/.."
 ARM=${1:?usage: learning-curve.sh ARM K}
 K=${2:?usage: learning-curve.sh ARM K}
 RECIPE=${RECIPE:-split-gate}
+SEED=${SEED:-0}
 EXTRA=${EXTRA:-}
 case "$ARM" in
   uniform) DIR=data/training/uniform-400000 ;;
@@ -39,12 +41,13 @@ for E in $EXTRA; do
 done
 TAG=$ARM-$K
 for E in $EXTRA; do TAG=$TAG+$(basename "$E"); done
+[ "$SEED" = 0 ] || TAG=$TAG-seed$SEED
 [[ "$K" =~ ^[0-9]+$ ]] || { echo "learning-curve.sh: K must be a count of rows, not '$K'" >&2; exit 2; }
 OUT=models/learning-curves.jsonl
 if [ -f "$OUT" ] && grep -q "\"tag\": \"$TAG\", \"recipe\": \"$RECIPE\"" "$OUT"; then
   echo "learning-curve.sh: $TAG $RECIPE is in $OUT already"; exit 0
 fi
-if [ -z "$EXTRA" ] && [ -f "$OUT" ] && grep -q "\"arm\": \"$ARM\", \"k\": $K, \"recipe\": \"$RECIPE\"" "$OUT"; then
+if [ -z "$EXTRA" ] && [ "$SEED" = 0 ] && [ -f "$OUT" ] && grep -q "\"arm\": \"$ARM\", \"k\": $K, \"recipe\": \"$RECIPE\"" "$OUT"; then
   echo "learning-curve.sh: $ARM $K $RECIPE is in $OUT already"; exit 0
 fi
 [ -f data/training/train.csv ] || bash data/training/make.sh
@@ -94,13 +97,13 @@ with open(out, "w", newline="") as f:
 EOF
 MODEL=models/learning-curve/$RECIPE-$TAG.safetensors
 SHIPPED=models/super-siegfried-rz-$RECIPE-t256-256-256-hd128-wd0.01.safetensors
-if [ "$K" -eq 0 ] && [ -z "$EXTRA" ] && [ -f "$SHIPPED" ] && cmp -s "$SET" data/training/train.csv; then
+if [ "$K" -eq 0 ] && [ -z "$EXTRA" ] && [ "$SEED" = 0 ] && [ -f "$SHIPPED" ] && cmp -s "$SET" data/training/train.csv; then
   # The 54 000 rows alone with the same recipe, seed and test set: the committed model is this
   # point (models/train.sh trained it with the same arguments).
   cp "$SHIPPED" "$MODEL"
 else
   $B train --data "$SET" --test data/training/test.csv --space spaces/super-siegfried-rz.toml \
-    --detector detectors/super-siegfried-k1.toml --recipe "$RECIPE" --seed 0 --out "$MODEL" \
+    --detector detectors/super-siegfried-k1.toml --recipe "$RECIPE" --seed "$SEED" --out "$MODEL" \
     --trunk 256,256,256 --head 128 --weight-decay 0.01 --force
   $B calibrate --model "$MODEL" --data data/training/calibration.csv --out "$MODEL" --force
 fi
@@ -111,10 +114,10 @@ if [ "$K" -gt 0 ]; then CPU=$(python3 -c "import json; print(json.load(open('$DI
 for E in $EXTRA; do
   CPU=$(python3 -c "import csv, json; d = json.load(open('$E/cpu.json')); n = sum(1 for r in csv.DictReader(open('$E/rows.csv')) if r['status'] == 'ok'); print($CPU + d['cpu_per_row_s'] * n)")
 done
-python3 - "$ARM" "$K" "$RECIPE" "$CPU" "${MODEL%.safetensors}" "$TAG" "$EXTRA" >> "$OUT" <<'EOF'
+python3 - "$ARM" "$K" "$RECIPE" "$CPU" "${MODEL%.safetensors}" "$TAG" "$EXTRA" "$SEED" >> "$OUT" <<'EOF'
 import json, sys
 arm, k, recipe, cpu, stem = sys.argv[1], int(sys.argv[2]), sys.argv[3], float(sys.argv[4]), sys.argv[5]
-tag, extra = sys.argv[6], sys.argv[7]
+tag, extra, seed = sys.argv[6], sys.argv[7], int(sys.argv[8])
 def figs(f):
     d = json.load(open(f))
     out = {key: d[key] for key in ("n", "rel_sigma", "abs_rel_q90", "abs_rel_q99", "coverage_2sigma")}
@@ -122,8 +125,10 @@ def figs(f):
         out[r["group"]] = {key: r[key] for key in ("n", "rel_sigma", "abs_rel_q90", "abs_rel_q99")}
     return out
 head = {"arm": arm, "k": k, "recipe": recipe}
-if extra:
+if extra or seed:
     head = {"tag": tag, "recipe": recipe, "arm": arm, "k": k, "extra": extra.split()}
+if seed:
+    head["seed"] = seed
 print(json.dumps({**head, "cpu_s": cpu,
                   "heldout_300000": figs(stem + ".h300000.json"),
                   "heldout": figs(stem + ".heldout.json"),

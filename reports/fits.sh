@@ -27,7 +27,10 @@ $B fit --prior priors/b-rz.toml --truth $T --likelihood paper --allow-exact-mism
 $B fit --prior priors/b-z.toml --sampler nuts --no-exact-check --force --out reports/fits/b-z-nuts || true
 $B fit --prior priors/b-rz.toml --truth $T --sampler nuts --no-exact-check --max-seconds 120 \
   --force --out reports/fits/b-rz-nuts || true
-# The coverage studies (reports/coverage/), each resuming per truth when started again:
+# The coverage studies (reports/coverage/), each resuming per truth when started again. Since
+# 2026-12-06 (issue 60) every fit of a study runs with the main job's settings (the measured
+# covariance, ESS 1000, 100 000 draws per chain at most); the timings below are those of the
+# earlier studies (the paper's likelihood, ESS 300, 20 000 draws) and grow with the ESS target:
 # about 40 min (B_RZ, surrogate data, 200 truths) and, with exact data, about 6-7 min of one
 # core per truth on the solver of 2026-11-29 (the full pipeline of `fit`, refinement included,
 # most of it exact solves; two truths run side by side on 2 cores, so 100 truths take about

@@ -2,7 +2,7 @@
 //!
 //! How every command of hpge-cv writes its outputs (issue 66):
 //!
-//! - whole or not at all: [`write`] and [`write_with`] write a temporary file beside the output
+//! - whole or not at all: [`write()`] and [`write_with`] write a temporary file beside the output
 //!   ([`temp_beside`]: a hidden name in the same folder), flush it to disk and rename it onto
 //!   the final name, so the final name never holds a partial or empty file; on failure the
 //!   temporary is removed;
@@ -19,6 +19,7 @@
 //!
 //! Errors are `std::io::Error`s; the callers name the file in their own error types.
 
+#![warn(missing_docs)]
 use std::ffi::OsString;
 use std::fs;
 use std::io::{self, BufWriter, Write};
@@ -47,6 +48,19 @@ pub fn temp_beside(path: &Path) -> PathBuf {
 }
 
 /// Writes `bytes` to `path` whole or not at all (see [`write_with`]).
+///
+/// ```
+/// let dir = std::env::temp_dir().join(format!("hpge-files-doc-{}", std::process::id()));
+/// std::fs::create_dir_all(&dir)?;
+/// let out = dir.join("cv.csv");
+/// hpge_files::write(&out, "voltage_V,c12_pF\n25,435.5\n")?;
+/// assert_eq!(std::fs::read_to_string(&out)?, "voltage_V,c12_pF\n25,435.5\n");
+/// // A failed write leaves the earlier file as it was (no folder: the temporary cannot be made).
+/// assert!(hpge_files::write(dir.join("no/such/folder/cv.csv"), "x").is_err());
+/// assert_eq!(std::fs::read_dir(&dir)?.count(), 1, "no temporary left behind");
+/// std::fs::remove_dir_all(&dir)?;
+/// # Ok::<(), std::io::Error>(())
+/// ```
 ///
 /// # Errors
 /// The I/O error of creating, writing, syncing or renaming the temporary file.
@@ -458,6 +472,21 @@ fn resolved(path: &Path) -> PathBuf {
 /// Whether an output written at `out` would write over the input `input` or into it: the same
 /// path once resolved (`.`, `..`, symbolic links), the same file under another name (a hard
 /// link: same device and inode), or `out` inside the folder `input`.
+///
+/// ```
+/// use std::path::Path;
+/// use hpge_files::overlaps;
+/// let d = std::env::temp_dir().join(format!("hpge-overlaps-doc-{}", std::process::id()));
+/// std::fs::create_dir_all(d.join("raw"))?;
+/// std::fs::write(d.join("det.toml"), "")?;
+/// assert!(overlaps(&d.join("det.toml"), &d.join("det.toml")));
+/// assert!(overlaps(&d.join("raw/../det.toml"), &d.join("det.toml")), "resolved");
+/// assert!(overlaps(&d.join("raw/cv.csv"), &d.join("raw")), "inside an input folder");
+/// assert!(!overlaps(&d.join("cv.csv"), &d.join("det.toml")));
+/// assert!(!overlaps(Path::new("a-new-file.csv"), &d.join("raw")));
+/// std::fs::remove_dir_all(&d)?;
+/// # Ok::<(), std::io::Error>(())
+/// ```
 pub fn overlaps(out: &Path, input: &Path) -> bool {
     if same_file(out, input) {
         return true;

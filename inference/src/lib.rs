@@ -9,8 +9,8 @@
 //! The root names what a fit or a discovery run needs; everything else lives in its module:
 //! [`model`] (the trait and its two implementations), [`prior`], [`posterior`] (likelihood and
 //! posterior), [`sampler`] (adaptive Metropolis and NUTS), [`diagnostics`] (R-hat, ESS),
-//! [`summary`] (intervals, modes, Pareto-smoothed importance sampling), [`fit`] (a whole fit,
-//! its predictive and the exact-solver check), [`discover`] (model discovery) and [`numerics`]
+//! [`summary`] (intervals, modes, Pareto-smoothed importance sampling), [`mod@fit`] (a whole fit,
+//! its predictive and the exact-solver check), [`mod@discover`] (model discovery) and [`numerics`]
 //! (the small dense linear algebra and optimiser they share).
 //!
 //! A model error at one point (a failed solve, a point outside the model's domain;
@@ -83,6 +83,7 @@
 //! # }
 //! ```
 
+#![warn(missing_docs)]
 pub mod diagnostics;
 pub mod discover;
 mod error;

@@ -38,6 +38,15 @@ impl Circuit {
     }
 
     /// c12_m = Q_t / U_2 in pF for a total charge Q_t in pC (paper, Eq. 6; pC / V = pF).
+    ///
+    /// ```
+    /// use hpge_measurement::circuit::Circuit;
+    /// let c = Circuit::default();
+    /// // The paper's circuit: U_2 = 126 mV x 51.4 / (50 + 6190 + 51.4) = 1.02941 mV.
+    /// assert!((c.injected_v() - 1.029_41e-3).abs() < 1e-8);
+    /// let q_pc = c.charge_pc(38.42);
+    /// assert!((c.c12_pf(q_pc) - 38.42).abs() < 1e-12);
+    /// ```
     pub fn c12_pf(&self, q_pc: f64) -> f64 {
         q_pc / self.injected_v()
     }

@@ -3,7 +3,7 @@
 //! The measurement side of hpge-cv (paper, sections 3-4): from the recorded pulser pulses of an
 //! HPGe detector to its measured C-V curve with the full covariance.
 //!
-//! The pipeline, one bias at a time ([`measure`], in parallel over the biases):
+//! The pipeline, one bias at a time ([`fn@measure`], in parallel over the biases):
 //!
 //! 1. **Pulses** ([`PulseSet`]): decay-corrected, calibrated preamplifier traces in pC, read from
 //!    `<stem>.npy` files with `<stem>.toml` sidecars ([`read_pulses`], [`read_raw_dir`]), or LH5
@@ -70,6 +70,7 @@
 //! # }
 //! ```
 
+#![warn(missing_docs)]
 pub mod circuit;
 mod error;
 pub mod formats;

@@ -15,23 +15,23 @@ pub const MIN_DECIMATED_SAMPLES: usize = 100;
 #[derive(Debug, Clone, PartialEq)]
 #[cfg_attr(feature = "clap", derive(clap::Args))]
 pub struct MeasureOptions {
-    /// Directory of pulse files: <stem>.npy [pulses, samples] in pC, or <stem>.lh5 (an LH5
-    /// waveform table, one bias per file), each with a <stem>.toml sidecar (bias_V,
+    /// Directory of pulse files: STEM.npy [pulses, samples] in pC, or STEM.lh5 (an LH5
+    /// waveform table, one bias per file), each with a STEM.toml sidecar (bias_V,
     /// sampling_period_ns, charge_unit); optional measurement.toml (voltages_V, circuit,
     /// uncertainties, tail fit). Or one .lh5 file (settings from measurement.toml beside it).
     #[cfg_attr(feature = "clap", arg(long, value_name = "DIR|FILE.lh5"))]
     pub raw: PathBuf,
-    /// The C-V curve (voltage_V,c12_pF,sigma_pF); the covariance goes to <stem>.covariance.csv
-    /// and a report to <stem>.measure.json.
+    /// The C-V curve (voltage_V,c12_pF,sigma_pF); the covariance goes to STEM.covariance.csv
+    /// and a report to STEM.measure.json.
     #[cfg_attr(feature = "clap", arg(long, value_name = "FILE"))]
     pub out: PathBuf,
-    /// Measurement settings (TOML) instead of <raw>/measurement.toml.
+    /// Measurement settings (TOML) instead of RAW/measurement.toml.
     #[cfg_attr(feature = "clap", arg(long, value_name = "FILE"))]
     pub settings: Option<PathBuf>,
 }
 
 impl MeasureOptions {
-    /// The settings and where they came from: `settings`, else `<raw>/measurement.toml` if
+    /// The settings and where they came from: `settings`, else `RAW/measurement.toml` if
     /// present (the folder of `raw` when it is a file), else the defaults (source `defaults`).
     ///
     /// # Errors

@@ -16,6 +16,19 @@ pub fn negative_slopes(voltage_v: &[f64], c12_pf: &[f64]) -> Vec<(f64, f64)> {
 /// the slope never falls that low (not fully depleted within the curve), or is already below
 /// it at the first midpoint (the crossing lies before the curve; the first voltage is then an
 /// upper bound, reported by the caller).
+///
+/// ```
+/// use hpge_measurement::depletion_voltage;
+/// // c12 falls by 1 pF/V up to 100 V and by 1e-4 pF/V after: the paper's 1e-3 pF/V is
+/// // crossed between the midpoints 95 V and 105 V.
+/// let u: Vec<f64> = (0..=20).map(|k| 10.0 * k as f64).collect();
+/// let c: Vec<f64> = u.iter().map(|&x| if x <= 100.0 { 200.0 - x } else { 100.0 - 1e-4 * (x - 100.0) }).collect();
+/// let u_fd = depletion_voltage(&u, &c, 1e-3).expect("crossed inside the curve");
+/// assert!(u_fd > 95.0 && u_fd < 105.0, "{u_fd}");
+/// // Never flat enough: no depletion voltage.
+/// let steep: Vec<f64> = u.iter().map(|&x| 300.0 - x).collect();
+/// assert_eq!(depletion_voltage(&u, &steep, 1e-3), None);
+/// ```
 pub fn depletion_voltage(
     voltage_v: &[f64],
     c12_pf: &[f64],

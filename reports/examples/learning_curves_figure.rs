@@ -7,7 +7,8 @@
 //! `cargo run --release -p hpge-reports --example learning_curves_figure -- JSONL OUT_STEM`
 //! writes OUT_STEM-sigma.{svg,png} (Gaussian sigma of the relative error) and
 //! OUT_STEM-q99.{svg,png} (99th percentile of |relative error|), each with one curve per arm
-//! and held-out set.
+//! and held-out set (a point trained on several arms' rows together is its own series, named by them; lines of a seed
+//! other than 0 are left out).
 
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -32,7 +33,44 @@ fn read(path: &PathBuf) -> Result<Series, Box<dyn std::error::Error>> {
                 .cloned()
                 .ok_or_else(|| format!("{} line {}: no `{k}`", path.display(), i + 1))
         };
-        let arm = field("arm")?.as_str().unwrap_or_default().to_string();
+        // Other seeds than 0 are the seed-scatter checks, not points of a curve.
+        if v.get("seed")
+            .and_then(serde_json::Value::as_u64)
+            .unwrap_or(0)
+            != 0
+        {
+            continue;
+        }
+        let mut arm = field("arm")?.as_str().unwrap_or_default().to_string();
+        // A point whose extra folders hold another arm's rows (not only the B_Z slice's low-bias
+        // rows, which belong to the low-bias arm) is a mixture: its own series.
+        let mixed = v
+            .get("extra")
+            .and_then(serde_json::Value::as_array)
+            .is_some_and(|e| {
+                e.iter()
+                    .filter_map(serde_json::Value::as_str)
+                    .any(|f| !f.ends_with("bz-low-bias-800000"))
+            });
+        if mixed {
+            let short = |f: &str| match f.rsplit('/').next().unwrap_or(f) {
+                "uniform-400000" => "uniform".to_string(),
+                "active-500000" => "active".to_string(),
+                "bz-low-bias-800000" => "B_Z low-bias".to_string(),
+                other => other.to_string(),
+            };
+            let k = v.get("k").and_then(serde_json::Value::as_u64).unwrap_or(0);
+            let mut parts: Vec<String> = if k > 0 { vec![arm.clone()] } else { vec![] };
+            parts.extend(
+                v["extra"]
+                    .as_array()
+                    .into_iter()
+                    .flatten()
+                    .filter_map(serde_json::Value::as_str)
+                    .map(short),
+            );
+            arm = parts.join(" + ");
+        }
         let recipe = field("recipe")?.as_str().unwrap_or_default().to_string();
         let hours = field("cpu_s")?.as_f64().unwrap_or(f64::NAN) / 3600.0;
         series.entry((arm, recipe)).or_default().push((

@@ -114,6 +114,20 @@ fn fit_rows(root: &Path, name: &str, what: &str, main: bool) -> Result<Vec<Statu
         .cloned()
         .unwrap_or_default();
     let pass = flag(&s, &rel, "/exact_check/pass")?;
+    // Today's rule (issue 60), applied to the record whenever it was made: k-hat within the
+    // limit for its number of draws, or near-equal weights.
+    let draws = num(&s, &rel, "/exact_check/draws")? as usize;
+    let failed = s
+        .pointer("/exact_check/failed")
+        .and_then(Value::as_u64)
+        .unwrap_or(0) as usize;
+    let range = s
+        .pointer("/exact_check/log_ratio_range")
+        .and_then(Value::as_f64)
+        .unwrap_or(f64::NAN);
+    let limit = hpge_inference::fit::k_hat_limit(draws);
+    let near_equal = failed == 0 && range <= hpge_inference::fit::NEAR_EQUAL_LOG_RANGE;
+    let weights_ok = hpge_inference::fit::weights_reliable(k, draws, range, failed);
     let after = if rounds.is_empty() {
         String::new()
     } else {
@@ -125,9 +139,18 @@ fn fit_rows(root: &Path, name: &str, what: &str, main: bool) -> Result<Vec<Statu
     };
     let mut rows = vec![StatusRow {
         what: format!("{what}: exact-solver check"),
-        result: format!("k-hat {k:.2}, largest mean shift {shift:.2} sd{after}"),
-        target: format!("k-hat <= {K_HAT_LIMIT}, shift <= {SHIFT_LIMIT_SD} sd"),
-        verdict: Verdict::of(pass && k <= K_HAT_LIMIT && shift <= SHIFT_LIMIT_SD),
+        result: format!(
+            "k-hat {k:.2} (limit {limit:.2} for {draws} draws{}), largest mean shift {shift:.2} sd{after}",
+            if near_equal {
+                "; weights within 2x: near-equal"
+            } else {
+                ""
+            }
+        ),
+        target: format!(
+            "k-hat <= min({K_HAT_LIMIT}, 1 - 1/log10 draws) or weights within 2x; shift <= {SHIFT_LIMIT_SD} sd"
+        ),
+        verdict: Verdict::of(pass && weights_ok && shift <= SHIFT_LIMIT_SD),
         source: rel.clone(),
     }];
     if !rounds.is_empty() {
@@ -226,14 +249,16 @@ fn coverage_stale(root: &Path, s: &Value, model: &str) -> Option<String> {
     if used != model {
         return Some(format!("made with {used}, not the default surrogate"));
     }
+    // Every reason, the settings' first (what the study tested), then the changed files.
+    let mut why: Vec<String> = settings_differ(s).into_iter().collect();
     for key in ["model", "data", "prior"] {
         if let (Some(file), Some(hash)) = (input(key), input(&format!("{key}_hash")))
             && hpge_inference::fit::file_hash(&root.join(file)) != hash
         {
-            return Some(format!("{file} has changed since"));
+            why.push(format!("{file} has changed since"));
         }
     }
-    settings_differ(s)
+    (!why.is_empty()).then(|| why.join("; "))
 }
 
 /// Where a coverage record's `settings` differ from the defaults of a study of its prior and
@@ -264,8 +289,12 @@ fn settings_differ(s: &Value) -> Option<String> {
         None
     } else {
         Some(format!(
-            "its settings are not today's defaults ({})",
-            paths.join(", ")
+            "its settings are not the main job's today ({})",
+            paths
+                .iter()
+                .map(|p| p.trim_start_matches("/fit/").trim_start_matches('/'))
+                .collect::<Vec<_>>()
+                .join(", ")
         ))
     }
 }
@@ -318,6 +347,17 @@ fn coverage_row(
     } else {
         format!("outside: {}", failing.join(", "))
     };
+    // Issue 60: a study passes only with at most 5% of its fits unconverged (records made before
+    // the rule have it in `unconverged`, not in `pass`).
+    let unconverged = s.get("unconverged").and_then(Value::as_u64).unwrap_or(0);
+    let converged_enough =
+        hpge_validation::studies::coverage::unconverged_ok(unconverged as usize, n as usize);
+    if !converged_enough {
+        detail.push_str(&format!(
+            "; {unconverged} of {n} fits unconverged, more than {:.0}%",
+            100.0 * hpge_validation::studies::coverage::MAX_UNCONVERGED_SHARE
+        ));
+    }
     detail.push_str(&subsets_note(&s));
     // A stale study's own verdict is moot: the cell says why it is stale (its record, linked,
     // has the rest).
@@ -325,18 +365,24 @@ fn coverage_row(
         Some(why) => format!("{n} truths, stale: {why}"),
         None => format!(
             "{n} truths, {} ({detail})",
-            if pass { "passes" } else { "fails" }
+            if pass && converged_enough {
+                "passes"
+            } else {
+                "fails"
+            }
         ),
     };
     Ok(StatusRow {
         what: what.into(),
         result,
         target: format!(
-            ">= {needed} truths; each parameter: rank KS p > 0.01, coverage in 99% bands"
+            ">= {needed} truths, >= 95% converged; each parameter: rank KS p > 0.01, coverage in 99% bands"
         ),
         // The acceptance's test per parameter (KS p > 0.01, stricter than the study's own
         // 0.01 / d) and the study's pass.
-        verdict: Verdict::of(pass && failing.is_empty() && n >= needed && stale.is_none()),
+        verdict: Verdict::of(
+            pass && converged_enough && failing.is_empty() && n >= needed && stale.is_none(),
+        ),
         source: rel,
     })
 }
@@ -634,10 +680,33 @@ mod tests {
         let mut lower = settings.clone();
         lower["fit"]["sample"]["ess_min"] = 200.0.into();
         let why = settings_differ(&record(&lower, "surrogate")).unwrap();
-        assert!(why.contains("/fit/sample/ess_min"), "{why}");
+        assert!(why.contains("sample/ess_min"), "{why}");
+        // Issue 60: a study tests the main job's pipeline; the likelihood and sampler targets of
+        // the studies made before 2026-12-06 (the paper's likelihood, ESS 300, 20 000 draws) are
+        // not the main job's, and the reason names each.
+        let mut old = settings.clone();
+        old["fit"]["noise"]["kind"] = "paper".into();
+        old["fit"]["sample"]["max_draws"] = 20_000.into();
+        let why = settings_differ(&record(&old, "surrogate")).unwrap();
+        assert!(why.contains("noise/kind"), "{why}");
+        assert!(why.contains("sample/max_draws"), "{why}");
+        assert!(why.contains("the main job's"), "{why}");
+        let main_job = serde_json::to_value(
+            hpge_inference::fit::FitOptions::default()
+                .settings()
+                .unwrap(),
+        )
+        .unwrap();
+        assert_eq!(settings["fit"]["noise"], main_job["noise"]);
+        for key in ["ess_min", "rhat_max", "max_draws", "chains", "sampler"] {
+            assert_eq!(
+                settings["fit"]["sample"][key], main_job["sample"][key],
+                "{key}"
+            );
+        }
         // The same settings as a study with exact data lack its pipeline (exact check, refinement).
         let why = settings_differ(&record(&settings, "exact")).unwrap();
-        assert!(why.contains("/pipeline"), "{why}");
+        assert!(why.contains("pipeline"), "{why}");
         assert!(settings_differ(&serde_json::json!({"n_truths": 200})).is_some());
     }
 

@@ -53,6 +53,18 @@ impl Parameters {
     }
 
     /// Parses `NAME=VALUE` (as given to `--param`); the error is an [`Error::Expression`].
+    ///
+    /// ```
+    /// use hpge_solver::Parameters;
+    /// let (name, value) = Parameters::parse_assignment("d_li_mm=2.5")?;
+    /// assert_eq!((name.as_str(), value), ("d_li_mm", 2.5));
+    /// let mut p = Parameters::new();
+    /// p.set(name, value);
+    /// assert_eq!(p.get("d_li_mm"), Some(2.5));
+    /// assert!(Parameters::parse_assignment("d_li_mm").is_err(), "no value");
+    /// assert!(Parameters::parse_assignment("d_li_mm=inf").is_err(), "not finite");
+    /// # Ok::<(), hpge_solver::Error>(())
+    /// ```
     pub fn parse_assignment(text: &str) -> Result<(String, f64)> {
         parse_assignment(text).map_err(|reason| Error::Expression {
             text: text.to_string(),

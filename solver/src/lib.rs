@@ -46,6 +46,7 @@
 //! # Ok::<(), hpge_solver::Error>(())
 //! ```
 
+#![warn(missing_docs)]
 mod carrier;
 mod error;
 mod relaxation;

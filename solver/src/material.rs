@@ -34,6 +34,14 @@ const LIBRARY: &[(&str, f64, bool)] = &[
 
 impl Material {
     /// The built-in material called `name`, if there is one.
+    ///
+    /// ```
+    /// use hpge_solver::material::Material;
+    /// let ge = Material::builtin("HPGe").expect("built in");
+    /// assert_eq!((ge.eps_r, ge.conductor), (16.0, false));
+    /// assert!(Material::builtin("copper").unwrap().conductor);
+    /// assert!(Material::builtin("germanium").is_none(), "names are exact");
+    /// ```
     pub fn builtin(name: &str) -> Option<Material> {
         LIBRARY
             .iter()

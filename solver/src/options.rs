@@ -24,7 +24,7 @@ pub struct DetectorInput {
     /// Impurity model file (TOML) replacing the detector's default model.
     #[cfg_attr(feature = "clap", arg(long, value_name = "FILE"))]
     pub impurity: Option<PathBuf>,
-    /// Override a parameter declared in the detector's [parameters], e.g. --param d_li_mm=3.
+    /// Override a parameter declared in the detector's `[parameters]`, e.g. --param d_li_mm=3.
     #[cfg_attr(
         feature = "clap",
         arg(

@@ -247,8 +247,13 @@ pub fn run(o: &FitOptions, print_json: bool, allow_unconverged: bool) -> Result<
     {
         let rounds = sm.refinement.as_ref().map_or(1, Vec::len);
         let msg = format!(
-            "Pareto k-hat {}, largest mean shift {:.2} sd after {rounds} round(s)",
+            "Pareto k-hat {} against its limit {:.2} for {} draws (log ratios' range {:.2}; \
+             near-equal weights, within a range of ln 2, would pass), largest mean shift {:.2} sd \
+             after {rounds} round(s)",
             k_hat(c.pareto_k),
+            c.k_hat_limit,
+            c.draws,
+            c.log_ratio_range,
             c.max_abs_shift_sd
         );
         if o.allow_exact_mismatch {

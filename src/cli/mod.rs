@@ -191,7 +191,7 @@ struct PredictArgs {
 
 #[derive(Debug, clap::Args)]
 struct MergeArgs {
-    /// The merged CSV (a sidecar <stem>.json records the run and the shards).
+    /// The merged CSV (a sidecar STEM.json records the run and the shards).
     #[arg(long, value_name = "FILE")]
     out: PathBuf,
     /// The shard folders.
@@ -307,7 +307,7 @@ struct DetectorArgs {
     /// Impurity model file (TOML) replacing the detector's default model.
     #[arg(long, value_name = "FILE")]
     impurity: Option<PathBuf>,
-    /// Override a parameter declared in the detector's [parameters], e.g. --param d_li_mm=3.
+    /// Override a parameter declared in the detector's `[parameters]`, e.g. --param d_li_mm=3.
     #[arg(long = "param", value_name = "NAME=VALUE", value_parser = hpge_solver::Parameters::parse_assignment)]
     params: Vec<(String, f64)>,
     /// Convert a LEGEND diode record (legend-metadata's diodes/NAME.json: geometry,

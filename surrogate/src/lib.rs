@@ -42,6 +42,7 @@
 //! # Ok::<(), hpge_surrogate::Error>(())
 //! ```
 
+#![warn(missing_docs)]
 mod error;
 
 pub mod generate;

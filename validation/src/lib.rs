@@ -28,6 +28,7 @@
 //! # Ok::<(), hpge_validation::Error>(())
 //! ```
 
+#![warn(missing_docs)]
 mod error;
 mod repo;
 

@@ -30,6 +30,19 @@ impl Diagnostics {
     /// Diagnostics of `chains` (each one chain's draws of one parameter, equal lengths >= 4):
     /// [`rank_rhat`], [`ess_bulk`] and [`ess_tail`], the chains split and rank-normalised once
     /// for all three.
+    ///
+    /// ```
+    /// use hpge_inference::diagnostics::Diagnostics;
+    /// // Four well-mixed chains (a Weyl sequence) pass the fit's targets of R-hat <= 1.01 and
+    /// // ESS >= 1000; the same chains with one shifted do not.
+    /// let mut chains: Vec<Vec<f64>> = (0..4)
+    ///     .map(|c| (0..2000).map(|i| ((i * 4 + c) as f64 * 0.618_033_988_75).fract()).collect())
+    ///     .collect();
+    /// assert!(Diagnostics::of(&chains).converged(1.01, 1000.0));
+    /// chains[3].iter_mut().for_each(|x| *x += 0.5);
+    /// let d = Diagnostics::of(&chains);
+    /// assert!(d.rhat > 1.01 && !d.converged(1.01, 1000.0));
+    /// ```
     pub fn of(chains: &[Vec<f64>]) -> Diagnostics {
         let split = split_chains(chains);
         let normalised = rank_normalise(&split);

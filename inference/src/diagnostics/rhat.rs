@@ -32,7 +32,18 @@ pub fn basic_rhat(chains: &[Vec<f64>]) -> f64 {
     (var_plus / w).sqrt()
 }
 
-/// Split R-hat: [`basic_rhat`] of the split chains.
+/// Split R-hat: `basic_rhat` of the split chains.
+///
+/// ```
+/// use hpge_inference::diagnostics::split_rhat;
+/// // Two chains that sample the same sequence agree (R-hat near 1); two stuck at different
+/// // values do not.
+/// let wave: Vec<f64> = (0..400).map(|i| (i as f64 * 0.7).sin()).collect();
+/// let shifted: Vec<f64> = wave.iter().rev().cloned().collect();
+/// assert!((split_rhat(&[wave.clone(), shifted]) - 1.0).abs() < 0.01);
+/// let apart: Vec<f64> = wave.iter().map(|x| x + 5.0).collect();
+/// assert!(split_rhat(&[wave, apart]) > 2.0);
+/// ```
 pub fn split_rhat(chains: &[Vec<f64>]) -> f64 {
     basic_rhat(&split_chains(chains))
 }

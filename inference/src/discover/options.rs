@@ -131,7 +131,7 @@ pub struct DiscoverOptions {
         arg(long, value_name = "NAME|FILE", default_value = DEFAULT_START_MODEL)
     )]
     pub start_model: String,
-    /// Output folder [default: discoveries/<start model>, under the working directory].
+    /// Output folder [default: discoveries/START_MODEL, under the working directory].
     #[cfg_attr(feature = "clap", arg(long, value_name = "DIR"))]
     pub out: Option<PathBuf>,
     /// Replace a discovery of another run (other inputs or settings) in the output folder;

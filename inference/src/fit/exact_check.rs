@@ -68,8 +68,50 @@ impl ExactGrids {
 }
 
 /// The check passes when the Pareto k-hat of its importance ratios is at most this: above it the
-/// re-weighted estimates are unreliable (Vehtari et al. 2024, section 3.2.4).
+/// re-weighted estimates are unreliable (Vehtari et al. 2024, section 3.2.4). With S draws the
+/// limit is the smaller [`k_hat_limit`]`(S) = min(0.7, 1 - 1/log10 S)`.
 pub const K_HAT_LIMIT: f64 = 0.7;
+
+/// ... unless the weights are near-equal: every log ratio within this of every other (every
+/// weight within a factor 2 of every other). Why that suffices without k-hat (issue 60): with
+/// normalised weights w_i and S w_i in [1/R, R], R = exp(range),
+/// - the weights' ESS = 1 / sum w_i^2 >= S / R (sum w_i^2 <= max w_i <= R / S): at least half
+///   the draws count, so the re-weighted estimates have at most R times the variance of the
+///   plain ones and the central limit theorem holds at the usual rate;
+/// - each re-weighted mean lies within (R - 1) sd of the plain one
+///   (|sum (w_i - 1/S)(f_i - mean f)| <= max |S w_i - 1| mean |f_i - mean f|), and the shifts,
+///   measured from these reliable weights, are held to [`SHIFT_LIMIT_SD`] as always.
+///
+/// k-hat estimates the shape of the largest ratios' tail whatever its scale: on near-equal
+/// weights it measures noise (the PPC example of `docs/own-detector.md`: k-hat 0.8-1.2 on
+/// log ratios of range 0.41). What no finite sample shows, a region the draws did not reach,
+/// k-hat fitted to those same draws does not show either.
+pub const NEAR_EQUAL_LOG_RANGE: f64 = std::f64::consts::LN_2;
+
+/// The sample-size-dependent k-hat limit of Vehtari et al. (JMLR 2024, section 3.2.4),
+/// min(0.7, 1 - 1/log10 S): 0.5 at S = 100, 0.57 at 200, 0.67 at 1000; 0 or below (no k-hat
+/// passes) for S <= 10.
+///
+/// ```
+/// use hpge_inference::fit::k_hat_limit;
+/// assert!((k_hat_limit(100) - 0.5).abs() < 1e-12);
+/// assert_eq!(k_hat_limit(1_000_000), 0.7);
+/// assert!(k_hat_limit(10) <= 0.0);
+/// ```
+pub fn k_hat_limit(draws: usize) -> f64 {
+    if draws < 2 {
+        return f64::NEG_INFINITY;
+    }
+    (1.0 - 1.0 / (draws as f64).log10()).min(K_HAT_LIMIT)
+}
+
+/// Whether importance ratios with Pareto `k_hat` over `draws` draws, whose log ratios span
+/// `log_ratio_range` (max - min; `failed` draws without an exact solve), are reliable:
+/// near-equal weights ([`NEAR_EQUAL_LOG_RANGE`], no failed draw), or k-hat within
+/// [`k_hat_limit`]. NaN fails.
+pub fn weights_reliable(k_hat: f64, draws: usize, log_ratio_range: f64, failed: usize) -> bool {
+    (failed == 0 && log_ratio_range <= NEAR_EQUAL_LOG_RANGE) || k_hat <= k_hat_limit(draws)
+}
 
 /// ... and every posterior mean lies within this many posterior sd of its exact re-weighted
 /// value (issue 21's acceptance: the surrogate moves no mean by more than a quarter of its sd).
@@ -158,9 +200,18 @@ pub struct ExactCheck {
     /// The largest |shift_sd|.
     #[serde(deserialize_with = "super::round::f64_or_nan")]
     pub max_abs_shift_sd: f64,
-    /// Whether k-hat <= [`K_HAT_LIMIT`], every |shift| <= [`SHIFT_LIMIT_SD`] and no ascent
-    /// found a better basin ([`super::BasinAscent::better`]).
+    /// Whether the weights are reliable ([`weights_reliable`]: near-equal, or k-hat within
+    /// [`k_hat_limit`] of the draws), every |shift| <= [`SHIFT_LIMIT_SD`] and no ascent found a
+    /// better basin ([`super::BasinAscent::better`]).
     pub pass: bool,
+    /// The k-hat limit for these draws, [`k_hat_limit`] (NaN in files made before it: there
+    /// the limit was [`K_HAT_LIMIT`]).
+    #[serde(default = "nan", deserialize_with = "super::round::f64_or_nan")]
+    pub k_hat_limit: f64,
+    /// Whether the weights were near-equal ([`NEAR_EQUAL_LOG_RANGE`]), which passes whatever
+    /// k-hat says.
+    #[serde(default)]
+    pub near_equal: bool,
     /// Wall time, s.
     #[serde(deserialize_with = "super::round::f64_or_nan")]
     pub seconds: f64,
@@ -367,7 +418,10 @@ pub fn exact_check(
         ess: p.ess,
         log_ratio_sd,
         log_ratio_range,
-        pass: p.k_hat <= K_HAT_LIMIT && max_abs_shift_sd <= SHIFT_LIMIT_SD,
+        pass: weights_reliable(p.k_hat, draws.len(), log_ratio_range, failed)
+            && max_abs_shift_sd <= SHIFT_LIMIT_SD,
+        k_hat_limit: k_hat_limit(draws.len()),
+        near_equal: failed == 0 && log_ratio_range <= NEAR_EQUAL_LOG_RANGE,
         parameters,
         max_rel_diff_at_mode: max_rel,
         chi2_exact_at_mode: chi2_exact,
@@ -471,4 +525,55 @@ fn mean_sd(x: &[f64]) -> (f64, f64) {
     let m = x.iter().sum::<f64>() / n;
     let sd = (x.iter().map(|v| (v - m).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
     (m, sd)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_k_hat_limit_falls_with_fewer_draws_and_near_equal_weights_pass_whatever_k_hat() {
+        // Vehtari et al. 2024: 1 - 1/log10(S), at most 0.7.
+        assert!((k_hat_limit(100) - 0.5).abs() < 1e-12);
+        assert!((k_hat_limit(200) - (1.0 - 1.0 / 200f64.log10())).abs() < 1e-12);
+        assert_eq!(k_hat_limit(10_000), 0.7);
+        assert!(k_hat_limit(10) <= 0.0 && k_hat_limit(1) == f64::NEG_INFINITY);
+        // The main job's round 1 (2026-12-06): k-hat 0.78, log ratios spread over 4.5: fails;
+        // its round 2, k-hat 0.43 over 100 draws: passes; 0.6 over 100 draws now fails.
+        assert!(!weights_reliable(0.78, 100, 4.53, 0));
+        assert!(weights_reliable(0.43, 100, 5.77, 0));
+        assert!(!weights_reliable(0.6, 100, 3.0, 0));
+        assert!(weights_reliable(0.6, 1000, 3.0, 0));
+        // NaN k-hat (too few draws for a tail) fails unless the weights are near-equal.
+        assert!(!weights_reliable(f64::NAN, 12, 2.0, 0));
+        assert!(weights_reliable(f64::NAN, 12, 0.3, 0));
+        // A draw without an exact solve has weight 0: never near-equal.
+        assert!(!weights_reliable(f64::NAN, 12, 0.3, 1));
+    }
+
+    #[test]
+    fn near_equal_weights_with_a_heavy_looking_tail_pass_and_a_real_heavy_tail_fails() {
+        // The PPC example's shape: 100 log ratios within 0.41 of each other whose top few spread
+        // out, so the tail's shape looks heavy: k-hat above 0.7, every weight within 1.5x.
+        let mut lr: Vec<f64> = (0..100).map(|i| 0.002 * f64::from(i % 7)).collect();
+        for (j, x) in lr.iter_mut().rev().take(6).enumerate() {
+            *x = 0.41 * (1.0 - 0.15 * j as f64);
+        }
+        let p = crate::summary::psis(&lr);
+        let (_, range) = spread(lr.iter().copied());
+        assert!(p.k_hat > 0.7, "k-hat {}", p.k_hat);
+        assert!(range <= 0.41 + 1e-12);
+        assert!(weights_reliable(p.k_hat, lr.len(), range, 0));
+        // Ratios with a Pareto tail of shape 1 (r = 1/u): neither near-equal nor a small k-hat.
+        let heavy: Vec<f64> = (1..=100)
+            .map(|i| -((f64::from(i) - 0.5) / 100.0).ln())
+            .collect();
+        let q = crate::summary::psis(&heavy);
+        let (_, range) = spread(heavy.iter().copied());
+        assert!(
+            !weights_reliable(q.k_hat, heavy.len(), range, 0),
+            "k-hat {}",
+            q.k_hat
+        );
+    }
 }

@@ -27,12 +27,13 @@ pub use checkpoint::{
 };
 pub use exact_check::{
     DEFAULT_GRID_CHECK, ExactCheck, ExactCheckSettings, ExactGrids, FailedSolve, GridCheck,
-    K_HAT_LIMIT, ParameterShift, SHIFT_LIMIT_SD, add_grid_check, exact_check,
+    K_HAT_LIMIT, NEAR_EQUAL_LOG_RANGE, ParameterShift, SHIFT_LIMIT_SD, add_grid_check, exact_check,
+    k_hat_limit, weights_reliable,
 };
 pub use job::{EXACT_CHECK_TOLERANCE, FitFiles, FitJob, file_hash};
 pub use options::{
     DEFAULT_DATA, DEFAULT_DETECTOR, DEFAULT_EXACT_DRAWS, DEFAULT_MODEL, DEFAULT_PRIOR,
-    FIT_MAX_SECONDS, FitOptions, check_positive, noise_settings, sampler_kind,
+    FIT_LIKELIHOOD, FIT_MAX_SECONDS, FitOptions, check_positive, noise_settings, sampler_kind,
 };
 pub use predictive::thin_indices;
 pub use predictive::{Predictive, predictive};

@@ -48,7 +48,7 @@ pub const FIT_LIKELIHOOD: &str = "auto";
 #[cfg_attr(feature = "clap", derive(clap::Args))]
 pub struct FitOptions {
     /// The measured C-V curve (CSV with voltage_V, c12_pF, sigma_pF; its covariance is read from
-    /// <stem>.covariance.csv when present).
+    /// STEM.covariance.csv when present).
     #[cfg_attr(feature = "clap", arg(long, value_name = "FILE", default_value = DEFAULT_DATA))]
     pub data: PathBuf,
     /// The surrogate model (.safetensors).
@@ -64,7 +64,7 @@ pub struct FitOptions {
         arg(long, value_name = "FILE", default_value = DEFAULT_DETECTOR)
     )]
     pub detector: PathBuf,
-    /// Output folder [default: fits/<prior name>, under the working directory].
+    /// Output folder [default: fits/PRIOR_NAME, under the working directory].
     #[cfg_attr(feature = "clap", arg(long, value_name = "DIR"))]
     pub out: Option<PathBuf>,
     /// Replace a fit of another run (other inputs or settings) in the output folder; without
@@ -122,7 +122,7 @@ pub struct FitOptions {
     pub allow_exact_mismatch: bool,
     /// Likelihood: paper (independent, 3% measurement term), covariance (the measured
     /// covariance instead of the 3% term: one calibration scale shared by every point), or auto
-    /// (covariance where the curve comes with its <stem>.covariance.csv, else paper).
+    /// (covariance where the curve comes with its STEM.covariance.csv, else paper).
     #[cfg_attr(feature = "clap", arg(long, default_value = FIT_LIKELIHOOD))]
     pub likelihood: String,
     /// The surrogate's constant sigma_p in the likelihood (the paper's eq. 13) even where its

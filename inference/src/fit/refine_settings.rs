@@ -50,7 +50,7 @@ impl RefineVariance {
     /// Parses `best` or `local`.
     ///
     /// # Errors
-    /// [`Error::BadOption`] naming `--refine-variance` and the value.
+    /// [`crate::Error::BadOption`] naming `--refine-variance` and the value.
     pub fn parse(name: &str) -> Result<Self> {
         match name {
             "best" => Ok(Self::Best),

@@ -118,7 +118,7 @@ fn quantile(sorted: &[f64], q: f64) -> f64 {
 }
 
 /// The fitted zeta at the global mode `mode` (the prior's free parameters) along the lines of
-/// the mode's detector (see [`lines`]); with `draws`, the 68.3% and 95.5% central bands over
+/// the mode's detector (see `lines`); with `draws`, the 68.3% and 95.5% central bands over
 /// their densities at the same points, and with `truth` (the prior's parameters), the truth's.
 /// A draw whose detector cannot be built (outside the model's domain) is left out of the bands.
 ///

@@ -98,7 +98,7 @@ impl CvModel for ExactModel {
         format!("exact solver ({})", self.solver.detector_file.display())
     }
 
-    /// The nearby curves on `x`'s grids ([`near_curves`]).
+    /// The nearby curves on `x`'s grids (`near_curves`).
     fn curves_near(
         &self,
         x: &[f64],

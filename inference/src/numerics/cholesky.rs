@@ -13,6 +13,17 @@ pub struct Cholesky {
 impl Cholesky {
     /// Factorises the symmetric positive-definite `a` (row-major n x n); None when a pivot is
     /// not positive.
+    ///
+    /// ```
+    /// use hpge_inference::numerics::Cholesky;
+    /// let a = [4.0, 2.0, 2.0, 3.0];
+    /// let c = Cholesky::new(&a, 2).expect("positive definite");
+    /// // det A = 8; A x = b solved back.
+    /// assert!((c.ln_det() - 8f64.ln()).abs() < 1e-14);
+    /// let x = c.solve(&[6.0, 5.0]);
+    /// assert!((x[0] - 1.0).abs() < 1e-14 && (x[1] - 1.0).abs() < 1e-14);
+    /// assert!(Cholesky::new(&[1.0, 2.0, 2.0, 1.0], 2).is_none(), "indefinite");
+    /// ```
     pub fn new(a: &[f64], n: usize) -> Option<Self> {
         let mut l = vec![0.0; n * n];
         for i in 0..n {

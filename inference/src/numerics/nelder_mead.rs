@@ -5,6 +5,15 @@
 
 /// Maximises `f` from `x0` with initial steps `step`; stops after `max_evals` evaluations or when
 /// the simplex's values agree within `tol`. Returns (x, f(x)).
+///
+/// ```
+/// use hpge_inference::numerics::nelder_mead;
+/// // The maximum of -(x - 1)^2 - 10 (y + 2)^2 at (1, -2).
+/// let f = |x: &[f64]| -(x[0] - 1.0).powi(2) - 10.0 * (x[1] + 2.0).powi(2);
+/// let (x, fx) = nelder_mead(&f, &[0.0, 0.0], 0.5, 2000, 1e-14);
+/// assert!((x[0] - 1.0).abs() < 1e-5 && (x[1] + 2.0).abs() < 1e-5);
+/// assert!(fx <= 0.0 && fx > -1e-9);
+/// ```
 pub fn nelder_mead(
     f: &dyn Fn(&[f64]) -> f64,
     x0: &[f64],

@@ -59,6 +59,25 @@ impl PriorSpec {
 
     /// Parses a prior from TOML text (`path` names it in messages) and checks what can be checked
     /// without a model: names unique, bounds ordered, standard deviations positive.
+    ///
+    /// ```
+    /// use std::path::Path;
+    /// use hpge_inference::PriorSpec;
+    /// let text = r#"
+    /// name = "li"
+    /// [[parameters]]
+    /// name = "d_li_mm"
+    /// inputs = ["d_li_mm"]
+    /// prior = { distribution = "uniform", lo = 0.2, hi = 5.0 }
+    /// "#;
+    /// let spec = PriorSpec::from_toml_str(text, Path::new("li.toml"))?;
+    /// assert_eq!(spec.parameters.len(), 1);
+    /// // Bounds out of order are refused, naming the file.
+    /// let bad = text.replace("lo = 0.2, hi = 5.0", "lo = 5.0, hi = 0.2");
+    /// let e = PriorSpec::from_toml_str(&bad, Path::new("li.toml")).unwrap_err();
+    /// assert!(e.to_string().contains("li.toml"), "{e}");
+    /// # Ok::<(), hpge_inference::Error>(())
+    /// ```
     pub fn from_toml_str(text: &str, path: &Path) -> Result<Self> {
         let mut spec: PriorSpec =
             toml::from_str(text).map_err(|e| Error::format(path, e.to_string()))?;

@@ -89,7 +89,7 @@ fn gpd_quantile(p: f64, k: f64, sigma: f64) -> f64 {
 }
 
 /// The fewest draws whose Pareto k-hat [`psis`] estimates (a tail of at least 5 draws);
-/// with fewer, k-hat is NaN and an exact-solver check cannot pass on it.
+/// with fewer, k-hat is NaN (an exact-solver check then passes only on near-equal weights).
 pub const PSIS_MIN_DRAWS: usize = 21;
 
 /// Pareto smoothed importance sampling of the log importance ratios `log_ratios` (one per draw).
@@ -111,6 +111,20 @@ pub const PSIS_MIN_DRAWS: usize = 21;
 /// leaves the tail unsmoothed with `k_hat = NaN`. Log ratios of `-inf` are zero weights; a NaN
 /// or `+inf` log ratio, or all of them `-inf`, gives NaN weights, `k_hat` and `ess`. Empty
 /// input gives no weights, `k_hat = NaN` and `ess = 0`.
+///
+/// ```
+/// use hpge_inference::summary::psis;
+/// // Equal ratios: uniform weights, k-hat 0, ESS = S.
+/// let flat = psis(&[0.3; 100]);
+/// assert_eq!(flat.k_hat, 0.0);
+/// assert!((flat.ess - 100.0).abs() < 1e-9);
+/// // Ratios with a Pareto tail of shape 1 (r = 1/u): k-hat far above 0.7, few effective draws.
+/// let heavy: Vec<f64> = (1..=400).map(|i| -((i as f64 - 0.5) / 400.0).ln()).collect();
+/// let p = psis(&heavy);
+/// assert!(p.k_hat > 0.7, "{}", p.k_hat);
+/// assert!(p.ess < 100.0);
+/// assert!((p.weights.iter().sum::<f64>() - 1.0).abs() < 1e-12);
+/// ```
 pub fn psis(log_ratios: &[f64]) -> Psis {
     let s = log_ratios.len();
     if s == 0 {

@@ -247,6 +247,8 @@ fn bz_reading(ctx: &Ctx, chi2: f64) -> String {
     )
 }
 
+/// The paper's B_Z fit (section 7.1) on the stand-in: its figures, its rows of the verdict
+/// table and its numbers (`fit_b_z`) in the report (skipped with `--quick`).
 pub fn run_bz(ctx: &mut Ctx) -> Result<()> {
     if ctx.quick {
         skipped(ctx, "b-z", &BZ_FIGS);
@@ -359,6 +361,8 @@ pub fn run_bz(ctx: &mut Ctx) -> Result<()> {
     Ok(())
 }
 
+/// The paper's B_RZ fit (section 7.2) on the stand-in: its figures, its rows of the verdict
+/// table and its numbers in the report (skipped with `--quick`).
 pub fn run_brz(ctx: &mut Ctx) -> Result<()> {
     if ctx.quick {
         skipped(ctx, "b-rz", &BRZ_FIGS);

@@ -8,9 +8,12 @@ use serde_json::json;
 use super::{Cmp, Criterion, Ctx, Judgement};
 use crate::{Error, Result, plot};
 
+/// The file stem of the figure and its record.
 pub const STEM: &str = "sensitivity-25V";
 const VOLTAGE_V: f64 = 25.0;
 
+/// Scans c12 at 25 V over constant densities, draws Fig. 13 and judges the sensitive range
+/// against the paper's zeta_l and zeta_u.
 pub fn run(ctx: &mut Ctx) -> Result<()> {
     // Four densities a decade from 1e7 to 1e11 (so 1e8 and 1e11 are on the grid), and 2e11.
     let zetas: Vec<f64> = if ctx.quick {

@@ -514,6 +514,7 @@ mod tests {
             pass,
             ranks: l,
             unconverged: 2,
+            converged: n - 2,
             unconverged_sampler: None,
             skipped: 0,
             levels,

@@ -27,6 +27,17 @@ impl Format {
 
 /// Checks an output path before any work: a known extension and an existing folder. `flag` names
 /// the option in the message.
+///
+/// ```
+/// use std::path::Path;
+/// use hpge_reports::plot::{Format, check_output};
+/// assert_eq!(Format::from_path(Path::new("cv.PNG")), Some(Format::Png));
+/// let dir = std::env::temp_dir();
+/// assert!(check_output(&dir.join("cv.svg"), "--plot").is_ok());
+/// let e = check_output(&dir.join("cv.jpg"), "--plot").unwrap_err().to_string();
+/// assert!(e.contains("--plot") && e.contains(".svg or .png"), "{e}");
+/// assert!(check_output(&dir.join("no/such/folder/cv.svg"), "--plot").is_err());
+/// ```
 pub fn check_output(path: &Path, flag: &str) -> Result<()> {
     let output = |message: String| Error::Output {
         flag: flag.to_string(),

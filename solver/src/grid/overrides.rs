@@ -12,7 +12,7 @@ use crate::field::FieldSettings;
 #[derive(Debug, Clone, Default, PartialEq)]
 #[cfg_attr(feature = "clap", derive(clap::Args))]
 pub struct GridOverrides {
-    /// Target relative error of c12 for the adaptive grid (the detector's [grid] table, else
+    /// Target relative error of c12 for the adaptive grid (the detector's `[grid]` table, else
     /// 0.002 = 0.2%; for the exact solver of `fit` and `discover`, else 0.01 = 1%).
     #[cfg_attr(
         feature = "clap",
@@ -21,7 +21,7 @@ pub struct GridOverrides {
     pub tolerance: Option<f64>,
     /// A grid setting as KEY=VALUE, VALUE in TOML syntax (e.g. front_spacing_mm=0.1,
     /// adaptive=false, refinement_limits=[0.2,0.1]); repeatable. The keys are those of the
-    /// detector file's [grid] table (detectors/README.md).
+    /// detector file's `[grid]` table (detectors/README.md).
     #[cfg_attr(
         feature = "clap",
         arg(long = "grid", value_name = "KEY=VALUE", value_parser = parse_grid_setting)

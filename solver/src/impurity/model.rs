@@ -82,6 +82,16 @@ pub struct LinearZModel {
 
 impl LinearZModel {
     /// The linear model; errors unless all values are finite and z_top_mm > z_bottom_mm.
+    ///
+    /// ```
+    /// use hpge_solver::impurity::{ImpurityModel, LinearZModel};
+    /// // The manufacturer's p-type levels of Super-Siegfried (cm^-3, negative: p-type).
+    /// let m = LinearZModel::new(-0.7e10, -0.55e10, 0.0, 70.0)?;
+    /// assert!((m.density_cm3(10.0, 35.0) + 0.625e10).abs() < 1.0);
+    /// assert_eq!(m.density_cm3(0.0, 0.0), m.density_cm3(30.0, 0.0), "independent of r");
+    /// assert!(LinearZModel::new(-1e10, -1e10, 5.0, 5.0).is_err());
+    /// # Ok::<(), hpge_solver::Error>(())
+    /// ```
     pub fn new(bottom_cm3: f64, top_cm3: f64, z_bottom_mm: f64, z_top_mm: f64) -> Result<Self> {
         for (name, value) in [
             ("bottom_cm3", bottom_cm3),

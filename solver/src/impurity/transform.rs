@@ -82,6 +82,16 @@ impl LogTransform {
     /// x = T(y) = sign(y) x_l |y|^(1/v) + (x_u - x_l) y (paper Eqs. (19), (20)); dimensionless.
     ///
     /// Defined for every y (|y| > 1 continues the formula and gives |x| > x_u); odd; NaN gives NaN.
+    ///
+    /// ```
+    /// use hpge_solver::impurity::LogTransform;
+    /// let t = LogTransform::default();
+    /// // T(+-1) = +-x_u, T(0) = 0, and the paper's y = 0.7062704 is 1.3e10 cm^-3 (1.3e16 m^-3).
+    /// assert!((t.x_of_y(1.0) - 17.0).abs() < 1e-12 && t.x_of_y(-1.0) == -t.x_of_y(1.0));
+    /// let zeta_cm3 = t.zeta_m3_of_x(t.x_of_y(0.706_270_4)) * 1e-6;
+    /// assert!((zeta_cm3 / 1.3e10 - 1.0).abs() < 1e-4);
+    /// assert!((t.y_of_x(t.x_of_y(0.3)) - 0.3).abs() < 1e-13);
+    /// ```
     pub fn x_of_y(&self, y: f64) -> f64 {
         if y == 0.0 || y.is_nan() {
             return y;

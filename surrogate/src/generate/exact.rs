@@ -219,7 +219,7 @@ impl ExactSolver {
     }
 
     /// c12 (pF) along a C-V curve: `params` as for [`ExactSolver::detector`], `volts` the biases
-    /// (V, increasing). Each point is seeded from its neighbour ([`cv_curve`]).
+    /// (V, increasing). Each point is seeded from its neighbour (`hpge_solver::field::cv_curve`).
     pub fn curve(&self, params: &[f64], volts: &[f64]) -> Result<Vec<f64>> {
         self.curve_with(params, volts, Continuation::Seeded)
     }

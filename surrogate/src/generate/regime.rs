@@ -64,6 +64,15 @@ impl Regime {
 
     /// Parses the three fields as [`Regime::csv`] writes them (None: a failed row's NaNs, or
     /// text that is not a regime).
+    ///
+    /// ```
+    /// use hpge_surrogate::generate::Regime;
+    /// // One pocket at -12.5 V of 0.25 cm^3, as a row of rows.csv carries it.
+    /// let r = Regime::parse("1", "-12.5", "0.25").expect("a regime");
+    /// assert_eq!((r.pockets, r.level_v, r.volume_cm3), (1, -12.5, 0.25));
+    /// assert_eq!(Regime::csv(Some(&r)), "1,-12.5,0.25");
+    /// assert_eq!(Regime::parse("NaN", "NaN", "NaN"), None, "a failed row");
+    /// ```
     pub fn parse(pockets: &str, level_v: &str, volume_cm3: &str) -> Option<Regime> {
         Some(Regime {
             pockets: pockets.trim().parse().ok()?,

@@ -29,6 +29,16 @@ impl Shard {
     pub const WHOLE: Shard = Shard { k: 0, m: 1 };
 
     /// Parses `K/M`; the error is an [`Error::Argument`] named by the text.
+    ///
+    /// ```
+    /// use hpge_surrogate::Shard;
+    /// let s = Shard::parse("1/4")?;
+    /// // Strided: shard 1 of 4 takes every fourth index from offset + 1.
+    /// assert_eq!(s.indices(100, 10).collect::<Vec<_>>(), [101, 105, 109]);
+    /// assert!(Shard::parse("4/4").is_err());
+    /// assert!(Shard::parse("1of4").is_err());
+    /// # Ok::<(), hpge_surrogate::Error>(())
+    /// ```
     pub fn parse(s: &str) -> Result<Shard> {
         let bad = |message: String| Error::Argument {
             name: s.to_string(),
@@ -84,7 +94,7 @@ pub struct Fingerprint {
     #[serde(default = "one", skip_serializing_if = "is_one")]
     pub curve_points: u64,
     /// Active learning (`generate --where`): the models and share that chose which of the
-    /// `n` candidates are solved ([`super::select`]). Absent from the files of runs that
+    /// `n` candidates are solved (`generate::select`). Absent from the files of runs that
     /// solve every index, so their fingerprints are what they were before.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub selection: Option<SelectionInfo>,
@@ -291,7 +301,7 @@ impl Generator {
 
     /// Active learning: of the run's `n` candidate indices, solve only the top `share` by the
     /// disagreement of `models` ((file as given, its bytes, the loaded model); see
-    /// [`super::select`]). Refused for a model of another space or detector (naming both
+    /// `generate::select`). Refused for a model of another space or detector (naming both
     /// hashes), a share outside (0, 1], and in curve mode.
     pub fn with_selection(
         mut self,
@@ -397,8 +407,8 @@ impl Generator {
             .collect()
     }
 
-    /// The CSV header: index, u_<name>..., <name>..., c12_pF, status, c12_err_pF, pockets,
-    /// pocket_level_V, pocket_cm3, seconds ([`super::regime`]).
+    /// The CSV header: index, u_NAME..., NAME..., c12_pF, status, c12_err_pF, pockets,
+    /// pocket_level_V, pocket_cm3, seconds (`generate::regime`).
     pub fn header(&self) -> String {
         self.header_with(true)
     }

@@ -54,8 +54,8 @@ pub struct TrainJob {
     /// baseline).
     #[cfg_attr(feature = "clap", arg(long, default_value = DEFAULT_RECIPE))]
     pub recipe: String,
-    /// The model file (.safetensors); learning curves go to <stem>.curves.csv beside it, the
-    /// checkpoints of finished members to <stem>.partial/.
+    /// The model file (.safetensors); learning curves go to STEM.curves.csv beside it, the
+    /// checkpoints of finished members to STEM.partial/.
     #[cfg_attr(feature = "clap", arg(long, value_name = "FILE"))]
     pub out: PathBuf,
     /// Seed of the initial weights and the batch order (member m uses seed + m).

@@ -15,7 +15,7 @@ pub const GATE_INPUT: &str = "gate_proximity";
 
 impl Surrogate {
     /// The calibrated per-point uncertainty, when the model file has one: inputs the space's
-    /// dimensions (network order), and on a gated surrogate also [`GATE_INPUT`].
+    /// dimensions (network order), and on a gated surrogate also the gate input (`GATE_INPUT`).
     pub fn error_model(&self) -> Option<&ErrorModel> {
         let d = self.dims.len();
         self.info.error_model.as_ref().filter(|m| {

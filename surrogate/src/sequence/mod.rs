@@ -37,6 +37,13 @@ pub struct Sequence {
 }
 
 /// phi_d: the positive root of x^(d+1) = x + 1 (Newton from 2; phi_1 is the golden ratio).
+///
+/// ```
+/// use hpge_surrogate::sequence::phi_d;
+/// assert!((phi_d(1) - (1.0 + 5f64.sqrt()) / 2.0).abs() < 1e-15);
+/// let p = phi_d(10);
+/// assert!((p.powi(11) - p - 1.0).abs() < 1e-12);
+/// ```
 pub fn phi_d(d: usize) -> f64 {
     let p = (d + 1) as i32;
     let mut x = 2.0_f64;
@@ -111,6 +118,16 @@ impl Sequence {
     }
 
     /// Point n (n < [`Self::max_points`]; callers check the range), every coordinate in [0, 1).
+    ///
+    /// ```
+    /// use hpge_surrogate::{Sequence, SequenceKind};
+    /// let s = Sequence::new(SequenceKind::Golden, 3, 0);
+    /// // Seed 0 starts at the centre; point n adds n alpha (mod 1).
+    /// assert_eq!(s.point(0), vec![0.5, 0.5, 0.5]);
+    /// let p = s.point(1000);
+    /// assert!(p.iter().all(|x| (0.0..1.0).contains(x)));
+    /// assert_eq!(p, s.point(1000), "a point depends on its index alone");
+    /// ```
     pub fn point(&self, n: u64) -> Vec<f64> {
         match self.kind {
             SequenceKind::Golden => self

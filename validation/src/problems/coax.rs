@@ -100,6 +100,20 @@ impl LongCoax {
     }
 
     /// Capacitance per unit length c' = 2 pi eps / ln(b / r_d) in pF/mm at bias `bias_v` (V).
+    ///
+    /// ```
+    /// use hpge_validation::LongCoax;
+    /// let c = LongCoax::validation();
+    /// // Fully depleted: the vacuum coax formula with eps_r = 16, 2 pi eps / ln(37.5 / 6).
+    /// let eps = 8.854_187_812_8e-12 * 16.0;
+    /// let expected_pf_per_mm = 2.0 * std::f64::consts::PI * eps / (37.5f64 / 6.0).ln() * 1e9;
+    /// let above = c.c12_per_mm_pf(2.0 * c.full_depletion_v())?;
+    /// assert!((above / expected_pf_per_mm - 1.0).abs() < 1e-9);
+    /// // The front and the bias are each other's inverse.
+    /// let u = c.bias_for_front_v(20.0);
+    /// assert!((c.front_mm(u)? - 20.0).abs() < 1e-9);
+    /// # Ok::<(), hpge_validation::Error>(())
+    /// ```
     pub fn c12_per_mm_pf(&self, bias_v: f64) -> Result<f64> {
         let rd = self.front_mm(bias_v)?;
         // F/m -> pF/mm: 1e12 pF/F * 1e-3 m/mm.

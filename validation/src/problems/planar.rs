@@ -100,6 +100,19 @@ impl PlanarPn {
 
     /// Mutual capacitance c12 = eps A / w (w = T beyond U_fd) in pF at bias `bias_v` (V); an
     /// error at 0 V (w = 0) and outside the domain.
+    ///
+    /// ```
+    /// use hpge_validation::PlanarPn;
+    /// let p = PlanarPn::validation();
+    /// // U_fd = 565.47 V and eps A / T = 17.8024 pF (the file's numbers).
+    /// assert!((p.full_depletion_v() - 565.47).abs() < 0.01);
+    /// assert!((p.c12_pf(1000.0)? - 17.8024).abs() < 1e-4);
+    /// // Below U_fd, w grows as sqrt(U): a quarter of U_fd depletes half, so c12 doubles.
+    /// let c_quarter = p.c12_pf(p.full_depletion_v() / 4.0)?;
+    /// assert!((c_quarter / p.c12_fully_depleted_pf() - 2.0).abs() < 1e-12);
+    /// assert!(p.c12_pf(0.0).is_err());
+    /// # Ok::<(), hpge_validation::Error>(())
+    /// ```
     pub fn c12_pf(&self, bias_v: f64) -> Result<f64> {
         let w_mm = self.depth_mm(bias_v)?;
         if w_mm <= 0.0 {

@@ -270,6 +270,14 @@ pub fn marginal_mode(draws: &[f64], weights: Option<&[f64]>, range: [f64; 2], bi
 }
 
 /// Whether `x` lies in one of the closed intervals `[lo, hi]` (false for NaN).
+///
+/// ```
+/// use hpge_inference::summary::interval_contains;
+/// let two = [[0.0, 1.0], [2.0, 3.0]];
+/// assert!(interval_contains(&two, 1.0) && interval_contains(&two, 2.5));
+/// assert!(!interval_contains(&two, 1.5));
+/// assert!(!interval_contains(&two, f64::NAN));
+/// ```
 pub fn interval_contains(intervals: &[[f64; 2]], x: f64) -> bool {
     intervals.iter().any(|&[lo, hi]| lo <= x && x <= hi)
 }

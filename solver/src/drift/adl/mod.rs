@@ -53,7 +53,7 @@ impl AdlModel {
     }
 
     /// The unit vector (lab frame) of the crystal axis with Miller indices `hkl` (crystal <001>
-    /// = lab z, crystal [100] at azimuth phi110 + 45 deg).
+    /// = lab z, crystal `[100]` at azimuth phi110 + 45 deg).
     pub fn crystal_axis(&self, hkl: [f64; 3]) -> [f64; 3] {
         let n = norm3(hkl);
         let m = &self.to_crystal;

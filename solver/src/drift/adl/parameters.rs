@@ -69,7 +69,7 @@ impl AxisParameters {
 /// h111 (61215, 0.662, 182) as (mu0 cm^2/Vs, beta, E0 V/cm, mun cm^2/Vs); electron effective
 /// masses of the L valleys m_l = 1.64 m_e, m_t = 0.0819 m_e; crystal orientation phi110 = -45 deg.
 ///
-/// Orientation: the crystal's <001> axis is the detector axis z; the crystal [100] axis lies at
+/// Orientation: the crystal's `<001>` axis is the detector axis z; the crystal `[100]` axis lies at
 /// azimuth phi110 + 45 deg in the lab x-y plane, so the [1-10] axis (a <110> axis) lies at
 /// azimuth phi110 (the convention of SolidStateDetectors.jl). With the default -45 deg the
 /// crystal axes coincide with the lab axes.
