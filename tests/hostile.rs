@@ -57,6 +57,10 @@ struct Case {
     link: Vec<[String; 2]>,
     #[serde(default)]
     memory_kib: Option<u64>,
+    /// Seconds after which the run is killed (SIGKILL; the case then fails on its exit code):
+    /// for a case that would otherwise not end at all on the code before its fix.
+    #[serde(default)]
+    timeout_s: Option<u64>,
     /// Environment variables removed for the run.
     #[serde(default)]
     unset: Vec<String>,
@@ -92,6 +96,12 @@ struct FileSpec {
     /// Raw bytes in hex instead of text (binary garbage).
     #[serde(default)]
     hex: Option<String>,
+    /// `text` repeated this many times (a long table), `{x}` in it standing for numbers evenly
+    /// spaced over `range` (first and last included).
+    #[serde(default)]
+    repeat: Option<usize>,
+    #[serde(default)]
+    range: Option<[f64; 2]>,
 }
 
 /// The binary the cases run: this build's, or `HPGE_HOSTILE_BIN` (e.g. a build of the code
@@ -144,6 +154,13 @@ fn write_file(f: &FileSpec, tmp: &Path, case: &str) {
     if let Some(n) = f.head {
         text = text.lines().take(n).map(|l| format!("{l}\n")).collect();
     }
+    if let Some(n) = f.repeat {
+        let [a, b] = f.range.unwrap_or([0.0, 0.0]);
+        let step = if n > 1 { (b - a) / (n - 1) as f64 } else { 0.0 };
+        text = (0..n)
+            .map(|i| text.replace("{x}", &(a + step * i as f64).to_string()))
+            .collect();
+    }
     for [old, new] in &f.replace {
         assert!(
             text.contains(old.as_str()),
@@ -171,8 +188,10 @@ fn run_case(c: &Case) -> Vec<String> {
     }
     let args: Vec<String> = c.args.iter().map(|a| sh_quote(&expand(a, &tmp))).collect();
     let script = format!(
-        "ulimit -v {}; exec {} {}",
+        "ulimit -v {}; exec {}{} {}",
         c.memory_kib.unwrap_or(DEFAULT_MEMORY_KIB),
+        c.timeout_s
+            .map_or(String::new(), |t| format!("timeout --signal=KILL {t} ")),
         sh_quote(&binary()),
         args.join(" ")
     );

@@ -558,8 +558,11 @@ impl Drop for Tmpfs {
 }
 
 /// Issue 66, cause 3: on a full disk (a small tmpfs, filled up) no command leaves an empty or
-/// partial file under the name asked for, nor a temporary. Skipped where no tmpfs can be mounted
-/// (without root).
+/// partial file under the name asked for, nor a temporary, nor a folder it made: `simulate`,
+/// `field`, `detector --plot`, `measure`, `pulse`, `sensitivity`, `synthesize`, `generate`,
+/// `merge`, `train`, `evaluate --plot`, `fit`, `report paper`, `label` and `calibrate` (the
+/// commands that write files, but `discover` and `validate`, whose runs take minutes). Skipped
+/// where no tmpfs can be mounted (without root).
 #[test]
 fn a_full_disk_leaves_no_partial_output() {
     use std::io::Write as _;
@@ -577,7 +580,133 @@ fn a_full_disk_leaves_no_partial_output() {
         let _ = f.flush();
     }
     let at = |name: &str| disk.join(name).to_str().unwrap().to_string();
+    // Inputs off the full disk: rows for train, a shard for merge, a space for generate.
+    let rows = d.join("rows.csv");
+    let heldout = std::fs::read_to_string("data/training/heldout.csv").unwrap();
+    std::fs::write(
+        &rows,
+        heldout.lines().take(400).collect::<Vec<_>>().join("\n") + "\n",
+    )
+    .unwrap();
+    let test_rows = d.join("test.csv");
+    std::fs::write(
+        &test_rows,
+        heldout.lines().take(50).collect::<Vec<_>>().join("\n") + "\n",
+    )
+    .unwrap();
+    let space = bias_space(&d, "[100.0, 1000.0]");
+    let shard = d.join("shard");
+    ok(&generate(&space, "4", &shard, &[]));
+    let s_rows = s(&rows).to_string();
+    let s_test = s(&test_rows).to_string();
+    let s_space = s(&space).to_string();
+    let s_shard = s(&shard).to_string();
+    let s_shard_rows = s(&shard.join("rows.csv")).to_string();
     let cases: Vec<Vec<String>> = vec![
+        vec![
+            "pulse",
+            "--detector",
+            COAX,
+            "--voltage",
+            "2000",
+            "--at",
+            "30,0,5",
+            "--out",
+            at("p.csv").as_str(),
+        ],
+        vec![
+            "sensitivity",
+            "--detector",
+            COAX,
+            "--zeta-range",
+            "1e9:1e10:2",
+            "--voltage",
+            "1000",
+            "--out",
+            at("s.csv").as_str(),
+        ],
+        vec![
+            "synthesize",
+            "--curve",
+            "data/super-siegfried-k1/truth-cv.csv",
+            "--out",
+            at("raw").as_str(),
+            "--pulses",
+            "10",
+            "--decimate",
+            "40",
+        ],
+        vec![
+            "generate",
+            "--space",
+            &s_space,
+            "--detector",
+            COAX,
+            "--n",
+            "4",
+            "--out",
+            at("g").as_str(),
+            "--grid",
+            "adaptive=false",
+        ],
+        vec!["merge", "--out", at("all.csv").as_str(), &s_shard],
+        vec![
+            "train",
+            "--data",
+            &s_rows,
+            "--test",
+            &s_test,
+            "--recipe",
+            "poly3",
+            "--out",
+            at("m.safetensors").as_str(),
+        ],
+        vec![
+            "evaluate",
+            "--model",
+            "models/super-siegfried-rz-paper.safetensors",
+            "--data",
+            &s_test,
+            "--plot",
+            at("eval").as_str(),
+        ],
+        vec![
+            "fit",
+            "--prior",
+            "priors/b-z.toml",
+            "--no-exact-check",
+            "--ess",
+            "30",
+            "--chains",
+            "2",
+            "--mode-starts",
+            "1",
+            "--out",
+            at("fit").as_str(),
+        ],
+        vec!["report", "paper", "--quick", "--out", at("paper").as_str()],
+        vec![
+            "label",
+            "--data",
+            &s_shard_rows,
+            "--space",
+            &s_space,
+            "--detector",
+            COAX,
+            "--out",
+            at("l").as_str(),
+            "--grid",
+            "adaptive=false",
+        ],
+        vec![
+            "calibrate",
+            "--model",
+            "models/super-siegfried-rz-paper.safetensors",
+            "--data",
+            &s_test,
+            "--out",
+            at("m2.safetensors").as_str(),
+        ],
         vec![
             "simulate",
             "--detector",

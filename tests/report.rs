@@ -94,6 +94,18 @@ fn quick_report_makes_every_figure() {
     let faults = hpge_reports::paper::inconsistent_rows(&json);
     assert!(faults.is_empty(), "{faults:#?}");
     assert!(readme.contains("| criterion | verdict |"));
+    // Again into the same folder (issue 66): the figures are staged and put in place together
+    // with the README, a file of another name in figures/ stays, no temporary is left.
+    std::fs::write(out.join("figures").join("mine.txt"), "mine").unwrap();
+    let o = run(&["report", "paper", "--quick", "--out", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(out.join("figures").join("mine.txt").is_file());
+    for dir in [out.clone(), out.join("figures")] {
+        for e in std::fs::read_dir(&dir).unwrap() {
+            let name = e.unwrap().file_name().to_string_lossy().into_owned();
+            assert!(!name.starts_with('.'), "{name} left in {}", dir.display());
+        }
+    }
     let _ = std::fs::remove_dir_all(out.parent().unwrap());
 }
 

@@ -9,6 +9,10 @@
 //! - several outputs together: [`Staged`] writes each to its temporary and renames them all at
 //!   the end ([`Staged::commit`]); dropped before that (a later step failed), it removes the
 //!   temporaries and the folders it made, so a failing command leaves nothing behind;
+//! - not cut by a signal: [`Staged::commit`]'s renames run [`uninterrupted`] (SIGTERM, SIGINT
+//!   and SIGHUP take effect when they are done), so a command killed at any moment leaves all
+//!   of its outputs or none; the temporaries of a killed run are removed by the next
+//!   ([`remove_stale_temporaries`]);
 //! - never over an input: [`overlaps`] says whether an output path is an input (the same path
 //!   after resolving `.`, `..` and links, or the same file through a hard link) or lies inside
 //!   an input folder.
@@ -103,6 +107,10 @@ where
 pub struct Staged {
     /// (temporary, final) in the order they were staged.
     files: Vec<(PathBuf, PathBuf)>,
+    /// Temporary folders among `files`' temporaries, and whether each replaces its final
+    /// folder whole ([`Staged::replacing_folder`]) or only the files of the same names
+    /// ([`Staged::folder`]).
+    dirs: Vec<(PathBuf, bool)>,
     /// Folders made by this command, outermost first.
     folders: Vec<PathBuf>,
     /// Outputs written under their own names already ([`Staged::adopt`]).
@@ -152,6 +160,38 @@ impl Staged {
         tmp
     }
 
+    /// A temporary folder (made empty here, filled by the caller) whose files [`Staged::commit`]
+    /// puts into the output folder `path`: made if missing; where it exists, its files of the
+    /// same names are replaced and the others stay (a figure folder the user named may hold
+    /// other files).
+    ///
+    /// # Errors
+    /// The I/O error of making the temporary folder (or the folders above it).
+    pub fn folder(&mut self, path: &Path) -> io::Result<PathBuf> {
+        self.temporary_folder(path, false)
+    }
+
+    /// A temporary folder (made empty here, filled by the caller) that [`Staged::commit`] puts
+    /// in place of the output folder `path`: a folder already there (an earlier run's) is
+    /// replaced whole, so that none of its files stays mixed with this run's.
+    ///
+    /// # Errors
+    /// The I/O error of making the temporary folder (or the folders above it).
+    pub fn replacing_folder(&mut self, path: &Path) -> io::Result<PathBuf> {
+        self.temporary_folder(path, true)
+    }
+
+    fn temporary_folder(&mut self, path: &Path, replace: bool) -> io::Result<PathBuf> {
+        if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
+            self.make_folder(parent)?;
+        }
+        let tmp = temp_beside(path);
+        fs::create_dir(&tmp)?;
+        self.dirs.push((tmp.clone(), replace));
+        self.files.push((tmp.clone(), path.to_path_buf()));
+        Ok(tmp)
+    }
+
     /// Writes `bytes` as the output `path` (under a temporary name until [`Staged::commit`]).
     ///
     /// # Errors
@@ -181,11 +221,24 @@ impl Staged {
     /// The first rename that fails (with the output's final name). Then nothing of this command
     /// is left: the outputs renamed before it are removed again, with the temporaries not yet
     /// renamed, the outputs adopted and the folders made.
+    ///
+    /// The renames run [`uninterrupted`]: a SIGTERM, SIGINT or SIGHUP that arrives meanwhile
+    /// ends the process after the last of them, so a killed command leaves all of its outputs
+    /// or none.
     pub fn commit(mut self) -> Result<(), (PathBuf, io::Error)> {
+        uninterrupted(|| self.commit_renames())
+    }
+
+    fn commit_renames(&mut self) -> Result<(), (PathBuf, io::Error)> {
         let mut renamed = 0;
         let mut failure = None;
         for (tmp, path) in &self.files {
-            if let Err(e) = fs::rename(tmp, path) {
+            let r = match self.dirs.iter().find(|(d, _)| d == tmp) {
+                Some((_, true)) => replace_folder(tmp, path),
+                Some((_, false)) => merge_folder(tmp, path),
+                None => fs::rename(tmp, path),
+            };
+            if let Err(e) = r {
                 failure = Some((path.clone(), e));
                 break;
             }
@@ -216,12 +269,170 @@ impl Drop for Staged {
             return;
         }
         for f in self.files.iter().map(|(tmp, _)| tmp).chain(&self.written) {
-            let _ = fs::remove_file(f);
+            if self.dirs.iter().any(|(d, _)| d == f) || f.is_dir() {
+                let _ = fs::remove_dir_all(f);
+            } else {
+                let _ = fs::remove_file(f);
+            }
         }
         for d in self.folders.iter().rev() {
             let _ = fs::remove_dir_all(d);
         }
     }
+}
+
+/// Moves the files of the folder `tmp` into the folder `path` (renamed whole where `path` does
+/// not exist), replacing those of the same names, and removes `tmp`.
+fn merge_folder(tmp: &Path, path: &Path) -> io::Result<()> {
+    if fs::symlink_metadata(path).is_err() {
+        return fs::rename(tmp, path);
+    }
+    for e in fs::read_dir(tmp)? {
+        let e = e?;
+        let to = path.join(e.file_name());
+        if e.file_type()?.is_dir() {
+            merge_folder(&e.path(), &to)?;
+        } else {
+            fs::rename(e.path(), to)?;
+        }
+    }
+    fs::remove_dir(tmp)
+}
+
+/// Puts the folder `tmp` in place of `path`: a folder already there is moved aside first and
+/// removed after (restored if `tmp` cannot be renamed).
+fn replace_folder(tmp: &Path, path: &Path) -> io::Result<()> {
+    if fs::symlink_metadata(path).is_err() {
+        return fs::rename(tmp, path);
+    }
+    if !path.is_dir() {
+        return Err(io::Error::other("not a folder: a file is in the way"));
+    }
+    let old = temp_beside(path);
+    fs::rename(path, &old)?;
+    if let Err(e) = fs::rename(tmp, path) {
+        let _ = fs::rename(&old, path);
+        return Err(e);
+    }
+    let _ = fs::remove_dir_all(&old);
+    Ok(())
+}
+
+/// Runs `f` with SIGTERM, SIGINT and SIGHUP held back: one that arrives meanwhile takes its
+/// usual effect (the process ends, as killed by it) as soon as `f` returns. For the few
+/// renames that put several outputs in place together; a signal whose disposition is not the
+/// default (ignored, or handled by someone else) is left alone.
+pub fn uninterrupted<R>(f: impl FnOnce() -> R) -> R {
+    #[cfg(unix)]
+    {
+        signals::hold(f)
+    }
+    #[cfg(not(unix))]
+    {
+        f()
+    }
+}
+
+#[cfg(unix)]
+mod signals {
+    use std::sync::Once;
+    use std::sync::atomic::{AtomicI32, AtomicUsize, Ordering::SeqCst};
+
+    const SIGNALS: [libc::c_int; 3] = [libc::SIGTERM, libc::SIGINT, libc::SIGHUP];
+    /// Sections in progress (any thread).
+    static HELD: AtomicUsize = AtomicUsize::new(0);
+    /// A signal that arrived during one (0: none).
+    static PENDING: AtomicI32 = AtomicI32::new(0);
+    static INSTALL: Once = Once::new();
+
+    /// Ends the process as `sig` would have: its default disposition, raised again.
+    fn die(sig: libc::c_int) {
+        // SAFETY: signal and raise are async-signal-safe; SIG_DFL is a valid disposition.
+        unsafe {
+            libc::signal(sig, libc::SIG_DFL);
+            libc::raise(sig);
+        }
+    }
+
+    extern "C" fn handler(sig: libc::c_int) {
+        PENDING.store(sig, SeqCst);
+        // Not (or no longer) inside a section: the signal's usual effect, now.
+        if HELD.load(SeqCst) == 0 {
+            die(sig);
+        }
+    }
+
+    fn install() {
+        for sig in SIGNALS {
+            // SAFETY: a zeroed sigaction is valid; the old disposition is only read.
+            unsafe {
+                let mut old: libc::sigaction = std::mem::zeroed();
+                if libc::sigaction(sig, std::ptr::null(), &mut old) != 0
+                    || old.sa_sigaction != libc::SIG_DFL
+                {
+                    continue;
+                }
+                let mut new: libc::sigaction = std::mem::zeroed();
+                new.sa_sigaction = handler as *const () as libc::sighandler_t;
+                new.sa_flags = libc::SA_RESTART;
+                libc::sigemptyset(&mut new.sa_mask);
+                libc::sigaction(sig, &new, std::ptr::null_mut());
+            }
+        }
+    }
+
+    pub(super) fn hold<R>(f: impl FnOnce() -> R) -> R {
+        INSTALL.call_once(install);
+        HELD.fetch_add(1, SeqCst);
+        let r = f();
+        if HELD.fetch_sub(1, SeqCst) == 1 {
+            let sig = PENDING.load(SeqCst);
+            if sig != 0 {
+                die(sig);
+            }
+        }
+        r
+    }
+}
+
+/// Removes the temporaries ([`temp_beside`]: `.NAME.PID-N.tmp`, files or folders) in `dir` that
+/// a process no longer running left behind (a run killed before it could put them in place or
+/// remove them). Only where the running processes can be listed (`/proc`); errors are ignored.
+pub fn remove_stale_temporaries(dir: &Path) {
+    let proc = Path::new("/proc");
+    if !proc.join("self").exists() {
+        return;
+    }
+    let Ok(entries) = fs::read_dir(dir) else {
+        return;
+    };
+    for e in entries.flatten() {
+        let name = e.file_name();
+        let Some(name) = name.to_str() else { continue };
+        let Some(pid) = temporary_pid(name) else {
+            continue;
+        };
+        if pid == std::process::id() || proc.join(pid.to_string()).exists() {
+            continue;
+        }
+        let path = e.path();
+        if path.is_dir() && !path.is_symlink() {
+            let _ = fs::remove_dir_all(&path);
+        } else {
+            let _ = fs::remove_file(&path);
+        }
+    }
+}
+
+/// The pid in a temporary's name `.NAME.PID-N.tmp`, if it is one.
+fn temporary_pid(name: &str) -> Option<u32> {
+    let stem = name.strip_prefix('.')?.strip_suffix(".tmp")?;
+    let (_, tail) = stem.rsplit_once('.')?;
+    let (pid, n) = tail.split_once('-')?;
+    if pid.is_empty() || n.is_empty() || !n.bytes().all(|b| b.is_ascii_digit()) {
+        return None;
+    }
+    pid.parse().ok()
 }
 
 /// `path` made absolute and resolved (`.`, `..`, links) as far as it exists, the rest appended
@@ -354,6 +565,88 @@ mod tests {
         s.commit().expect("commit");
         assert_eq!(fs::read_dir(d.join("out")).expect("list").count(), 2);
         let _ = fs::remove_dir_all(&d);
+    }
+
+    #[test]
+    fn a_staged_folder_replaces_an_earlier_one_whole() {
+        let d = scratch("folder");
+        let out = d.join("figs");
+        fs::create_dir_all(&out).expect("folder");
+        fs::write(out.join("old.png"), b"old").expect("old");
+        {
+            let mut s = Staged::new();
+            let t = s.replacing_folder(&out).expect("temporary folder");
+            fs::write(t.join("new.png"), b"new").expect("new");
+        }
+        assert!(
+            out.join("old.png").exists(),
+            "uncommitted: the old folder stays"
+        );
+        assert_eq!(
+            fs::read_dir(&d).expect("list").count(),
+            1,
+            "no temporary left"
+        );
+        let mut s = Staged::new();
+        let t = s.replacing_folder(&out).expect("temporary folder");
+        fs::write(t.join("new.png"), b"new").expect("new");
+        s.commit().expect("commit");
+        let names: Vec<_> = fs::read_dir(&out)
+            .expect("list")
+            .map(|e| e.expect("entry").file_name())
+            .collect();
+        assert_eq!(names, [OsString::from("new.png")]);
+        assert_eq!(
+            fs::read_dir(&d).expect("list").count(),
+            1,
+            "no temporary left"
+        );
+        // A folder the user named: its files of other names stay.
+        let mut s = Staged::new();
+        let t = s.folder(&out).expect("temporary folder");
+        fs::write(t.join("cv.png"), b"cv").expect("cv");
+        fs::write(t.join("new.png"), b"newer").expect("new");
+        s.commit().expect("commit");
+        assert_eq!(fs::read_dir(&out).expect("list").count(), 2);
+        assert_eq!(fs::read(out.join("new.png")).expect("read"), b"newer");
+        assert_eq!(
+            fs::read_dir(&d).expect("list").count(),
+            1,
+            "no temporary left"
+        );
+        // A new folder: made.
+        let mut s = Staged::new();
+        let t = s.folder(&d.join("a/b")).expect("temporary folder");
+        fs::write(t.join("x.svg"), b"x").expect("x");
+        s.commit().expect("commit");
+        assert!(d.join("a/b/x.svg").is_file());
+        let _ = fs::remove_dir_all(&d);
+    }
+
+    #[test]
+    fn stale_temporaries_of_dead_processes_are_removed() {
+        let d = scratch("stale");
+        assert_eq!(temporary_pid(".samples.csv.123-4.tmp"), Some(123));
+        assert_eq!(temporary_pid(".x.tmp"), None);
+        assert_eq!(temporary_pid("samples.csv"), None);
+        let mine = temp_beside(&d.join("a.csv"));
+        fs::write(&mine, b"x").expect("write");
+        // A pid above the kernel's largest (4194304): no such process.
+        fs::write(d.join(".b.csv.999999999-0.tmp"), b"x").expect("write");
+        fs::create_dir(d.join(".figs.999999999-1.tmp")).expect("folder");
+        fs::write(d.join("keep.csv"), b"x").expect("write");
+        remove_stale_temporaries(&d);
+        if Path::new("/proc/self").exists() {
+            assert_eq!(fs::read_dir(&d).expect("list").count(), 2);
+        }
+        assert!(mine.exists() && d.join("keep.csv").exists());
+        let _ = fs::remove_dir_all(&d);
+    }
+
+    #[test]
+    fn uninterrupted_returns_what_it_ran() {
+        assert_eq!(uninterrupted(|| 2 + 2), 4);
+        assert_eq!(uninterrupted(|| uninterrupted(|| "nested")), "nested");
     }
 
     #[test]

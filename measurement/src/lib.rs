@@ -85,8 +85,8 @@ mod types;
 
 pub use error::{Error, Result};
 pub use formats::{
-    Data, PulseFormat, RawProblem, RawRun, covariance_path, load_data, read_curve, read_lh5_pulses,
-    read_model_curve, read_pulse_file, read_pulses, read_raw_dir, write_curve,
+    Data, PulseFormat, RawProblem, RawRun, covariance_path, curve_texts, load_data, read_curve,
+    read_lh5_pulses, read_model_curve, read_pulse_file, read_pulses, read_raw_dir, write_curve,
     write_curve_with_comments, write_pulses,
 };
 pub use measure::{MeasureSettings, Measurement, Problem, VoltagePoint, measure};

@@ -216,6 +216,14 @@ pub fn commit(outputs: hpge_files::Staged) -> Result<()> {
         .map_err(|(file, e)| anyhow::anyhow!("{}: cannot write the file: {e}", file.display()))
 }
 
+/// The folder `path` is in (`.` for a bare name).
+pub fn parent_or_here(path: &std::path::Path) -> &std::path::Path {
+    match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => std::path::Path::new("."),
+    }
+}
+
 /// `x` as `{}` writes it, or in exponent form where that would be long (`1e300`, not 301
 /// digits; issue 66).
 pub fn short(x: f64) -> String {

@@ -164,6 +164,18 @@ impl FitObserver for Display {
     }
 }
 
+/// A Pareto k-hat as printed: NaN (fewer draws than PSIS fits a tail to) says why.
+fn k_hat(k: f64) -> String {
+    if k.is_nan() {
+        format!(
+            "undefined (PSIS needs at least {} draws, --exact-draws)",
+            hpge_inference::summary::PSIS_MIN_DRAWS
+        )
+    } else {
+        format!("{k:.2}")
+    }
+}
+
 /// One line per refinement round.
 fn round_text(r: &RefineRound) -> String {
     let model = if r.round == 0 {
@@ -172,9 +184,9 @@ fn round_text(r: &RefineRound) -> String {
         format!("surrogate corrected by {} exact curves", r.training_curves)
     };
     format!(
-        "round {} ({model}): exact check k-hat {:.2}, largest mean shift {:.2} sd, {:.2}% off at the mode: {} (sampling {:.1} s, exact check {:.1} s){}",
+        "round {} ({model}): exact check k-hat {}, largest mean shift {:.2} sd, {:.2}% off at the mode: {} (sampling {:.1} s, exact check {:.1} s){}",
         r.round,
-        r.pareto_k,
+        k_hat(r.pareto_k),
         r.max_abs_shift_sd,
         100.0 * r.max_rel_diff_at_mode,
         if r.pass { "pass" } else { "fail" },
@@ -235,10 +247,14 @@ pub fn run(o: &FitOptions, print_json: bool, allow_unconverged: bool) -> Result<
     {
         let rounds = sm.refinement.as_ref().map_or(1, Vec::len);
         let msg = format!(
-            "Pareto k-hat {:.2} against its limit {:.2} for {} draws (log ratios' range {:.2}; \
+            "Pareto k-hat {} against its limit {:.2} for {} draws (log ratios' range {:.2}; \
              near-equal weights, within a range of ln 2, would pass), largest mean shift {:.2} sd \
              after {rounds} round(s)",
-            c.pareto_k, c.k_hat_limit, c.draws, c.log_ratio_range, c.max_abs_shift_sd
+            k_hat(c.pareto_k),
+            c.k_hat_limit,
+            c.draws,
+            c.log_ratio_range,
+            c.max_abs_shift_sd
         );
         if o.allow_exact_mismatch {
             eprintln!("warning: the exact-solver check failed ({msg})");

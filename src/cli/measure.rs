@@ -8,7 +8,7 @@ use hpge_measurement::stand_in::StandInDraws;
 use hpge_measurement::synth::voltage_seed;
 use hpge_measurement::{
     MeasureOptions, Measurement, PulseSet, RawProblem, SynthOptions, depletion_voltage, measure,
-    read_model_curve, read_raw_dir, synthesize_voltage, write_curve, write_pulses,
+    read_model_curve, read_raw_dir, synthesize_voltage, write_pulses,
 };
 use hpge_reports::plot;
 use indicatif::{ProgressBar, ProgressStyle};
@@ -34,6 +34,10 @@ pub fn run(o: &MeasureOptions, plot: Option<&PathBuf>, json: bool) -> Result<()>
         inputs.push(("--settings", s.as_path()));
     }
     super::args::check_outputs(&outputs, &inputs)?;
+    // What a killed run left under temporary names beside the outputs.
+    for (_, path) in &outputs {
+        hpge_files::remove_stale_temporaries(super::args::parent_or_here(path));
+    }
     let (settings, settings_source) = o.measure_settings()?;
     let run = read_raw_dir(&o.raw, settings.voltages_v.as_deref())?;
     for p in &run.problems {
@@ -62,18 +66,27 @@ pub fn run(o: &MeasureOptions, plot: Option<&PathBuf>, json: bool) -> Result<()>
             p.message
         );
     }
-    // Every output removed again if a later one fails: all of them, or none.
+    // Every output written under a temporary name and put in place together at the end: all
+    // of them or none, whether a later step fails or the process is killed (issue 66).
     let mut staged = hpge_files::Staged::new();
-    if let Some(dir) = plot {
+    let figures = match plot {
+        Some(dir) => Some(
+            staged
+                .folder(dir)
+                .with_context(|| format!("--plot {}: cannot create the folder", dir.display()))?,
+        ),
+        None => None,
+    };
+    let (table, covariance) = hpge_measurement::curve_texts(&o.out, &m.curve, &[])?;
+    staged
+        .write(&o.out, table.as_bytes())
+        .with_context(|| format!("{}: cannot write the file", o.out.display()))?;
+    let covariance_file = hpge_measurement::covariance_path(&o.out);
+    if let Some(text) = &covariance {
         staged
-            .make_folder(dir)
-            .with_context(|| format!("--plot {}: cannot create the folder", dir.display()))?;
+            .write(&covariance_file, text.as_bytes())
+            .with_context(|| format!("{}: cannot write the file", covariance_file.display()))?;
     }
-    staged.adopt(&o.out);
-    if m.curve.covariance_pf2.is_some() {
-        staged.adopt(&hpge_measurement::covariance_path(&o.out));
-    }
-    write_curve(&o.out, &m.curve)?;
     let mut report = report_json(&m, &o.raw, &settings_source, &run.problems);
     if let Some(obj) = report.as_object_mut() {
         // The curve's provenance (cv.csv is a plain table: one header row, no comment lines).
@@ -99,10 +112,19 @@ pub fn run(o: &MeasureOptions, plot: Option<&PathBuf>, json: bool) -> Result<()>
     staged
         .write(&report_path, format!("{report:#}\n").as_bytes())
         .with_context(|| format!("{}: cannot write the report", report_path.display()))?;
-    if let Some(dir) = plot {
+    if let Some(dir) = &figures {
         plot::measurement(&m, &run.sets, dir)?;
     }
     super::args::commit(staged)?;
+    // A curve without a covariance: an older covariance beside it would be read with it.
+    if covariance.is_none() && covariance_file.is_file() {
+        std::fs::remove_file(&covariance_file).with_context(|| {
+            format!(
+                "{}: cannot remove the stale covariance of the curve",
+                covariance_file.display()
+            )
+        })?;
+    }
     if json {
         outln!("{report}");
     } else {
@@ -197,6 +219,7 @@ pub fn synthesize(o: &SynthOptions) -> Result<()> {
         &[("--out", o.out.as_path())],
         &[("--curve", o.curve.as_path())],
     )?;
+    check_synthesis_folder(&o.out)?;
     let settings = o.settings();
     settings.validate().map_err(|e| match &e {
         hpge_measurement::Error::Setting { key, message } if key == "pulser_pulses" => {
@@ -218,31 +241,63 @@ pub fn synthesize(o: &SynthOptions) -> Result<()> {
             )
         })?,
     };
-    if o.out.exists() {
-        write_synthetic(o, &o.out, &settings, &volts, &c12, ufd, &draws)?;
-    } else {
-        // A new folder is filled under a temporary name beside it and renamed when complete: a
-        // killed or failed run leaves no partial raw folder that `measure` would read as a
-        // short curve (issue 66).
-        let tmp = hpge_files::temp_beside(&o.out);
-        let written = std::fs::create_dir_all(&tmp)
-            .with_context(|| format!("--out {}: cannot create the folder", o.out.display()))
-            .and_then(|()| write_synthetic(o, &tmp, &settings, &volts, &c12, ufd, &draws))
-            .and_then(|()| {
-                std::fs::rename(&tmp, &o.out)
-                    .with_context(|| format!("--out {}: cannot create the folder", o.out.display()))
-            });
-        if written.is_err() {
-            let _ = std::fs::remove_dir_all(&tmp);
-        }
-        written?;
-    }
+    // The folder is filled under a temporary name beside it and put in place when complete: a
+    // killed or failed run leaves no partial raw folder that `measure` would read as a short
+    // curve, and a folder of an earlier run is replaced whole, none of its files kept among
+    // this run's (issue 66).
+    hpge_files::remove_stale_temporaries(super::args::parent_or_here(&o.out));
+    let mut staged = hpge_files::Staged::new();
+    let tmp = staged
+        .replacing_folder(&o.out)
+        .with_context(|| format!("--out {}: cannot create the folder", o.out.display()))?;
+    write_synthetic(o, &tmp, &settings, &volts, &c12, ufd, &draws)?;
+    super::args::commit(staged)?;
     outln!(
         "wrote {} pulse files to {} (seed {}, U_fd {ufd:.0} V)",
         volts.len(),
         o.out.display(),
         o.seed
     );
+    Ok(())
+}
+
+/// Refuses an `--out` of `synthesize` that is a file, or a folder holding anything but what an
+/// earlier `synthesize` wrote (`U<bias>V.*`, `measurement.toml`, `truth.json`): the run replaces
+/// the folder whole, so it must not hold anything else.
+fn check_synthesis_folder(out: &Path) -> Result<()> {
+    if !out.exists() {
+        return Ok(());
+    }
+    if !out.is_dir() {
+        bail!(
+            "--out {}: not a folder (synthesize writes a folder of pulse files)",
+            out.display()
+        );
+    }
+    let entries = std::fs::read_dir(out)
+        .with_context(|| format!("--out {}: cannot read the folder", out.display()))?;
+    for e in entries {
+        let e = e.with_context(|| format!("--out {}: cannot read the folder", out.display()))?;
+        let name = e.file_name();
+        let name = name.to_string_lossy();
+        let ours = name == "measurement.toml"
+            || name == "truth.json"
+            || (name.starts_with('U')
+                && name.split_once('.').is_some_and(|(stem, _)| {
+                    stem.len() > 2
+                        && stem.ends_with('V')
+                        && stem[1..stem.len() - 1].bytes().all(|b| b.is_ascii_digit())
+                })
+                && e.file_type().is_ok_and(|t| t.is_file()));
+        if !ours {
+            bail!(
+                "--out {}: the folder holds {name}, which synthesize did not write; it replaces \
+                 the folder whole (an earlier run's pulse files, measurement.toml, truth.json), \
+                 so choose a new or empty folder",
+                out.display()
+            );
+        }
+    }
     Ok(())
 }
 

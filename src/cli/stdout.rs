@@ -1,9 +1,15 @@
 //! What the commands print on stdout goes through [`outln!`] and [`out!`] (declared in
 //! `main.rs`): a write that fails (stdout on a full disk, `/dev/full`, or a pipe whose reader
-//! has gone, as in `| head`) is an error, never a panic (issue 66). `main` ends a broken pipe
-//! quietly with the command's usual status; any other failure is an error naming stdout.
+//! has gone, as in `| head`) is an error, never a panic (issue 66). A broken pipe is not the
+//! command's failure: the rest of stdout is dropped and the command goes on to its usual status
+//! (a fit that did not converge still exits with 3); any other failure is an error naming
+//! stdout.
 
 use std::io::Write;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// The reader of stdout has gone: what is left to print is dropped.
+static READER_GONE: AtomicBool = AtomicBool::new(false);
 
 /// Writing stdout failed.
 #[derive(Debug, thiserror::Error)]
@@ -25,9 +31,21 @@ impl StdoutError {
 ///
 /// # Errors
 /// [`StdoutError`] when stdout cannot be written.
+/// A broken pipe is not an error: it is noted, and this and every later write are dropped.
 pub fn write_fmt(args: std::fmt::Arguments<'_>) -> Result<(), StdoutError> {
+    if READER_GONE.load(Ordering::Relaxed) {
+        return Ok(());
+    }
     let mut out = std::io::stdout().lock();
-    out.write_fmt(args)
+    match out
+        .write_fmt(args)
         .and_then(|()| out.flush())
         .map_err(|source| StdoutError { source })
+    {
+        Err(e) if e.broken_pipe() => {
+            READER_GONE.store(true, Ordering::Relaxed);
+            Ok(())
+        }
+        r => r,
+    }
 }

@@ -63,6 +63,27 @@ struct Saved<T> {
     value: T,
 }
 
+/// Whether `f` is a file discover writes into its stages folder: `<stage>-<16 hex>.json`
+/// ([`Stages::path`]), a temporary of one (`.<name>.PID-K.tmp`) or an older version's
+/// `<name>.tmp`; a file of any other name there is left alone.
+fn is_stage_file(f: &Path) -> bool {
+    let Some(name) = f.file_name().and_then(|n| n.to_str()) else {
+        return false;
+    };
+    let name = name.strip_prefix('.').unwrap_or(name);
+    let Some((base, rest)) = name.split_once(".json") else {
+        return false;
+    };
+    let Some((slug, key)) = base.rsplit_once('-') else {
+        return false;
+    };
+    !slug.is_empty()
+        && slug.chars().all(|c| c.is_ascii_alphanumeric() || c == '-')
+        && key.len() == 16
+        && key.chars().all(|c| c.is_ascii_hexdigit())
+        && (rest.is_empty() || rest.ends_with(".tmp"))
+}
+
 /// The finished stages of one run (see the module docs).
 #[derive(Debug)]
 pub struct Stages {
@@ -80,7 +101,7 @@ impl Stages {
     /// [`Error::Io`] when the folder cannot be made or read, or a stale file cannot be removed.
     pub fn open(out: &Path, fingerprint: String) -> Result<Self> {
         let dir = out.join(STAGES_DIR);
-        remove_stale(&dir, |f| f != Some(fingerprint.as_str()))?;
+        remove_stale(&dir, is_stage_file, |f| f != Some(fingerprint.as_str()))?;
         Ok(Self {
             dir,
             fingerprint,
@@ -207,10 +228,25 @@ mod tests {
         })
         .unwrap();
         assert_eq!(calls, 2);
-        // Another run in the same folder: every file of run-a is removed.
-        std::fs::write(d.join(STAGES_DIR).join("cut.json.tmp"), "{\"finger").unwrap();
+        // Another run in the same folder: every file of run-a is removed (a cut-short one
+        // too), but no file discover does not write there (issue 66).
+        let stages = d.join(STAGES_DIR);
+        std::fs::write(
+            stages.join("quick-fit-0123456789abcdef.json.tmp"),
+            "{\"finger",
+        )
+        .unwrap();
+        std::fs::write(stages.join("notes.json"), "{}").unwrap();
+        std::fs::write(stages.join("README.md"), "mine").unwrap();
         let s = Stages::open(&d, "run-b".into()).unwrap();
-        assert_eq!(std::fs::read_dir(d.join(STAGES_DIR)).unwrap().count(), 0);
+        let mut left: Vec<String> = std::fs::read_dir(&stages)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        left.sort();
+        assert_eq!(left, ["README.md", "notes.json"]);
+        std::fs::remove_file(stages.join("README.md")).unwrap();
+        std::fs::remove_file(stages.join("notes.json")).unwrap();
         assert!(s.get::<Vec<f64>>("quick fit", &start).is_none());
         // A failed stage saves nothing.
         let e: Result<Vec<f64>> = stage(Some(&s), &Quiet, "x", &start, || {

@@ -159,18 +159,26 @@ pub fn folder_files(dir: &Path) -> Result<Vec<PathBuf>> {
     Ok(entries.filter_map(|e| Some(e.ok()?.path())).collect())
 }
 
-/// Removes the files of checkpoint folder `dir` (made first if missing) whose recorded run is
-/// stale: `stale(fingerprint)` with the file's top-level `fingerprint` field, None for a file
-/// that cannot be read or parsed (cut short, or another program's).
+/// Removes the files of checkpoint folder `dir` (made first if missing) that the caller writes
+/// there (`ours`: by name) and whose recorded run is stale: `stale(fingerprint)` with the file's
+/// top-level `fingerprint` field, None for a file that cannot be read or parsed (cut short).
+/// Any other file is left alone (issue 66).
 ///
 /// # Errors
 /// [`Error::Io`] when the folder cannot be made or read, or a stale file cannot be removed.
-pub fn remove_stale(dir: &Path, stale: impl Fn(Option<&str>) -> bool) -> Result<()> {
+pub fn remove_stale(
+    dir: &Path,
+    ours: impl Fn(&Path) -> bool,
+    stale: impl Fn(Option<&str>) -> bool,
+) -> Result<()> {
     #[derive(Deserialize)]
     struct Recorded {
         fingerprint: String,
     }
-    for f in folder_files(dir)? {
+    for f in folder_files(dir)?
+        .into_iter()
+        .filter(|f| f.is_file() && ours(f))
+    {
         let recorded = std::fs::read_to_string(&f)
             .ok()
             .and_then(|t| serde_json::from_str::<Recorded>(&t).ok());

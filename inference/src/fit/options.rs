@@ -138,7 +138,9 @@ pub struct FitOptions {
     /// Target R-hat (rank-normalised, split).
     #[cfg_attr(feature = "clap", arg(long, default_value_t = DEFAULT_RHAT_MAX, allow_hyphen_values = true))]
     pub rhat: f64,
-    /// Stop sampling after this many seconds even if the targets are not reached.
+    /// The time budget of each sampling run (its mode search and tuning included): it stops
+    /// when the budget is spent even if the targets are not reached, and the fit then skips
+    /// the exact check (exit code 3).
     #[cfg_attr(feature = "clap", arg(long, default_value_t = FIT_MAX_SECONDS, allow_hyphen_values = true))]
     pub max_seconds: f64,
     /// Known parameter values (TOML NAME = VALUE) to mark on the figures and check against the

@@ -31,7 +31,7 @@ use crate::posterior::{Likelihood, Posterior};
 use crate::prior::Prior;
 use crate::refine::{CorrectedModel, GpCorrection, GpHyper};
 use crate::rejection::unless_rejected;
-use crate::sampler::Status;
+use crate::sampler::{SamplerStop, Status};
 
 /// Of the exact curves `solved` (inputs x, c_exact) and `best` so far, the one of highest exact
 /// likelihood ln L_exact (`like` without a surrogate term), as (ln L, x); a curve whose ln L is
@@ -260,6 +260,22 @@ pub fn refine_fit(
             let mut result = fit(&posterior, settings, inputs.clone(), progress.sampling)?;
             let sampling_seconds = t.elapsed().as_secs_f64();
             (progress.sampled)(round);
+            if result.samples.stop == SamplerStop::MaxSeconds {
+                // The time budget (--max-seconds) ran out while sampling: the draws did not
+                // converge, and the exact check (whose cost grows with the voltages) is not run
+                // on them; the fit ends here, unconverged (issue 66).
+                result.summary.exact_check_skipped = Some(format!(
+                    "the time budget ({} s, --max-seconds) ran out while sampling in round {round}",
+                    settings.sample.max_seconds
+                ));
+                result.summary.refinement = (!rounds.is_empty()).then(|| rounds.clone());
+                return Ok(RefinedFit {
+                    fit: result,
+                    rounds,
+                    correction,
+                    training,
+                });
+            }
             let (mut chk, info) = match saved {
                 Some(s) => {
                     let mut chk = s.check.clone();

@@ -8,7 +8,7 @@ use serde::{Deserialize, Serialize};
 use super::predictive::{Predictive, predictive, thin_indices};
 use super::summary::{FitSummary, LEVELS, ModeSummary, ParameterSummary};
 use crate::Result;
-use crate::numerics::nelder_mead;
+use crate::numerics::nelder_mead_until;
 use crate::posterior::{NoiseSettings, Posterior};
 use crate::rejection::Latch;
 use crate::sampler::{LogDensity, SampleSettings, Samples, Status, sample};
@@ -114,7 +114,11 @@ pub fn fit(
                 .map(|(l, _)| posterior.output(z, l).1)
         })
     };
-    let (z_mode, _) = nelder_mead(&f, &z0, 0.05, 200 * d + 400, 1e-10);
+    // Within the run's time budget too (a run cut short keeps its best draw, refined so far).
+    let deadline = settings.sample.deadline(start);
+    let (z_mode, _) = nelder_mead_until(&f, &z0, 0.05, 200 * d + 400, 1e-10, &|| {
+        Instant::now() >= deadline
+    });
     latch.check()?;
     let mut mode = vec![0.0; d];
     prior.from_unconstrained(&z_mode, &mut mode);
@@ -191,6 +195,7 @@ pub fn fit(
         modes,
         local_modes: samples.local_modes.clone(),
         exact_check: None,
+        exact_check_skipped: None,
         refinement: None,
         posterior_outside_support: None,
         program_version: env!("CARGO_PKG_VERSION").into(),

@@ -75,6 +75,10 @@ pub struct FitSummary {
     /// round's.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub exact_check: Option<ExactCheck>,
+    /// Why the exact-solver check was not run although asked for (the time budget,
+    /// `--max-seconds`, ran out while sampling: issue 66).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub exact_check_skipped: Option<String>,
     /// The rounds of posterior-adaptive refinement, the plain surrogate's first (absent with
     /// --no-exact-check).
     #[serde(skip_serializing_if = "Option::is_none")]

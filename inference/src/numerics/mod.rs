@@ -5,4 +5,4 @@ mod cholesky;
 mod nelder_mead;
 
 pub use cholesky::Cholesky;
-pub use nelder_mead::nelder_mead;
+pub use nelder_mead::{nelder_mead, nelder_mead_until};

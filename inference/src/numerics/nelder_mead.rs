@@ -21,6 +21,19 @@ pub fn nelder_mead(
     max_evals: usize,
     tol: f64,
 ) -> (Vec<f64>, f64) {
+    nelder_mead_until(f, x0, step, max_evals, tol, &|| false)
+}
+
+/// As [`nelder_mead`], also stopping (with the best point so far) as soon as `stop()` holds
+/// after a step (a time budget; the first simplex is always evaluated).
+pub fn nelder_mead_until(
+    f: &dyn Fn(&[f64]) -> f64,
+    x0: &[f64],
+    step: f64,
+    max_evals: usize,
+    tol: f64,
+    stop: &dyn Fn() -> bool,
+) -> (Vec<f64>, f64) {
     let d = x0.len();
     // Minimise g = -f; NaN counts as +inf.
     let g = |x: &[f64]| {
@@ -36,7 +49,7 @@ pub fn nelder_mead(
         simplex.push((x, v));
     }
     let mut evals = d + 1;
-    while evals < max_evals {
+    while evals < max_evals && !stop() {
         simplex.sort_by(|a, b| a.1.total_cmp(&b.1));
         if (simplex[d].1 - simplex[0].1).abs() <= tol {
             break;

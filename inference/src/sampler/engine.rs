@@ -6,7 +6,7 @@ use std::time::Instant;
 use rayon::prelude::*;
 
 use super::samples::{ChainDraws, LocalMode, SamplerStop, Samples};
-use super::settings::SampleSettings;
+use super::settings::{MIN_DRAWS_AT_BUDGET, SampleSettings};
 use super::status::{Phase, Status};
 use super::target::LogDensity;
 use crate::Result;
@@ -67,13 +67,20 @@ pub(super) fn finish(
     let mut accept_sum = vec![0.0; m];
     let mut steps = 0usize;
     let batch = settings.batch_draws;
+    // The budget covers the whole run (mode search and tuning included, issue 66): a batch
+    // ends early when it is spent, once every chain has its minimum of draws.
+    let deadline = settings.deadline(start);
     let (stop, diagnostics) = loop {
+        let have = chains[0].theta.len();
         let results: Vec<Result<(Vec<Draw>, f64)>> = engines
             .par_iter_mut()
             .map(|e| {
                 let mut kept = Vec::with_capacity(batch);
                 let mut acc = 0.0;
                 for _ in 0..batch {
+                    if have + kept.len() >= MIN_DRAWS_AT_BUDGET && Instant::now() >= deadline {
+                        break;
+                    }
                     for _ in 0..settings.thin - 1 {
                         acc += e.draw()?.accept;
                     }
@@ -84,12 +91,17 @@ pub(super) fn finish(
                 Ok((kept, acc))
             })
             .collect();
-        steps += batch * settings.thin;
+        let mut results = results.into_iter().collect::<Result<Vec<_>>>()?;
+        // Chains of equal length: the draws beyond the shortest chain's are dropped.
+        let taken = results.iter().map(|r| r.0.len()).min().unwrap_or(0);
+        for r in &mut results {
+            r.0.truncate(taken);
+        }
+        steps += taken * settings.thin;
         let mut batch_accept = 0.0;
-        for (c, r) in results.into_iter().enumerate() {
-            let (kept, acc) = r?;
+        for (c, (kept, acc)) in results.into_iter().enumerate() {
             accept_sum[c] += acc;
-            batch_accept += acc / (batch * settings.thin) as f64 / m as f64;
+            batch_accept += acc / (taken.max(1) * settings.thin) as f64 / m as f64;
             for dr in kept {
                 let (theta, lp) = target.output(&dr.z, dr.ln_density);
                 chains[c].theta.push(theta);
@@ -119,7 +131,7 @@ pub(super) fn finish(
         if draws + batch > settings.max_draws {
             break (SamplerStop::MaxDraws, diagnostics);
         }
-        if seconds - tuning_seconds > settings.max_seconds {
+        if Instant::now() >= deadline {
             break (SamplerStop::MaxSeconds, diagnostics);
         }
     };

@@ -123,7 +123,7 @@ pub(super) fn tune<'a>(
 ) -> Result<Tuned<'a>> {
     let d = target.dim();
     let modes = if s.mode_starts > 0 {
-        search(target, s.mode_starts, s.seed)?
+        search(target, s.mode_starts, s.seed, s.deadline(start))?
     } else {
         Modes {
             modes: Vec::new(),
@@ -174,7 +174,10 @@ pub(super) fn tune<'a>(
     let mut tuned = false;
     let mut cycle = 0;
     let mut previous: Vec<Vec<Vec<f64>>> = vec![Vec::new(); s.chains];
-    while cycle < s.max_cycles {
+    // Tuning ends at the run's time budget too (untuned: the sampling phase then stops at once
+    // with the draws it must keep).
+    let deadline = s.deadline(start);
+    while cycle < s.max_cycles && Instant::now() < deadline {
         cycle += 1;
         let runs: Vec<(Vec<Vec<f64>>, f64)> = chains
             .par_iter_mut()
@@ -182,11 +185,16 @@ pub(super) fn tune<'a>(
                 let mut zs = Vec::with_capacity(s.cycle_draws);
                 let mut acc = 0.0;
                 for _ in 0..s.cycle_draws {
+                    // A cycle ends early at the time budget (two draws for a covariance).
+                    if zs.len() >= 2 && Instant::now() >= deadline {
+                        break;
+                    }
                     let dr = ch.step()?;
                     acc += dr.accept;
                     zs.push(dr.z);
                 }
-                Ok((zs, acc / s.cycle_draws as f64))
+                let n = zs.len().max(1) as f64;
+                Ok((zs, acc / n))
             })
             .collect::<Result<_>>()?;
         // Pooled covariance of the cycle's draws.

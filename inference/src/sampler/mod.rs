@@ -21,7 +21,7 @@ pub use run::sample;
 pub use samples::{ChainDraws, LocalMode, SamplerStop, Samples};
 pub use settings::{
     DEFAULT_CHAINS, DEFAULT_ESS_MIN, DEFAULT_MAX_SECONDS, DEFAULT_MODE_STARTS, DEFAULT_RHAT_MAX,
-    DEFAULT_SEED, SampleSettings, SamplerKind,
+    DEFAULT_SEED, MIN_DRAWS_AT_BUDGET, SampleSettings, SamplerKind,
 };
 pub use status::{Phase, Status};
 pub use target::{GaussianTarget, LogDensity};

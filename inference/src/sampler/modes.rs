@@ -14,12 +14,13 @@ use rand::RngExt;
 use rand::rngs::StdRng;
 use rand_distr::{Distribution, StandardNormal};
 use rayon::prelude::*;
+use std::time::Instant;
 
 use super::samples::LocalMode;
 use super::start::chain_rng;
 use super::target::LogDensity;
 use crate::Result;
-use crate::numerics::{Cholesky, nelder_mead};
+use crate::numerics::{Cholesky, nelder_mead_until};
 use crate::rejection::Latch;
 
 /// Width factor of the mixture components over the Laplace covariance.
@@ -116,14 +117,26 @@ fn laplace_cov(neg_h: &[f64], d: usize) -> Vec<f64> {
 }
 
 /// Searches for modes from `starts` dispersed points. A recoverable model error is a point of
-/// zero density; any other error ends the search and is returned.
-pub(super) fn search(target: &dyn LogDensity, starts: usize, seed: u64) -> Result<Modes> {
+/// zero density; any other error ends the search and is returned. At `deadline` (the sampling
+/// run's time budget) the search stops with what it has: starts not begun are skipped, the
+/// simplexes stop where they are, and only the best point found becomes a mode.
+pub(super) fn search(
+    target: &dyn LogDensity,
+    starts: usize,
+    seed: u64,
+    deadline: Instant,
+) -> Result<Modes> {
     let d = target.dim();
     let latch = Latch::default();
     let f = |z: &[f64]| latch.value(|| target.ln_density(z, None));
+    let past = || Instant::now() >= deadline;
     let runs: Vec<(Vec<f64>, f64, u64)> = (0..starts)
         .into_par_iter()
         .filter_map(|s| {
+            // The first start always runs: the chains need a point to start from.
+            if s > 0 && past() {
+                return None;
+            }
             let mut rng = chain_rng(seed ^ 0x6d6f_6465, s);
             let mut z0 = None;
             for _ in 0..100 {
@@ -136,8 +149,8 @@ pub(super) fn search(target: &dyn LogDensity, starts: usize, seed: u64) -> Resul
             let z0 = z0?;
             let max_evals = 250 * d + 500;
             // Two restarts of the simplex: Nelder-Mead stalls in curved valleys.
-            let (z1, _) = nelder_mead(&f, &z0, 0.5, max_evals, 1e-9);
-            let (z2, l2) = nelder_mead(&f, &z1, 0.1, max_evals, 1e-10);
+            let (z1, _) = nelder_mead_until(&f, &z0, 0.5, max_evals, 1e-9, &past);
+            let (z2, l2) = nelder_mead_until(&f, &z1, 0.1, max_evals, 1e-10, &past);
             Some((z2, l2, 2 * max_evals as u64))
         })
         .collect();
@@ -152,7 +165,8 @@ pub(super) fn search(target: &dyn LogDensity, starts: usize, seed: u64) -> Resul
     let mut modes: Vec<Mode> = Vec::new();
     let best = found.first().map_or(f64::NEG_INFINITY, |r| r.1);
     for (z, lp) in found {
-        if lp < best - LN_P_WINDOW {
+        // Past the budget: the best point alone (its Laplace covariance starts the tuning).
+        if lp < best - LN_P_WINDOW || (!modes.is_empty() && past()) {
             break;
         }
         let same = modes.iter().any(|m| {

@@ -285,7 +285,7 @@ pub(super) fn run(
     // Laplace standard deviation; dispersed prior draws without a search. NUTS does not jump
     // between modes: chains started in different ones make R-hat report it.
     let found = if s.mode_starts > 0 {
-        search(target, s.mode_starts, s.seed)?
+        search(target, s.mode_starts, s.seed, s.deadline(start))?
     } else {
         Modes {
             modes: Vec::new(),

@@ -90,9 +90,14 @@ pub struct SampleSettings {
     pub thin: usize,
     /// Most kept draws per chain.
     pub max_draws: usize,
-    /// Stop sampling (not tuning) after this many seconds.
+    /// The run's time budget (s): the mode search, the tuning and the sampling stop when it is
+    /// spent (the sampling keeps [`MIN_DRAWS_AT_BUDGET`] draws per chain at least).
     pub max_seconds: f64,
 }
+
+/// Draws per chain the sampling phase keeps even when the time budget ran out before (so that
+/// a run cut short still has draws to summarise, however slow one evaluation is).
+pub const MIN_DRAWS_AT_BUDGET: usize = 20;
 
 impl Default for SampleSettings {
     fn default() -> Self {
@@ -122,6 +127,15 @@ impl SampleSettings {
             max_draws: 100_000,
             max_seconds: DEFAULT_MAX_SECONDS,
         }
+    }
+
+    /// When a run started at `start` has spent its time budget (`max_seconds`).
+    pub fn deadline(&self, start: std::time::Instant) -> std::time::Instant {
+        std::time::Duration::try_from_secs_f64(self.max_seconds)
+            .ok()
+            .and_then(|d| start.checked_add(d))
+            .or_else(|| start.checked_add(std::time::Duration::from_secs(1 << 32)))
+            .unwrap_or(start)
     }
 
     /// Checks the values.

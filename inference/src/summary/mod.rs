@@ -9,4 +9,4 @@ mod pareto;
 pub use component::Component;
 pub use intervals::{interval_contains, marginal_mode, smallest_intervals};
 pub use mixture::{Mixture, find_modes, fit_mixture};
-pub use pareto::{Psis, gpd_fit, psis};
+pub use pareto::{PSIS_MIN_DRAWS, Psis, gpd_fit, psis};

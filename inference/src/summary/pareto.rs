@@ -88,6 +88,10 @@ fn gpd_quantile(p: f64, k: f64, sigma: f64) -> f64 {
     }
 }
 
+/// The fewest draws whose Pareto k-hat [`psis`] estimates (a tail of at least 5 draws);
+/// with fewer, k-hat is NaN (an exact-solver check then passes only on near-equal weights).
+pub const PSIS_MIN_DRAWS: usize = 21;
+
 /// Pareto smoothed importance sampling of the log importance ratios `log_ratios` (one per draw).
 ///
 /// Following Vehtari et al. (2024), with `S` draws:

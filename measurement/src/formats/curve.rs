@@ -171,6 +171,32 @@ pub fn write_curve(csv: &Path, data: &CvData) -> Result<()> {
 /// (its CSVs are plain tables, their provenance in a JSON sidecar, so that `pandas.read_csv`
 /// loads them without `comment='#'`); it stays for library users and old-format tests.
 pub fn write_curve_with_comments(csv: &Path, data: &CvData, comments: &[String]) -> Result<()> {
+    let (table, covariance) = curve_texts(csv, data, comments)?;
+    write_file(csv, table.as_bytes())?;
+    let cov_file = covariance_path(csv);
+    match covariance {
+        Some(text) => write_file(&cov_file, text.as_bytes()),
+        None if cov_file.is_file() => std::fs::remove_file(&cov_file).map_err(|source| Error::Io {
+            file: cov_file,
+            action: "cannot remove the stale covariance of the curve",
+            source,
+        }),
+        None => Ok(()),
+    }
+}
+
+/// The texts [`write_curve_with_comments`] writes for the curve file `csv` (named in errors
+/// only): the curve table and, where the curve has one, its covariance table
+/// ([`covariance_path`]); for a caller that puts them in place itself (together with other
+/// outputs).
+///
+/// # Errors
+/// A curve with no points or with columns (or a covariance) of other lengths.
+pub fn curve_texts(
+    csv: &Path,
+    data: &CvData,
+    comments: &[String],
+) -> Result<(String, Option<String>)> {
     let n = data.voltage_v.len();
     let argument = |message: String| Error::Argument {
         name: "data".to_string(),
@@ -210,32 +236,22 @@ pub fn write_curve_with_comments(csv: &Path, data: &CvData, comments: &[String])
             data.voltage_v[i], data.c12_pf[i], data.sigma_pf[i]
         ));
     }
-    write_file(csv, out.as_bytes())?;
-
-    let cov_file = covariance_path(csv);
-    match &data.covariance_pf2 {
-        Some(cov) => {
-            let mut out = String::from("voltage_V");
-            for v in &data.voltage_v {
-                out.push_str(&format!(",{v}"));
+    let covariance = data.covariance_pf2.as_ref().map(|cov| {
+        let mut out = String::from("voltage_V");
+        for v in &data.voltage_v {
+            out.push_str(&format!(",{v}"));
+        }
+        out.push('\n');
+        for (v, row) in data.voltage_v.iter().zip(cov) {
+            out.push_str(&v.to_string());
+            for c in row {
+                out.push_str(&format!(",{c}"));
             }
             out.push('\n');
-            for (v, row) in data.voltage_v.iter().zip(cov) {
-                out.push_str(&v.to_string());
-                for c in row {
-                    out.push_str(&format!(",{c}"));
-                }
-                out.push('\n');
-            }
-            write_file(&cov_file, out.as_bytes())
         }
-        None if cov_file.is_file() => std::fs::remove_file(&cov_file).map_err(|source| Error::Io {
-            file: cov_file,
-            action: "cannot remove the stale covariance of the curve",
-            source,
-        }),
-        None => Ok(()),
-    }
+        out
+    });
+    Ok((out, covariance))
 }
 
 /// The sibling covariance file of a curve: `<stem>.covariance.csv`.

@@ -26,7 +26,8 @@ mod sidecar;
 use std::path::Path;
 
 pub use curve::{
-    covariance_path, read_curve, read_model_curve, write_curve, write_curve_with_comments,
+    covariance_path, curve_texts, read_curve, read_model_curve, write_curve,
+    write_curve_with_comments,
 };
 pub use lh5::read_lh5_pulses;
 pub use npy::{read_pulses, write_pulses};

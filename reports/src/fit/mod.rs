@@ -73,6 +73,15 @@ pub fn run_fit(o: &FitOptions, observer: &dyn FitObserver) -> Result<FitRun> {
         None => None,
     };
     job.posterior()?;
+    if !o.no_exact_check && o.exact_draws < hpge_inference::summary::PSIS_MIN_DRAWS {
+        job.warnings.push(format!(
+            "--exact-draws {}: PSIS estimates its Pareto k-hat from {} draws or more; with fewer \
+             k-hat is undefined and the exact check passes only on near-equal weights (it still \
+             reports each mean's shift)",
+            o.exact_draws,
+            hpge_inference::summary::PSIS_MIN_DRAWS
+        ));
+    }
     let out = o.out_dir();
     // No output of the fit over one of its inputs (issue 66).
     let mut inputs: Vec<(&str, &Path)> = vec![
@@ -115,6 +124,9 @@ pub fn run_fit(o: &FitOptions, observer: &dyn FitObserver) -> Result<FitRun> {
     )? {
         job.warnings.push(w);
     }
+    let mut made = MadeFolder {
+        path: (!out.exists()).then(|| out.clone()),
+    };
     std::fs::create_dir_all(&out).map_err(|e| Error::Output {
         flag: "--out".into(),
         file: out.clone(),
@@ -158,41 +170,66 @@ pub fn run_fit(o: &FitOptions, observer: &dyn FitObserver) -> Result<FitRun> {
         });
         (refined.fit, file)
     };
-    // The outputs of this run, each written whole; if a later one fails, those written before
-    // it are removed again (issue 66): summary.json, written last, marks a complete fit. The
-    // rounds (OUT/rounds/) stay, for a rerun to take back.
+    // The outputs of this run, each written under a temporary name and put in place together
+    // at the end (issue 66): a failing step or a kill leaves all of them or none. The rounds
+    // (OUT/rounds/) stay, for a rerun to take back.
     let mut staged = hpge_files::Staged::new();
-    for name in [
-        outputs::ERROR_MODEL_FILE,
-        "samples.csv",
-        "predictive.csv",
-        "zeta-mode.csv",
-        "report.md",
-        "summary.json",
-    ] {
-        staged.adopt(&out.join(name));
-    }
     if let Some(file) = &correction {
-        outputs::write_error_model(&out.join(outputs::ERROR_MODEL_FILE), file)?;
+        let path = staged.path(&out.join(outputs::ERROR_MODEL_FILE));
+        outputs::write_error_model(&path, file)?;
     }
     let records = truth.as_ref().map(|t| truth_records(&fit.summary, t));
-    write_outputs(o, &out, &job, &fit, truth.as_deref(), records.as_deref())?;
+    write_outputs(
+        o,
+        &out,
+        &mut staged,
+        &job,
+        &fit,
+        truth.as_deref(),
+        records.as_deref(),
+    )?;
     let mut summary_json = outputs::summary_json(&fit, records.as_deref())?;
     if let Some(obj) = summary_json.as_object_mut() {
         obj.insert("run".into(), o.run_args().into());
     }
-    outputs::write_summary(&out.join("summary.json"), &summary_json)?;
+    let path = staged.path(&out.join("summary.json"));
+    outputs::write_summary(&path, &summary_json)?;
     staged.commit().map_err(|(file, source)| Error::Io {
         file,
         action: "cannot write",
         source,
     })?;
+    made.path = None;
+    // An error model of an earlier run in this folder that this run did not replace.
+    if correction.is_none() {
+        let stale = out.join(outputs::ERROR_MODEL_FILE);
+        if stale.is_file() {
+            std::fs::remove_file(&stale).map_err(Error::io(&stale, "cannot remove"))?;
+        }
+    }
     Ok(FitRun {
         job,
         fit,
         out,
         summary_json,
     })
+}
+
+/// The output folder a fit made, removed again when the fit fails before its outputs are in
+/// place (a full disk, issue 66), unless it holds finished rounds to resume from.
+struct MadeFolder {
+    path: Option<PathBuf>,
+}
+
+impl Drop for MadeFolder {
+    fn drop(&mut self) {
+        if let Some(p) = &self.path {
+            let rounds = std::fs::read_dir(p.join("rounds")).map_or(0, |d| d.count());
+            if rounds == 0 {
+                let _ = std::fs::remove_dir_all(p);
+            }
+        }
+    }
 }
 
 /// What identifies a fit in its `summary.json`: its inputs with their hashes, the sampler's
@@ -234,33 +271,39 @@ pub fn describe_run(v: &serde_json::Value) -> String {
 pub fn write_outputs(
     o: &FitOptions,
     out: &Path,
+    staged: &mut hpge_files::Staged,
     s: &FitJob,
     fit: &Fit,
     truth: Option<&[Option<f64>]>,
     truth_records: Option<&[TruthRecord]>,
 ) -> Result<()> {
-    outputs::write_samples(&out.join("samples.csv"), fit)?;
-    outputs::write_predictive(&out.join("predictive.csv"), fit)?;
+    outputs::write_samples(&staged.path(&out.join("samples.csv")), fit)?;
+    outputs::write_predictive(&staged.path(&out.join("predictive.csv")), fit)?;
     let zeta = s.zeta_at_mode(fit, truth)?;
-    outputs::write_zeta(&out.join("zeta-mode.csv"), &zeta)?;
+    outputs::write_zeta(&staged.path(&out.join("zeta-mode.csv")), &zeta)?;
     let mut figures = Vec::new();
+    let final_figures = out.join("figures");
     if !o.no_plots {
         let names = s.prior.names();
         let pairs = default_pairs(&names);
         let truth_vals: Option<Vec<f64>> =
             truth.map(|t| t.iter().map(|v| v.unwrap_or(f64::NAN)).collect());
         let title = format!("{} fit", s.prior.name);
-        figures = plot::fit_figures(
-            &out.join("figures"),
-            fit,
-            &zeta,
-            &pairs,
-            truth_vals.as_deref(),
-            &title,
-        )?;
+        // Drawn into a temporary folder that replaces `figures/` whole (an earlier run's
+        // figures of other pairs do not stay beside this run's).
+        let dir = staged
+            .replacing_folder(&final_figures)
+            .map_err(Error::io(&final_figures, "cannot create the folder"))?;
+        figures = plot::fit_figures(&dir, fit, &zeta, &pairs, truth_vals.as_deref(), &title)?
+            .into_iter()
+            .map(|f| match f.strip_prefix(&dir) {
+                Ok(rel) => final_figures.join(rel),
+                Err(_) => f,
+            })
+            .collect();
     }
     write_report(
-        &out.join("report.md"),
+        &staged.path(&out.join("report.md")),
         o,
         out,
         s,
@@ -356,11 +399,14 @@ pub fn summary_text(fit: &Fit, out: &Path) -> String {
             );
         }
     }
+    if let Some(why) = &s.exact_check_skipped {
+        let _ = writeln!(t, "exact check not run: {why}");
+    }
     if let Some(c) = &s.exact_check {
         let rounds = s.refinement.as_ref().map_or(1, Vec::len);
         let _ = writeln!(
             t,
-            "exact check{} ({} draws on {}, {:.1} s): Pareto k {:.2} (weights' ESS {:.0}, log ratios' sd {:.3}), largest mean shift {:.2} sd, |c_exact - c_model|/c at the mode <= {:.2}%: {}",
+            "exact check{} ({} draws on {}, {:.1} s): Pareto k {} (weights' ESS {:.0}, log ratios' sd {:.3}), largest mean shift {:.2} sd, |c_exact - c_model|/c at the mode <= {:.2}%: {}",
             if rounds > 1 {
                 format!(
                     " after {} rounds of refinement (the surrogate corrected by {} exact curves)",
@@ -376,7 +422,14 @@ pub fn summary_text(fit: &Fit, out: &Path) -> String {
             c.draws,
             grids_text(c),
             c.seconds,
-            c.pareto_k,
+            if c.pareto_k.is_nan() {
+                format!(
+                    "undefined (PSIS needs at least {} draws)",
+                    hpge_inference::summary::PSIS_MIN_DRAWS
+                )
+            } else {
+                format!("{:.2}", c.pareto_k)
+            },
             c.ess,
             c.log_ratio_sd,
             c.max_abs_shift_sd,

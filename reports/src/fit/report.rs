@@ -223,7 +223,10 @@ pub fn write_report(
             c.failed,
             c.seconds,
             c.pareto_k,
-            if c.pareto_k < 0.5 {
+            if c.pareto_k.is_nan() {
+                "undefined: PSIS fits its Pareto tail only to 21 draws or more (--exact-draws); \
+                 the check then passes only on near-equal weights"
+            } else if c.pareto_k < 0.5 {
                 "reliable"
             } else if c.pareto_k < 0.7 {
                 "usable"

@@ -27,7 +27,7 @@ fn cell(s: &str) -> String {
 }
 
 /// Writes README.md and report.json into the output folder; returns the README's path.
-pub fn write(ctx: &Ctx, total_s: f64) -> Result<PathBuf> {
+pub fn write(ctx: &Ctx, total_s: f64, staged: &mut hpge_files::Staged) -> Result<PathBuf> {
     let mut t = String::new();
     writeln!(
         t,
@@ -127,7 +127,9 @@ pub fn write(ctx: &Ctx, total_s: f64) -> Result<PathBuf> {
     }
     writeln!(t, "| **total** | **{total_s:.1}** |")?;
     let readme = ctx.out.join("README.md");
-    hpge_files::write(&readme, t).map_err(Error::io(&readme, "cannot write"))?;
+    staged
+        .write(&readme, t.as_bytes())
+        .map_err(Error::io(&readme, "cannot write"))?;
     let j = json!({
         "program": crate::provenance::PROGRAM,
         "version": crate::provenance::VERSION,
@@ -141,7 +143,8 @@ pub fn write(ctx: &Ctx, total_s: f64) -> Result<PathBuf> {
         "numbers": ctx.numbers,
     });
     let path = ctx.out.join("report.json");
-    hpge_files::write(&path, serde_json::to_string_pretty(&j)? + "\n")
+    staged
+        .write(&path, (serde_json::to_string_pretty(&j)? + "\n").as_bytes())
         .map_err(Error::io(&path, "cannot write"))?;
     Ok(readme)
 }

@@ -69,11 +69,19 @@ pub fn run_paper(
     }
     let mut ctx = Ctx::new(out.clone(), quick, exact_check, inputs);
     ctx.fit_observer = observer;
-    std::fs::create_dir_all(&ctx.figures).map_err(|e| Error::Output {
+    // The figures are drawn into a temporary folder and put into `figures/` together with
+    // README.md and report.json when every step is done (issue 66): a failed or killed run
+    // leaves the earlier report as it was, never half of a new one. Figures of other names
+    // there (a full run's, when this one is `--quick`) stay.
+    let folder_error = |e: std::io::Error| Error::Output {
         flag: "--out".into(),
         file: out.clone(),
         message: format!("cannot create the folder: {e}"),
-    })?;
+    };
+    let mut staged = hpge_files::Staged::new();
+    staged.make_folder(&out).map_err(folder_error)?;
+    let figures = ctx.figures.clone();
+    ctx.figures = staged.folder(&figures).map_err(folder_error)?;
     let n = STEPS.len();
     for (k, (name, run)) in STEPS.iter().enumerate() {
         step(name, k + 1, n, start.elapsed().as_secs_f64());
@@ -83,7 +91,22 @@ pub fn run_paper(
             .push((name.to_string(), t.elapsed().as_secs_f64()));
     }
     let total = start.elapsed().as_secs_f64();
-    let written = readme::write(&ctx, total)?;
+    // The README and report.json name the figures where they will be.
+    ctx.files = ctx
+        .files
+        .iter()
+        .map(|f| match f.strip_prefix(&ctx.figures) {
+            Ok(rel) => figures.join(rel),
+            Err(_) => f.clone(),
+        })
+        .collect();
+    ctx.figures = figures;
+    let written = readme::write(&ctx, total, &mut staged)?;
+    staged.commit().map_err(|(file, source)| Error::Io {
+        file,
+        action: "cannot write",
+        source,
+    })?;
     Ok(PaperRun {
         readme: written,
         figures: ctx

@@ -97,8 +97,47 @@ fn io<'a>(file: &'a Path, action: &'static str) -> impl Fn(std::io::Error) -> Er
     }
 }
 
+/// The largest file of rows `label` reads: 256 MiB (about a million rows of the paper's space,
+/// each of which takes seconds of CPU to label; split a larger set), checked before the file is
+/// read into memory, so that a wrong file (a device, a huge binary) is refused instead of
+/// exhausting the memory (issue 66, cause 7: bounds before allocation).
+pub const MAX_LABEL_INPUT_BYTES: u64 = 256 << 20;
+
+/// The bytes of `path`, refused when above [`MAX_LABEL_INPUT_BYTES`] (by its size where it has
+/// one, else after reading one byte more than the bound).
+fn read_bounded(path: &Path) -> Result<Vec<u8>> {
+    use std::io::Read as _;
+    let too_large = |size: String| Error::Invalid {
+        file: path.into(),
+        key: "rows".into(),
+        message: format!(
+            "{size}: at most {} MiB of rows are labelled in one run; split the file",
+            MAX_LABEL_INPUT_BYTES >> 20
+        ),
+    };
+    let file = std::fs::File::open(path).map_err(io(path, "cannot read the rows to label"))?;
+    let len = file
+        .metadata()
+        .map_err(io(path, "cannot read the rows to label"))?
+        .len();
+    if len > MAX_LABEL_INPUT_BYTES {
+        return Err(too_large(format!("{len} bytes")));
+    }
+    let mut bytes = Vec::new();
+    file.take(MAX_LABEL_INPUT_BYTES + 1)
+        .read_to_end(&mut bytes)
+        .map_err(io(path, "cannot read the rows to label"))?;
+    if bytes.len() as u64 > MAX_LABEL_INPUT_BYTES {
+        return Err(too_large(format!(
+            "more than {} MiB",
+            MAX_LABEL_INPUT_BYTES >> 20
+        )));
+    }
+    Ok(bytes)
+}
+
 fn read_input(path: &Path, exact: &ExactSolver) -> Result<(Input, String)> {
-    let bytes = std::fs::read(path).map_err(io(path, "cannot read the rows to label"))?;
+    let bytes = read_bounded(path)?;
     let hash = format!("{:016x}", fnv1a(&bytes));
     let text = String::from_utf8(bytes).map_err(|_| Error::Invalid {
         file: path.into(),
@@ -251,7 +290,30 @@ pub fn label(
     progress: impl Fn(usize, usize) + Sync,
 ) -> Result<LabelReport> {
     let (input, input_hash) = read_input(input_path, exact)?;
+    let made = !out.exists();
     std::fs::create_dir_all(out).map_err(io(out, "cannot create the output folder"))?;
+    let r = label_into(exact, input_path, out, threads, progress, input, input_hash);
+    // A folder this run made and that holds no row when it fails (a full disk before the first
+    // row, issue 66) is removed again: nothing to resume, nothing left behind.
+    if r.is_err() && made {
+        let rows = std::fs::read_to_string(out.join("rows.csv")).unwrap_or_default();
+        if rows.lines().nth(1).is_none() {
+            let _ = std::fs::remove_dir_all(out);
+        }
+    }
+    r
+}
+
+/// [`label`] into the existing folder `out`, the input read.
+fn label_into(
+    exact: &ExactSolver,
+    input_path: &Path,
+    out: &Path,
+    threads: Option<usize>,
+    progress: impl Fn(usize, usize) + Sync,
+    input: Input,
+    input_hash: String,
+) -> Result<LabelReport> {
     let _lock = super::lock::FolderLock::acquire_named(out, "label.lock")?;
     let space_text = toml::to_string(&exact.space).unwrap_or_default();
     let settings_text = toml::to_string(&exact.settings).unwrap_or_default();

@@ -87,6 +87,9 @@ impl FolderLock {
             .map_err(io("cannot write the lock file"))?;
         file.write_all(text.as_bytes())
             .map_err(io("cannot write the lock file"))?;
+        // The folder is this process's now: what a killed writer left under temporary names
+        // (never put in place) goes (issue 66).
+        hpge_files::remove_stale_temporaries(dir);
         Ok(Self { _file: file, path })
     }
 

@@ -169,7 +169,27 @@ pub fn run(
     threads: Option<usize>,
     progress: impl Fn(usize, usize) + Sync,
 ) -> Result<RunReport> {
+    let made = !out.exists();
     std::fs::create_dir_all(out).map_err(io(out, "cannot create the output folder"))?;
+    let r = run_in(g, out, threads, progress);
+    // A folder this run made and that holds no row when it fails (a full disk before the first
+    // row, issue 66) is removed again: nothing to resume, nothing left behind.
+    if r.is_err() && made {
+        let rows = std::fs::read_to_string(out.join("rows.csv")).unwrap_or_default();
+        if rows.lines().nth(1).is_none() {
+            let _ = std::fs::remove_dir_all(out);
+        }
+    }
+    r
+}
+
+/// [`run`] into the existing folder `out`.
+fn run_in(
+    g: &Generator,
+    out: &Path,
+    threads: Option<usize>,
+    progress: impl Fn(usize, usize) + Sync,
+) -> Result<RunReport> {
     // One writer per folder, held until this function returns (`lock.rs`).
     let _lock = super::lock::FolderLock::acquire(out)?;
     let info_path = out.join("generate.json");

@@ -145,6 +145,7 @@ fn synthetic_fit(d: usize, chains: usize) -> Fit {
         modes: Vec::new(),
         local_modes: Vec::new(),
         exact_check: None,
+        exact_check_skipped: None,
         refinement: None,
         posterior_outside_support: None,
         program_version: "test".into(),

@@ -219,7 +219,13 @@ impl TruthStore {
         let lock = FolderLock::acquire_named(out, &name).map_err(hpge_inference::Error::from)?;
         let dir = out.join(TRUTHS_DIR);
         // Only files another run wrote: a shard beside this one may be writing its own.
-        remove_stale(&dir, |f| f.is_some_and(|f| f != fingerprint))?;
+        // Only truth files (`truth-NNNNN.json`): any other file there is left alone.
+        let truth_file = |f: &Path| {
+            f.file_name()
+                .and_then(|n| n.to_str())
+                .is_some_and(|n| n.starts_with("truth-") && n.ends_with(".json"))
+        };
+        remove_stale(&dir, truth_file, |f| f.is_some_and(|f| f != fingerprint))?;
         Ok(Self {
             dir,
             fingerprint,
