@@ -560,9 +560,10 @@ impl Drop for Tmpfs {
 /// Issue 66, cause 3: on a full disk (a small tmpfs, filled up) no command leaves an empty or
 /// partial file under the name asked for, nor a temporary, nor a folder it made: `simulate`,
 /// `field`, `detector --plot`, `measure`, `pulse`, `sensitivity`, `synthesize`, `generate`,
-/// `merge`, `train`, `evaluate --plot`, `fit`, `report paper`, `label` and `calibrate` (the
-/// commands that write files, but `discover` and `validate`, whose runs take minutes). Skipped
-/// where no tmpfs can be mounted (without root).
+/// `merge`, `train`, `evaluate --plot`, `fit`, `report paper`, `label`, `calibrate`,
+/// `validate coverage`, `validate discovery` and `discover` (each at a size that reaches its
+/// first write in seconds): every command that writes files. Skipped where no tmpfs can be
+/// mounted (without root).
 #[test]
 fn a_full_disk_leaves_no_partial_output() {
     use std::io::Write as _;
@@ -602,7 +603,74 @@ fn a_full_disk_leaves_no_partial_output() {
     let s_space = s(&space).to_string();
     let s_shard = s(&shard).to_string();
     let s_shard_rows = s(&shard.join("rows.csv")).to_string();
+    // A one-mode prior (B_Z's parameters near the manufacturer's levels) keeps the coverage
+    // study's first truth to seconds.
+    let narrow = d.join("narrow.toml");
+    std::fs::write(
+        &narrow,
+        "name = \"narrow\"\n[[parameters]]\nname = \"d_li_mm\"\ninputs = [\"d_li_mm\"]\n\
+         prior = { distribution = \"uniform\", lo = 0.9, hi = 1.1 }\n[[parameters]]\nname = \"y_bot\"\n\
+         inputs = [\"y1_bot\", \"y2_bot\", \"y3_bot\", \"y4_bot\"]\n\
+         prior = { distribution = \"uniform\", lo = 0.69, hi = 0.72 }\n[[parameters]]\nname = \"y_top\"\n\
+         inputs = [\"y1_top\", \"y2_top\", \"y3_top\", \"y4_top\"]\n\
+         prior = { distribution = \"uniform\", lo = 0.54, hi = 0.56 }\n",
+    )
+    .unwrap();
+    let s_narrow = s(&narrow).to_string();
     let cases: Vec<Vec<String>> = vec![
+        vec![
+            "validate",
+            "coverage",
+            "--prior",
+            &s_narrow,
+            "--truths",
+            "2",
+            "--ess",
+            "60",
+            "--ranks",
+            "9",
+            "--mode-starts",
+            "1",
+            "--out",
+            at("cov").as_str(),
+        ],
+        vec![
+            "validate",
+            "discovery",
+            "--effects",
+            "none",
+            "--only",
+            "stray-capacitance",
+            "--ess",
+            "100",
+            "--grid",
+            "max_spacing_semiconductor_mm=2.0",
+            "--grid",
+            "front_spacing_mm=0.5",
+            "--tolerance",
+            "0.05",
+            "--no-plots",
+            "--out",
+            at("hidden").as_str(),
+        ],
+        vec![
+            "discover",
+            "--only",
+            "stray-capacitance",
+            "--ess",
+            "100",
+            "--max-seconds",
+            "30",
+            "--grid",
+            "max_spacing_semiconductor_mm=2.0",
+            "--grid",
+            "front_spacing_mm=0.5",
+            "--tolerance",
+            "0.05",
+            "--no-plots",
+            "--out",
+            at("disc").as_str(),
+        ],
         vec![
             "pulse",
             "--detector",

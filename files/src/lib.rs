@@ -469,6 +469,64 @@ fn resolved(path: &Path) -> PathBuf {
     }
 }
 
+/// An output folder a command is about to fill: made by [`NewFolder::create`] and removed again,
+/// with what is in it, when dropped before [`NewFolder::keep`] (the command failed, e.g. on a
+/// full disk), unless `holds_state` says it holds resumable state (finished truths, rows,
+/// rounds). A folder that existed before is never removed (issue 66: a failed command leaves
+/// no folder it made).
+///
+/// ```
+/// let d = std::env::temp_dir().join(format!("hpge-newfolder-doc-{}", std::process::id()));
+/// {
+///     let _f = hpge_files::NewFolder::create(&d, |_| false)?;
+///     assert!(d.is_dir());
+/// } // dropped before keep(): the command failed
+/// assert!(!d.exists());
+/// let mut f = hpge_files::NewFolder::create(&d, |_| false)?;
+/// f.keep();
+/// drop(f);
+/// assert!(d.is_dir());
+/// std::fs::remove_dir_all(&d)?;
+/// # Ok::<(), std::io::Error>(())
+/// ```
+#[derive(Debug)]
+pub struct NewFolder {
+    path: PathBuf,
+    made: bool,
+    kept: bool,
+    holds_state: fn(&Path) -> bool,
+}
+
+impl NewFolder {
+    /// Makes `path` (and its parents) unless it exists.
+    ///
+    /// # Errors
+    /// The I/O error of making it.
+    pub fn create(path: &Path, holds_state: fn(&Path) -> bool) -> io::Result<Self> {
+        let made = !path.exists();
+        fs::create_dir_all(path)?;
+        Ok(Self {
+            path: path.to_path_buf(),
+            made,
+            kept: false,
+            holds_state,
+        })
+    }
+
+    /// The command finished: the folder stays.
+    pub fn keep(&mut self) {
+        self.kept = true;
+    }
+}
+
+impl Drop for NewFolder {
+    fn drop(&mut self) {
+        if self.made && !self.kept && !(self.holds_state)(&self.path) {
+            let _ = fs::remove_dir_all(&self.path);
+        }
+    }
+}
+
 /// Whether an output written at `out` would write over the input `input` or into it: the same
 /// path once resolved (`.`, `..`, symbolic links), the same file under another name (a hard
 /// link: same device and inode), or `out` inside the folder `input`.

@@ -36,8 +36,12 @@ pub fn coverage(o: &CoverageOptions, as_json: bool, force: bool) -> Result<()> {
     if let Some(w) = check_other_study(out, &s.inputs, o, &settings, &fingerprint, force)? {
         eprintln!("warning: {w}");
     }
-    std::fs::create_dir_all(out)
-        .with_context(|| format!("--out {}: cannot create the folder", out.display()))?;
+    // A folder this study makes is removed again if it fails before a truth is written (a full
+    // disk, issue 66); one with finished truths stays, to resume from.
+    let _folder = hpge_files::NewFolder::create(out, |dir| {
+        std::fs::read_dir(dir.join("truths")).is_ok_and(|mut d| d.next().is_some())
+    })
+    .with_context(|| format!("--out {}: cannot create the folder", out.display()))?;
     eprintln!(
         "coverage: the study's folder is {}{}",
         out.display(),

@@ -95,6 +95,16 @@ pub fn run(a: &DiscoveryArgs) -> Result<()> {
         "validate discovery: the study's folder is {}",
         o.out.display()
     );
+    // A study folder this run makes is removed again when it fails before any effect's curve is
+    // written (a full disk, issue 66); one holding curves or a summary stays.
+    let _study = hpge_files::NewFolder::create(&o.out, |d| {
+        std::fs::read_dir(d).is_ok_and(|entries| {
+            entries
+                .filter_map(Result::ok)
+                .any(|e| e.file_name() == "summary.json" || e.path().join("cv.csv").exists())
+        })
+    })
+    .with_context(|| format!("{}: cannot create the folder", o.out.display()))?;
     let surrogate: Arc<dyn CvModel> = Arc::new(s.surrogate.clone());
     let volts = s.data.voltage_v.clone();
     let mut outcomes = Vec::new();

@@ -90,6 +90,9 @@ pub fn run_discover(
 ) -> Result<Discovery> {
     let mut inputs = job.inputs.clone();
     inputs.insert("start_model".into(), start_file.display().to_string());
+    // A folder this run makes is removed again when it fails before a stage is finished (a
+    // full disk, issue 66); one with finished stages stays, to resume from.
+    let mut folder = None;
     let (lock, stages) = match out {
         Some(dir) => {
             // A folder holding another run's discovery is refused unless `force` (issue 69).
@@ -102,11 +105,16 @@ pub fn run_discover(
             )? {
                 progress.stage(&format!("warning: {w}"));
             }
-            std::fs::create_dir_all(dir).map_err(|e| Error::Output {
-                flag: "--out".into(),
-                file: dir.to_path_buf(),
-                message: format!("cannot create the folder: {e}"),
-            })?;
+            folder = Some(
+                hpge_files::NewFolder::create(dir, |d| {
+                    std::fs::read_dir(d.join("stages")).is_ok_and(|mut s| s.next().is_some())
+                })
+                .map_err(|e| Error::Output {
+                    flag: "--out".into(),
+                    file: dir.to_path_buf(),
+                    message: format!("cannot create the folder: {e}"),
+                })?,
+            );
             let lock = lock_output(dir)?;
             let fp = run_fingerprint(&inputs, settings, &job.exact.settings);
             (Some(lock), Some(Stages::open(dir, fp)?))
@@ -131,6 +139,9 @@ pub fn run_discover(
         write_outputs(dir, &d, &job.exact, no_plots)?;
     }
     drop(lock);
+    if let Some(f) = folder.as_mut() {
+        f.keep();
+    }
     Ok(d)
 }
 
