@@ -519,6 +519,12 @@ impl NewFolder {
     }
 }
 
+/// Whether `dir` is a folder with at least one entry (false when it is missing or unreadable):
+/// the usual `holds_state` of a [`NewFolder`] (finished truths, rounds or stages in a subfolder).
+pub fn has_entries(dir: &Path) -> bool {
+    fs::read_dir(dir).is_ok_and(|mut d| d.next().is_some())
+}
+
 impl Drop for NewFolder {
     fn drop(&mut self) {
         if self.made && !self.kept && !(self.holds_state)(&self.path) {

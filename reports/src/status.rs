@@ -126,7 +126,7 @@ fn fit_rows(root: &Path, name: &str, what: &str, main: bool) -> Result<Vec<Statu
         .and_then(Value::as_f64)
         .unwrap_or(f64::NAN);
     let limit = hpge_inference::fit::k_hat_limit(draws);
-    let near_equal = failed == 0 && range <= hpge_inference::fit::NEAR_EQUAL_LOG_RANGE;
+    let near_equal = hpge_inference::fit::near_equal_weights(range, failed);
     let weights_ok = hpge_inference::fit::weights_reliable(k, draws, range, failed);
     let after = if rounds.is_empty() {
         String::new()

@@ -38,10 +38,9 @@ pub fn coverage(o: &CoverageOptions, as_json: bool, force: bool) -> Result<()> {
     }
     // A folder this study makes is removed again if it fails before a truth is written (a full
     // disk, issue 66); one with finished truths stays, to resume from.
-    let _folder = hpge_files::NewFolder::create(out, |dir| {
-        std::fs::read_dir(dir.join("truths")).is_ok_and(|mut d| d.next().is_some())
-    })
-    .with_context(|| format!("--out {}: cannot create the folder", out.display()))?;
+    let _folder =
+        hpge_files::NewFolder::create(out, |dir| hpge_files::has_entries(&dir.join("truths")))
+            .with_context(|| format!("--out {}: cannot create the folder", out.display()))?;
     eprintln!(
         "coverage: the study's folder is {}{}",
         out.display(),

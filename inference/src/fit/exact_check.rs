@@ -110,7 +110,13 @@ pub fn k_hat_limit(draws: usize) -> f64 {
 /// near-equal weights ([`NEAR_EQUAL_LOG_RANGE`], no failed draw), or k-hat within
 /// [`k_hat_limit`]. NaN fails.
 pub fn weights_reliable(k_hat: f64, draws: usize, log_ratio_range: f64, failed: usize) -> bool {
-    (failed == 0 && log_ratio_range <= NEAR_EQUAL_LOG_RANGE) || k_hat <= k_hat_limit(draws)
+    near_equal_weights(log_ratio_range, failed) || k_hat <= k_hat_limit(draws)
+}
+
+/// Whether the weights are near-equal: log ratios spanning at most [`NEAR_EQUAL_LOG_RANGE`] and
+/// no draw without an exact solve (weight 0). NaN is not near-equal.
+pub fn near_equal_weights(log_ratio_range: f64, failed: usize) -> bool {
+    failed == 0 && log_ratio_range <= NEAR_EQUAL_LOG_RANGE
 }
 
 /// ... and every posterior mean lies within this many posterior sd of its exact re-weighted
@@ -421,7 +427,7 @@ pub fn exact_check(
         pass: weights_reliable(p.k_hat, draws.len(), log_ratio_range, failed)
             && max_abs_shift_sd <= SHIFT_LIMIT_SD,
         k_hat_limit: k_hat_limit(draws.len()),
-        near_equal: failed == 0 && log_ratio_range <= NEAR_EQUAL_LOG_RANGE,
+        near_equal: near_equal_weights(log_ratio_range, failed),
         parameters,
         max_rel_diff_at_mode: max_rel,
         chi2_exact_at_mode: chi2_exact,

@@ -28,7 +28,7 @@ pub use checkpoint::{
 pub use exact_check::{
     DEFAULT_GRID_CHECK, ExactCheck, ExactCheckSettings, ExactGrids, FailedSolve, GridCheck,
     K_HAT_LIMIT, NEAR_EQUAL_LOG_RANGE, ParameterShift, SHIFT_LIMIT_SD, add_grid_check, exact_check,
-    k_hat_limit, weights_reliable,
+    k_hat_limit, near_equal_weights, weights_reliable,
 };
 pub use job::{EXACT_CHECK_TOLERANCE, FitFiles, FitJob, file_hash};
 pub use options::{

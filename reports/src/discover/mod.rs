@@ -106,14 +106,12 @@ pub fn run_discover(
                 progress.stage(&format!("warning: {w}"));
             }
             folder = Some(
-                hpge_files::NewFolder::create(dir, |d| {
-                    std::fs::read_dir(d.join("stages")).is_ok_and(|mut s| s.next().is_some())
-                })
-                .map_err(|e| Error::Output {
-                    flag: "--out".into(),
-                    file: dir.to_path_buf(),
-                    message: format!("cannot create the folder: {e}"),
-                })?,
+                hpge_files::NewFolder::create(dir, |d| hpge_files::has_entries(&d.join("stages")))
+                    .map_err(|e| Error::Output {
+                        flag: "--out".into(),
+                        file: dir.to_path_buf(),
+                        message: format!("cannot create the folder: {e}"),
+                    })?,
             );
             let lock = lock_output(dir)?;
             let fp = run_fingerprint(&inputs, settings, &job.exact.settings);

@@ -124,14 +124,15 @@ pub fn run_fit(o: &FitOptions, observer: &dyn FitObserver) -> Result<FitRun> {
     )? {
         job.warnings.push(w);
     }
-    let mut made = MadeFolder {
-        path: (!out.exists()).then(|| out.clone()),
-    };
-    std::fs::create_dir_all(&out).map_err(|e| Error::Output {
-        flag: "--out".into(),
-        file: out.clone(),
-        message: format!("cannot create the folder: {e}"),
-    })?;
+    // A folder this fit makes is removed again when it fails before its outputs are in place (a
+    // full disk, issue 66), unless it holds finished rounds to resume from.
+    let mut made =
+        hpge_files::NewFolder::create(&out, |d| hpge_files::has_entries(&d.join("rounds")))
+            .map_err(|e| Error::Output {
+                flag: "--out".into(),
+                file: out.clone(),
+                message: format!("cannot create the folder: {e}"),
+            })?;
     // One writer per folder, until the last file is written.
     let _lock = hpge_inference::fit::lock_output(&out)?;
     observer.setup_done(&job, o, &settings);
@@ -199,7 +200,7 @@ pub fn run_fit(o: &FitOptions, observer: &dyn FitObserver) -> Result<FitRun> {
         action: "cannot write",
         source,
     })?;
-    made.path = None;
+    made.keep();
     // An error model of an earlier run in this folder that this run did not replace.
     if correction.is_none() {
         let stale = out.join(outputs::ERROR_MODEL_FILE);
@@ -213,23 +214,6 @@ pub fn run_fit(o: &FitOptions, observer: &dyn FitObserver) -> Result<FitRun> {
         out,
         summary_json,
     })
-}
-
-/// The output folder a fit made, removed again when the fit fails before its outputs are in
-/// place (a full disk, issue 66), unless it holds finished rounds to resume from.
-struct MadeFolder {
-    path: Option<PathBuf>,
-}
-
-impl Drop for MadeFolder {
-    fn drop(&mut self) {
-        if let Some(p) = &self.path {
-            let rounds = std::fs::read_dir(p.join("rounds")).map_or(0, |d| d.count());
-            if rounds == 0 {
-                let _ = std::fs::remove_dir_all(p);
-            }
-        }
-    }
 }
 
 /// What identifies a fit in its `summary.json`: its inputs with their hashes, the sampler's

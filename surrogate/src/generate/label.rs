@@ -290,16 +290,13 @@ pub fn label(
     progress: impl Fn(usize, usize) + Sync,
 ) -> Result<LabelReport> {
     let (input, input_hash) = read_input(input_path, exact)?;
-    let made = !out.exists();
-    std::fs::create_dir_all(out).map_err(io(out, "cannot create the output folder"))?;
-    let r = label_into(exact, input_path, out, threads, progress, input, input_hash);
-    // A folder this run made and that holds no row when it fails (a full disk before the first
+    // A folder this run makes and that holds no row when it fails (a full disk before the first
     // row, issue 66) is removed again: nothing to resume, nothing left behind.
-    if r.is_err() && made {
-        let rows = std::fs::read_to_string(out.join("rows.csv")).unwrap_or_default();
-        if rows.lines().nth(1).is_none() {
-            let _ = std::fs::remove_dir_all(out);
-        }
+    let mut folder = hpge_files::NewFolder::create(out, super::run::holds_rows)
+        .map_err(io(out, "cannot create the output folder"))?;
+    let r = label_into(exact, input_path, out, threads, progress, input, input_hash);
+    if r.is_ok() {
+        folder.keep();
     }
     r
 }

@@ -169,18 +169,21 @@ pub fn run(
     threads: Option<usize>,
     progress: impl Fn(usize, usize) + Sync,
 ) -> Result<RunReport> {
-    let made = !out.exists();
-    std::fs::create_dir_all(out).map_err(io(out, "cannot create the output folder"))?;
-    let r = run_in(g, out, threads, progress);
-    // A folder this run made and that holds no row when it fails (a full disk before the first
+    // A folder this run makes and that holds no row when it fails (a full disk before the first
     // row, issue 66) is removed again: nothing to resume, nothing left behind.
-    if r.is_err() && made {
-        let rows = std::fs::read_to_string(out.join("rows.csv")).unwrap_or_default();
-        if rows.lines().nth(1).is_none() {
-            let _ = std::fs::remove_dir_all(out);
-        }
+    let mut folder = hpge_files::NewFolder::create(out, holds_rows)
+        .map_err(io(out, "cannot create the output folder"))?;
+    let r = run_in(g, out, threads, progress);
+    if r.is_ok() {
+        folder.keep();
     }
     r
+}
+
+/// Whether the folder's `rows.csv` has a row below its header: a `generate` or `label` run
+/// there to resume.
+pub(super) fn holds_rows(dir: &Path) -> bool {
+    std::fs::read_to_string(dir.join("rows.csv")).is_ok_and(|rows| rows.lines().nth(1).is_some())
 }
 
 /// [`run`] into the existing folder `out`.
