@@ -15,7 +15,8 @@
 # default model's widths and weight decay) is trained on them with the same test set and seed,
 # and one JSON line is appended to models/learning-curves.jsonl. EXTRA (optional): more
 # generate folders whose ok rows all join as well (e.g. data/training/bz-low-bias-800000, the
-# B_Z slice at 10-110 V); the line records them and adds their CPU time:
+# B_Z slice at 10-110 V), or DIR:N for the first N ok rows of a folder still being generated
+# (e.g. data/training/uniform-900000:8000); the line records them and adds their CPU time:
 #   arm, k, the arm's CPU seconds for those K rows (CPU_PER_ROW_S of the arm, below, times K),
 #   the figures of `evaluate --json` on data/training/heldout-300000.csv and heldout.csv
 #   (sigma, q90, q99, coverage, and the pocket / no-pocket split of the former).
@@ -37,10 +38,15 @@ case "$ARM" in
   *) echo "learning-curve.sh: ARM must be uniform, active or low-bias, not '$ARM'" >&2; exit 2 ;;
 esac
 for E in $EXTRA; do
-  [ -f "$E/rows.csv" ] && [ -f "$E/cpu.json" ] || { echo "learning-curve.sh: EXTRA folder '$E' has no rows.csv and cpu.json" >&2; exit 2; }
+  D=${E%%:*}
+  [ -f "$D/rows.csv" ] && [ -f "$D/cpu.json" ] || { echo "learning-curve.sh: EXTRA folder '$D' has no rows.csv and cpu.json" >&2; exit 2; }
+  if [ "$D" != "$E" ] && ! [[ "${E#*:}" =~ ^[0-9]+$ ]]; then echo "learning-curve.sh: EXTRA '$E': N in DIR:N must be a count of rows" >&2; exit 2; fi
 done
 TAG=$ARM-$K
-for E in $EXTRA; do TAG=$TAG+$(basename "$E"); done
+for E in $EXTRA; do
+  D=${E%%:*}
+  if [ "$D" = "$E" ]; then TAG=$TAG+$(basename "$D"); else TAG=$TAG+$(basename "$D")-first${E#*:}; fi
+done
 [ "$SEED" = 0 ] || TAG=$TAG-seed$SEED
 [[ "$K" =~ ^[0-9]+$ ]] || { echo "learning-curve.sh: K must be a count of rows, not '$K'" >&2; exit 2; }
 OUT=models/learning-curves.jsonl
@@ -89,7 +95,13 @@ if k > 0:
         sys.exit(f"learning-curve.sh: {rows_file} has {len(ok)} ok rows, fewer than K = {k}")
     added = [line(row) for row in ok[:k]]
 for e in extra:
-    added += [line(row) for row in ok_rows(e + "/rows.csv")]
+    folder, _, n = e.partition(":")
+    ok = ok_rows(folder + "/rows.csv")
+    if n:
+        if len(ok) < int(n):
+            sys.exit(f"learning-curve.sh: {folder}/rows.csv has {len(ok)} ok rows, fewer than {n}")
+        ok = ok[: int(n)]
+    added += [line(row) for row in ok]
 with open(out, "w", newline="") as f:
     w = csv.writer(f, lineterminator="\n")
     w.writerows(base)
@@ -112,7 +124,9 @@ $B evaluate --model "$MODEL" --data data/training/heldout.csv --json > "${MODEL%
 CPU=0
 if [ "$K" -gt 0 ]; then CPU=$(python3 -c "import json; print(json.load(open('$DIR/cpu.json'))['cpu_per_row_s'] * $K)"); fi
 for E in $EXTRA; do
-  CPU=$(python3 -c "import csv, json; d = json.load(open('$E/cpu.json')); n = sum(1 for r in csv.DictReader(open('$E/rows.csv')) if r['status'] == 'ok'); print($CPU + d['cpu_per_row_s'] * n)")
+  D=${E%%:*}
+  N=""; [ "$D" = "$E" ] || N=${E#*:}
+  CPU=$(python3 -c "import csv, json; d = json.load(open('$D/cpu.json')); n = sum(1 for r in csv.DictReader(open('$D/rows.csv')) if r['status'] == 'ok'); n = min(n, int('$N')) if '$N' else n; print($CPU + d['cpu_per_row_s'] * n)")
 done
 python3 - "$ARM" "$K" "$RECIPE" "$CPU" "${MODEL%.safetensors}" "$TAG" "$EXTRA" "$SEED" >> "$OUT" <<'EOF'
 import json, sys

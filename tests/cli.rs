@@ -153,6 +153,13 @@ fn simulate_coax_json_csv_and_plots() {
     // Closed form of coax-analytic.toml: 3501.1 V (validation/tests/depletion_voltage.rs).
     let vd = v["depletion_voltage_V"].as_f64().unwrap();
     assert!((vd - 3501.1).abs() < 0.003 * 3501.1, "{vd}");
+    // Issue 64: U_fd with its error bar, which bounds the closed form.
+    let vd_err = v["depletion_voltage_err_V"].as_f64().unwrap();
+    assert!(
+        (vd - 3501.1).abs() <= vd_err && vd_err < 0.01 * vd,
+        "{vd} +- {vd_err}"
+    );
+    assert!(v["pinch_off_voltage_V"].is_null() && v["pinch_off_voltage_err_V"].is_null());
     assert_eq!(v["method"], "fast");
     assert!(v["grid"]["nr"].as_u64().unwrap() > 10 && v["seconds"].as_f64().unwrap() > 0.0);
     // Issue 18: every c12 with its estimated error, within the default tolerance (0.2%).
@@ -163,9 +170,47 @@ fn simulate_coax_json_csv_and_plots() {
     }
     assert_eq!(v["tolerance"], 0.002);
     let text = std::fs::read_to_string(&csv).unwrap();
-    assert!(text.starts_with("voltage_V,c12_pF,fully_depleted,c12_err_pF\n25,"));
+    assert!(text.starts_with(
+        "voltage_V,c12_pF,fully_depleted,c12_err_pF,tolerance_reached,depletion_voltage_V,depletion_voltage_err_V,pinch_off_voltage_V,pinch_off_voltage_err_V\n25,"
+    ));
+    // The curve's voltages repeat on every row; no pinch-off: empty cells.
+    let row: Vec<&str> = text.lines().nth(1).unwrap().split(',').collect();
+    assert_eq!(row.len(), 9, "{row:?}");
+    assert_eq!(row[4], "true");
+    assert_eq!(row[5].parse::<f64>().unwrap(), vd);
+    assert_eq!((row[7], row[8]), ("", ""));
     assert_eq!(&std::fs::read(&png).unwrap()[..4], b"\x89PNG");
     assert!(std::fs::read_to_string(&field).unwrap().starts_with("<svg"));
+}
+
+/// Issue 64: a curve none of whose points reaches the tolerance still gives its values, each
+/// flagged `tolerance_reached: false` with its estimate, and says so on stderr (exit 0, not 2).
+#[test]
+fn simulate_returns_values_flagged_where_no_bias_reaches_the_tolerance() {
+    let out = hpge_cv(&[
+        "simulate",
+        "--detector",
+        "detectors/coax-analytic.toml",
+        "--voltages",
+        "1025,2000",
+        "--tolerance",
+        "1e-6",
+        "--grid",
+        "max_adaptive_passes=2",
+        "--json",
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(stderr.contains("no bias reached it"), "{stderr}");
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("one JSON object");
+    for k in 0..2 {
+        assert_eq!(v["tolerance_reached"][k], false);
+        let (c, e) = (
+            v["c12_pF"][k].as_f64().unwrap(),
+            v["c12_err_pF"][k].as_f64().unwrap(),
+        );
+        assert!(c > 0.0 && e > 1e-6 * c, "{k}: {c} +- {e}");
+    }
 }
 
 #[test]

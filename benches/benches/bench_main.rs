@@ -2,6 +2,7 @@
 
 use criterion::{criterion_group, criterion_main};
 
+mod depletion;
 mod drift;
 mod generate;
 mod gpu;
@@ -15,6 +16,7 @@ criterion_group!(
     benches,
     impurity::bench,
     solver::bench,
+    depletion::bench,
     problems::bench,
     gpu::bench,
     generate::bench,

@@ -23,7 +23,8 @@ use crate::{HpgeError, array, err, matrix};
 ///
 /// Returns a dict: `voltage_V`, `c12_pF`, `c12_err_pF` (numpy arrays), `fully_depleted`,
 /// `tolerance_reached` (bool arrays), `depletion_voltage_V` (the full-depletion voltage U_fd, V,
-/// or None), `pinch_off_voltage_V` (V or None) and `pockets` (per bias a list of dicts:
+/// or None) with `depletion_voltage_err_V` (its estimated error, V), `pinch_off_voltage_V` (V or
+/// None) with `pinch_off_voltage_err_V`, and `pockets` (per bias a list of dicts:
 /// `carrier`, `level_V`, `volume_cm3`, `centroid_mm`, `r_range_mm`, `z_range_mm`). The GIL is
 /// released while the solver runs.
 #[pyfunction]
@@ -67,8 +68,15 @@ pub(crate) fn simulate<'py>(
         "tolerance_reached",
         PyArray1::from_vec(py, pts.iter().map(|p| p.tolerance_reached).collect()),
     )?;
+    // An error bar that could not be estimated (infinite) is None, as in the command's JSON.
+    let finite = |e: Option<f64>| e.filter(|x| x.is_finite());
     d.set_item("depletion_voltage_V", curve.depletion_voltage_v)?;
-    d.set_item("pinch_off_voltage_V", pinch)?;
+    d.set_item(
+        "depletion_voltage_err_V",
+        finite(curve.depletion_voltage_err_v),
+    )?;
+    d.set_item("pinch_off_voltage_V", pinch.map(|e| e.voltage_v))?;
+    d.set_item("pinch_off_voltage_err_V", finite(pinch.map(|e| e.err_v)))?;
     let pockets = PyList::empty(py);
     for p in pts {
         let list = PyList::empty(py);

@@ -39,6 +39,11 @@ def test_simulate_equals_the_command_line(cli_json):
     assert got["depletion_voltage_V"] == pytest.approx(ref["depletion_voltage_V"], rel=1e-12)
     # The closed form: full depletion of this coax at 3501.1 V (detectors/coax-analytic.toml).
     assert got["depletion_voltage_V"] == pytest.approx(3501.1, rel=2e-3)
+    # Issue 64: its error bar, as the command line's, bounds the closed form; no pinch-off.
+    err = got["depletion_voltage_err_V"]
+    assert err == pytest.approx(ref["depletion_voltage_err_V"], rel=1e-12)
+    assert abs(got["depletion_voltage_V"] - 3501.1) <= err < 0.01 * 3501.1
+    assert got["pinch_off_voltage_V"] is None and got["pinch_off_voltage_err_V"] is None
     assert seen, "the progress callable was never called"
 
 

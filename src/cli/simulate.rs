@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 use hpge_reports::plot;
-use hpge_solver::field::{curve_pinch_off_voltage, normalise_voltages};
+use hpge_solver::field::{VoltageEstimate, curve_pinch_off_voltage, normalise_voltages};
 use hpge_solver::gpu::gpu_adapter;
 use hpge_solver::{
     Backend, CvCurve, Error, FieldSettings, Precision, cv_curve, solve_point, solve_potential,
@@ -127,9 +127,13 @@ pub fn run(o: &SimulateOptions<'_>) -> Result<()> {
         .iter()
         .filter(|p| !p.tolerance_reached)
         .collect();
+    // A value whose estimate misses the tolerance is still a value (issue 64): every point
+    // comes back with `tolerance_reached: false` and its estimate; a note below names each, and
+    // one more says what would help when none reached it. Exit 2 is kept for inputs that cannot
+    // be solved at all.
     if settings.grid.adaptive && !missed.is_empty() && missed.len() == curve.points.len() {
-        bail!(
-            "grid.tolerance {:e}: no bias reached it (estimated relative errors {:.1e} to {:.1e}); the grid cannot be refined that far with min_tick_distance_mm = {} mm in {} passes and {} nodes: raise --tolerance (or --grid max_nodes=N)",
+        eprintln!(
+            "warning: grid.tolerance {:e}: no bias reached it (estimated relative errors {:.1e} to {:.1e}); every value is flagged tolerance_reached = false. The grid cannot be refined further with min_tick_distance_mm = {} mm in {} passes and {} nodes: raise --tolerance (or --grid max_nodes=N) for values within it",
             settings.grid.tolerance,
             missed
                 .iter()
@@ -160,12 +164,13 @@ pub fn run(o: &SimulateOptions<'_>) -> Result<()> {
     if curve.points.iter().all(|p| !p.fully_depleted) && curve.points.len() > 1 {
         eprintln!("note: the detector is not fully depleted at any listed voltage");
     }
+    let pinch_off_v = curve_pinch_off_voltage(&det, &curve, &settings)?;
     let seconds = start.elapsed().as_secs_f64();
     // The CSV under its name only once every figure is drawn too.
     let mut staged = hpge_files::Staged::new();
     if let Some(path) = o.out {
         staged
-            .write_with(path, |f| write_csv(f, &curve))
+            .write_with(path, |f| write_csv(f, &curve, pinch_off_v))
             .with_context(|| format!("--out {}: cannot write the file", path.display()))?;
     }
     if let Some(path) = o.plot {
@@ -184,7 +189,6 @@ pub fn run(o: &SimulateOptions<'_>) -> Result<()> {
         plot::depletion_map(&det, &states, path)?;
     }
     super::args::commit(staged)?;
-    let pinch_off_v = curve_pinch_off_voltage(&det, &curve, &settings)?;
     let last = curve.points.last().map_or((0, 0), |p| p.grid);
     if o.json {
         let v = super::args::with_detector_provenance(
@@ -197,7 +201,9 @@ pub fn run(o: &SimulateOptions<'_>) -> Result<()> {
                 "adaptive": settings.grid.adaptive,
                 "fully_depleted": curve.points.iter().map(|p| p.fully_depleted).collect::<Vec<_>>(),
                 "depletion_voltage_V": curve.depletion_voltage_v,
-                "pinch_off_voltage_V": pinch_off_v,
+                "depletion_voltage_err_V": finite_or_null(curve.depletion_voltage_err_v),
+                "pinch_off_voltage_V": pinch_off_v.map(|e| e.voltage_v),
+                "pinch_off_voltage_err_V": finite_or_null(pinch_off_v.map(|e| e.err_v)),
                 "pockets": curve.points.iter().map(|p| p.pockets.iter().map(|k| json!({
                     "carrier": k.carrier,
                     "level_V": k.level_v,
@@ -251,11 +257,18 @@ pub fn run(o: &SimulateOptions<'_>) -> Result<()> {
                 );
             }
         }
-        if let Some(v) = pinch_off_v {
-            outln!("pinch-off voltage {v:.1} V (a pocket of trapped carriers forms)");
+        if let Some(e) = pinch_off_v {
+            outln!(
+                "pinch-off voltage {:.1} +- {} V (a pocket of trapped carriers forms)",
+                e.voltage_v,
+                plus_minus(e.err_v)
+            );
         }
         match curve.depletion_voltage_v {
-            Some(v) => outln!("full-depletion voltage {v:.1} V"),
+            Some(v) => outln!(
+                "full-depletion voltage {v:.1} +- {} V",
+                plus_minus(curve.depletion_voltage_err_v.unwrap_or(f64::INFINITY))
+            ),
             None => outln!("not fully depleted at any listed bias"),
         }
         outln!(
@@ -301,16 +314,48 @@ pub(super) fn backend_json(settings: &FieldSettings) -> Result<serde_json::Value
     }))
 }
 
-fn write_csv(f: &mut impl Write, curve: &CvCurve) -> std::io::Result<()> {
-    writeln!(f, "voltage_V,c12_pF,fully_depleted,c12_err_pF")?;
+/// The curve as CSV: one row per bias; the curve's full-depletion and pinch-off voltages with
+/// their error bars repeat on every row (empty where there is none; an error bar that could not
+/// be estimated is `inf`).
+fn write_csv(
+    f: &mut impl Write,
+    curve: &CvCurve,
+    pinch_off: Option<VoltageEstimate>,
+) -> std::io::Result<()> {
+    writeln!(
+        f,
+        "voltage_V,c12_pF,fully_depleted,c12_err_pF,tolerance_reached,depletion_voltage_V,depletion_voltage_err_V,pinch_off_voltage_V,pinch_off_voltage_err_V"
+    )?;
+    let cell = |x: Option<f64>| x.map_or(String::new(), |v| v.to_string());
+    let tail = [
+        cell(curve.depletion_voltage_v),
+        cell(curve.depletion_voltage_err_v),
+        cell(pinch_off.map(|e| e.voltage_v)),
+        cell(pinch_off.map(|e| e.err_v)),
+    ]
+    .join(",");
     for p in &curve.points {
         writeln!(
             f,
-            "{},{},{},{}",
-            p.voltage_v, p.c12_pf, p.fully_depleted, p.c12_err_pf
+            "{},{},{},{},{},{tail}",
+            p.voltage_v, p.c12_pf, p.fully_depleted, p.c12_err_pf, p.tolerance_reached
         )?;
     }
     Ok(())
+}
+
+/// An error bar for JSON: null where it could not be estimated (infinite).
+fn finite_or_null(err_v: Option<f64>) -> Option<f64> {
+    err_v.filter(|e| e.is_finite())
+}
+
+/// An error bar for text: `?` where it could not be estimated.
+fn plus_minus(err_v: f64) -> String {
+    if err_v.is_finite() {
+        format!("{err_v:.1}")
+    } else {
+        "? (a coarser grid finds no threshold near it)".into()
+    }
 }
 
 /// `capacitance`: the full Maxwell matrix at one bias.

@@ -2,10 +2,10 @@
 
 use serde::Serialize;
 
-use super::full_depletion::full_depletion_voltage;
-use super::mesh::Mesh;
+use super::depleted;
+use super::full_depletion::full_depletion_voltage_estimate;
 use super::pockets::Pocket;
-use super::point::{Seed, solve_point_with};
+use super::point::{Seed, pair, solve_point_with};
 use super::settings::FieldSettings;
 use crate::detector::Detector;
 use crate::error::{Error, Result};
@@ -46,10 +46,16 @@ pub struct CvCurve {
     /// The points, in increasing voltage.
     pub points: Vec<CvPoint>,
     /// Full-depletion voltage (V): the lowest bias at which no semiconductor is undepleted,
-    /// between the last listed bias that is not fully depleted (or 0 V) and the first that is,
-    /// from the unconstrained potential on the first fully depleted point's grid
-    /// (`full_depletion_voltage`); None when no listed bias depletes the detector.
+    /// from the unconstrained potential on the fully depleted reference's grid (`field::depleted`:
+    /// the grid of every fully depleted point, the same for any voltage list), searched from
+    /// the last listed bias that is not fully depleted (or 0 V) and the first that is
+    /// ([`super::full_depletion_voltage_estimate`]); None when no listed bias depletes the
+    /// detector.
     pub depletion_voltage_v: Option<f64>,
+    /// Estimated error of `depletion_voltage_v`, V: the larger difference to the same search on
+    /// the grid's two complementary coarsenings plus the bisection's width (`field::threshold`;
+    /// infinite where a coarsening does not deplete near it).
+    pub depletion_voltage_err_v: Option<f64>,
 }
 
 /// Checks a voltage list: every value finite and positive; returns it sorted and deduplicated.
@@ -134,15 +140,13 @@ pub(crate) fn curve_keeping(
         .max(1);
     let size = volts.len().div_ceil(chunks);
     let done = AtomicUsize::new(0);
-    // Each chunk returns its points, the mesh of its first fully depleted point (for the
-    // full-depletion voltage) and the kept grids and potentials.
-    type Part = (Vec<CvPoint>, Option<Mesh>, Vec<KeptPoint>);
+    // Each chunk returns its points and the kept grids and potentials.
+    type Part = (Vec<CvPoint>, Vec<KeptPoint>);
     let parts: Vec<Result<Part>> = volts
         .par_chunks(size)
         .map(|chunk| {
             let mut points = Vec::with_capacity(chunk.len());
             let mut prev: Option<Seed> = None;
-            let mut depleted_mesh: Option<Mesh> = None;
             let mut kept = Vec::new();
             for (k, &v) in chunk.iter().enumerate() {
                 let start = std::time::Instant::now();
@@ -163,9 +167,6 @@ pub(crate) fn curve_keeping(
                     seconds: start.elapsed().as_secs_f64(),
                     pockets: p.potential.pockets.clone(),
                 });
-                if depleted_mesh.is_none() && p.fully_depleted() {
-                    depleted_mesh = Some(p.mesh.clone());
-                }
                 if keep {
                     let shift = p.carried.map_or(0.0, |c| c.shift_pf);
                     kept.push((p.mesh.grid.clone(), p.potential.phi_v.clone(), shift));
@@ -175,30 +176,31 @@ pub(crate) fn curve_keeping(
                 }
                 progress(done.fetch_add(1, Ordering::Relaxed) + 1, volts.len());
             }
-            Ok((points, depleted_mesh, kept))
+            Ok((points, kept))
         })
         .collect();
     let mut points = Vec::with_capacity(volts.len());
-    let mut depleted_mesh = None;
     let mut kept = Vec::new();
     for part in parts {
-        let (pts, mesh, k) = part?;
+        let (pts, k) = part?;
         points.extend(pts);
-        depleted_mesh = depleted_mesh.or(mesh);
         kept.extend(k);
     }
-    // The first chunk with a fully depleted point holds the first such point overall.
-    let depletion_voltage_v = match (points.iter().position(|p| p.fully_depleted), depleted_mesh) {
-        (Some(k), Some(mesh)) => {
+    // U_fd on the fully depleted reference's grid, which every fully depleted point uses: the
+    // listed points only bracket the search.
+    let estimate = match points.iter().position(|p| p.fully_depleted) {
+        Some(k) => {
             let lo = if k > 0 { points[k - 1].voltage_v } else { 0.0 };
-            Some(full_depletion_voltage(&mesh, det, lo, points[k].voltage_v)?)
+            let grid = &depleted::reference(det, settings, pair(det)?)?.grid;
+            full_depletion_voltage_estimate(det, grid, lo, points[k].voltage_v)?
         }
-        _ => None,
+        None => None,
     };
     Ok((
         CvCurve {
             points,
-            depletion_voltage_v,
+            depletion_voltage_v: estimate.map(|e| e.voltage_v),
+            depletion_voltage_err_v: estimate.map(|e| e.err_v),
         },
         kept,
     ))

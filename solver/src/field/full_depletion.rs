@@ -26,8 +26,10 @@ use super::depletion::potential_dofs;
 use super::mesh::{Mesh, NodeKind};
 use super::pockets::{CARRIERS, deepest_depression_v};
 use super::system::{Dof, System};
+use super::threshold::{VoltageEstimate, bisect_threshold, threshold_with_error};
 use crate::detector::Detector;
 use crate::error::Result;
+use crate::grid::Grid;
 
 /// Relative width to which the full-depletion voltage is bisected.
 const RELATIVE_TOLERANCE: f64 = 1e-7;
@@ -173,4 +175,30 @@ pub fn full_depletion_voltage(mesh: &Mesh, det: &Detector, lo_v: f64, hi_v: f64)
         }
     }
     Ok(hi)
+}
+
+/// The full-depletion voltage U_fd (V) on `grid` with its error bar (`field::threshold`): the
+/// lowest bias at which the detector is fully depleted on that grid's mesh (see the module
+/// docs), searched from the bracket [lo_v, hi_v] (widened where the mesh puts U_fd outside it,
+/// up to 4 hi_v), and the same on the grid's two complementary coarsenings:
+///
+///   err = max_k |U_fd(h) - U_fd(H_k)| + the bisection's width.
+///
+/// Two linear solves per grid; the bisection itself costs flood fills only. None when the
+/// detector is not fully depleted on `grid` up to 4 hi_v.
+pub fn full_depletion_voltage_estimate(
+    det: &Detector,
+    grid: &Grid,
+    lo_v: f64,
+    hi_v: f64,
+) -> Result<Option<VoltageEstimate>> {
+    let ceiling = 4.0 * hi_v;
+    let ticks = det.ticks();
+    threshold_with_error(grid, (&ticks.0, &ticks.1), (lo_v, hi_v), |g, bracket| {
+        let mesh = Mesh::new(det, g.clone());
+        let a = affine(&mesh, det)?;
+        bisect_threshold(bracket, (0.0, ceiling), RELATIVE_TOLERANCE, |u| {
+            Ok(a.depleted(&mesh, u))
+        })
+    })
 }

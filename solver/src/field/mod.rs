@@ -24,6 +24,7 @@ mod settings;
 pub(crate) mod sor;
 mod space_charge;
 mod system;
+mod threshold;
 mod union_find;
 mod weighting;
 
@@ -43,10 +44,10 @@ pub use convergence::{ConvergenceRow, convergence_study};
 pub use curve::{Continuation, CvCurve, CvPoint, cv_curve, cv_curve_with, normalise_voltages};
 pub use depleted::{CARRY_POWER, Carried, carried_weight};
 pub use depletion::{MAX_POCKET_ROUNDS, PotentialSolution, solve_fast, solve_fast_with};
-pub use full_depletion::full_depletion_voltage;
+pub use full_depletion::{full_depletion_voltage, full_depletion_voltage_estimate};
 pub use mesh::{Mesh, NodeKind};
 pub use near::{NearCurves, NearEach, NearSeeding, SeedChain, cv_curves_near, cv_curves_near_each};
-pub use pinch_off::{curve_pinch_off_voltage, pinch_off_voltage};
+pub use pinch_off::{curve_pinch_off_voltage, pinch_off_voltage, pinch_off_voltage_estimate};
 pub use pockets::{Pocket, deepest_depression_v, deepest_empty_depression_v, find_pockets};
 pub use point::{
     PointResult, PotentialPoint, Seed, solve_point, solve_point_on_grid, solve_potential,
@@ -56,6 +57,7 @@ pub use settings::FieldSettings;
 pub use sor::{
     SorSettings, solve_sor, solve_sor_wgpu, solve_sor_wgpu_with, weighting_potentials_wgpu,
 };
+pub use threshold::VoltageEstimate;
 pub use weighting::{
     PAPER_EPSILON_FACTOR, WeightingMode, WeightingPotentials, weighting_potentials,
 };

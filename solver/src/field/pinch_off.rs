@@ -7,15 +7,24 @@
 //! depend on the seed).
 
 use super::curve::CvCurve;
+use super::depleted;
 use super::depletion::solve_fast;
 use super::mesh::Mesh;
-use super::point::solve_potential;
+use super::pockets::Pocket;
+use super::point::pair;
 use super::settings::FieldSettings;
+use super::threshold::{VoltageEstimate, bisect_threshold, threshold_with_error};
 use crate::detector::Detector;
 use crate::error::Result;
+use crate::grid::Grid;
 
 /// Relative width to which the pinch-off voltage is bisected.
 const RELATIVE_TOLERANCE: f64 = 1e-5;
+
+/// Relative width to which [`pinch_off_voltage_estimate`] bisects on each grid: 0.14 V on an
+/// ICPC, far inside the grids' own difference (several volts, `reports/accuracy/depletion.md`),
+/// and 3-4 solves fewer per grid than [`RELATIVE_TOLERANCE`]; the width is part of the error bar.
+const ESTIMATE_TOLERANCE: f64 = 1e-4;
 
 /// The lowest bias in [lo_v, hi_v] at which the solution on `mesh` holds a pocket, bisected to
 /// 1e-5 relative; `None` when there is none at `hi_v`, `lo_v` when there is one already there.
@@ -43,17 +52,21 @@ pub fn pinch_off_voltage(mesh: &Mesh, det: &Detector, lo_v: f64, hi_v: f64) -> R
     Ok(Some(hi))
 }
 
-/// The pinch-off voltage of a C-V curve (V): bisected ([`pinch_off_voltage`]) between the last
-/// listed bias without a pocket (or 0.1% of the first with one) and the first with one, on the
-/// latter's refined grid; None when no listed bias holds a pocket. About 20 solves on that grid:
-/// asked for explicitly (`hpge-cv simulate` reports it), not part of every [`super::cv_curve`]
-/// (the training data and the fits' exact solves do not need it).
+/// The pinch-off voltage of a C-V curve (V) with its error bar
+/// ([`pinch_off_voltage_estimate`]): searched on the fully depleted reference's grid
+/// (`field::depleted`, the same for every voltage list, so the answer does not depend on which
+/// other biases were listed), starting from the last listed bias without a pocket (or 0.1% of
+/// the first with one) and the first with one; None when no listed bias holds a pocket, or when
+/// the reference grid has none near them. About 20 solves on that grid and 10-20 on each of its
+/// two coarsenings: asked for explicitly (`hpge-cv simulate` reports it), not part of every
+/// [`super::cv_curve`] (the training data and the fits' exact solves do not need it).
 pub fn curve_pinch_off_voltage(
     det: &Detector,
     curve: &CvCurve,
     settings: &FieldSettings,
-) -> Result<Option<f64>> {
-    let Some(k) = curve.points.iter().position(|p| !p.pockets.is_empty()) else {
+) -> Result<Option<VoltageEstimate>> {
+    let resolved = |p: &super::curve::CvPoint| p.pockets.iter().any(Pocket::resolved);
+    let Some(k) = curve.points.iter().position(resolved) else {
         return Ok(None);
     };
     let hi = curve.points[k].voltage_v;
@@ -62,6 +75,45 @@ pub fn curve_pinch_off_voltage(
     } else {
         0.0
     };
-    let p = solve_potential(det, hi, settings, None)?;
-    pinch_off_voltage(&p.mesh, det, lo.max(1e-3 * hi), hi)
+    // Pockets vanish again at full depletion: the search never goes past the first listed bias
+    // after the pocket window, or the full-depletion voltage.
+    let ceiling = curve.points[k..]
+        .iter()
+        .find(|p| !resolved(p))
+        .map(|p| p.voltage_v)
+        .or(curve.depletion_voltage_v)
+        .unwrap_or(2.0 * hi);
+    let grid = &depleted::reference(det, settings, pair(det)?)?.grid;
+    pinch_off_voltage_estimate(det, grid, (lo.max(1e-3 * hi), hi), ceiling)
+}
+
+/// The pinch-off voltage (V) on `grid` with its error bar (`field::threshold`): the lowest bias
+/// at which the potential on that grid's mesh holds a pocket that the grid resolves
+/// ([`Pocket::resolved`]), searched from [lo_v, hi_v]
+/// (widened where the mesh puts it outside, never above `ceiling_v`: pockets vanish again at
+/// full depletion) and bisected to 1e-4 relative, then the same on the grid's two
+/// complementary coarsenings:
+///
+///   err = max_k |U_po(h) - U_po(H_k)| + the bisection's width.
+///
+/// About 20 nonlinear solves on `grid` and 10-20 on each coarsening. None when no pocket forms
+/// on `grid` near the bracket.
+pub fn pinch_off_voltage_estimate(
+    det: &Detector,
+    grid: &Grid,
+    (lo_v, hi_v): (f64, f64),
+    ceiling_v: f64,
+) -> Result<Option<VoltageEstimate>> {
+    let ticks = det.ticks();
+    threshold_with_error(grid, (&ticks.0, &ticks.1), (lo_v, hi_v), |g, bracket| {
+        let mesh = Mesh::new(det, g.clone());
+        // Each solve seeds the next (the answer does not depend on the seed, only the work).
+        let mut guess: Option<Vec<f64>> = None;
+        bisect_threshold(bracket, (0.0, ceiling_v), ESTIMATE_TOLERANCE, |u| {
+            let s = solve_fast(&mesh, det, u, guess.as_deref())?;
+            let pocket = s.pockets.iter().any(Pocket::resolved);
+            guess = Some(s.phi_v);
+            Ok(pocket)
+        })
+    })
 }
