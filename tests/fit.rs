@@ -108,6 +108,46 @@ fn b_z_fit_writes_every_output() {
     assert!(!samples.contains('#'));
 }
 
+/// Issue 63: a mode or a 68.3% interval at a prior bound is flagged in summary.json, the
+/// printed summary and report.md. The B_Z prior with d_Li cut at 1 mm (the data want about 3 mm)
+/// makes the bound bind.
+#[test]
+fn a_mode_at_a_prior_bound_is_flagged() {
+    let d = temp("fit-bound");
+    let prior = d.join("b-z-thin.toml");
+    let text = std::fs::read_to_string("priors/b-z.toml")
+        .unwrap()
+        .replace("lo = 0.2, hi = 5.0", "lo = 0.2, hi = 1.0");
+    std::fs::write(&prior, text).unwrap();
+    let out = d.join("bound");
+    let args = [
+        "fit",
+        "--prior",
+        prior.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--ess",
+        "300",
+        "--no-exact-check",
+        "--no-plots",
+    ];
+    let stdout = ok(&run(&args));
+    assert!(stdout.contains("AT A PRIOR BOUND: d_li_mm"), "{stdout}");
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let flags = |j: usize| {
+        v["parameters"][j]["at_prior_bound"]
+            .as_array()
+            .unwrap()
+            .len()
+    };
+    assert!(flags(0) > 0, "{}", v["parameters"][0]);
+    // The y levels sit inside their supports.
+    assert_eq!((flags(1), flags(2)), (0, 0), "{}", v["parameters"]);
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(report.contains("**At a prior bound: d_li_mm**"), "{report}");
+}
+
 #[test]
 fn nuts_and_the_covariance_likelihood_run() {
     let d = temp("fit-nuts");

@@ -128,13 +128,23 @@ fn print_summary(d: &Discovery, out: &Path) -> Result<()> {
         );
     }
     for c in &s.candidates {
-        outln!(
-            "  {:<18} ln B {:>8.2}  delta chi2 {:>8.2}  ({})",
-            c.name,
-            c.score,
-            c.delta_chi2,
-            c.predictor
-        );
+        if c.at_prior_bound.is_empty() {
+            outln!(
+                "  {:<18} ln B {:>8.2}  delta chi2 {:>8.2}  ({})",
+                c.name,
+                c.score,
+                c.delta_chi2,
+                c.predictor
+            );
+        } else {
+            outln!(
+                "  {:<18} ln B     none  delta chi2 {:>8.2}  ({}): its optimum is at a prior bound ({}), where the Laplace evidence does not hold",
+                c.name,
+                c.delta_chi2,
+                c.predictor,
+                c.at_prior_bound.join("; ")
+            );
+        }
     }
     outln!("{:.1} s; outputs in {}", s.seconds, out.display());
     Ok(())

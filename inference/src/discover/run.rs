@@ -16,6 +16,7 @@ use crate::model::{CvModel, ExactModel};
 use crate::posterior::Posterior;
 use crate::posterior::{LaplaceFit, laplace_fit};
 use crate::prior::Prior;
+use crate::summary::near_bound;
 
 /// Runs the workflow (see the module docs).
 pub fn discover(
@@ -159,9 +160,27 @@ pub fn discover(
             std::slice::from_ref(&start),
             || laplace_fit(&p, &start, &settings.laplace),
         )?;
+        // A Laplace evidence is a Gaussian around a stationary point: at a prior bound the mode
+        // is the bound, not a maximum, and ln Z (so ln B) is not valid there (issue 63). Such a
+        // candidate gets no ln B (null) and the reason, and cannot be chosen.
+        let at_prior_bound: Vec<String> = prior
+            .parameters
+            .iter()
+            .zip(&lf.theta)
+            .filter_map(|(p, &x)| {
+                near_bound(x, p.support)
+                    .map(|side| format!("{} = {x:.4} at the {side} bound of the prior", p.name))
+            })
+            .collect();
+        let score = if at_prior_bound.is_empty() {
+            lf.ln_evidence - baseline.ln_evidence
+        } else {
+            f64::NAN
+        };
         scores.push(CandidateScore {
             name: c.name.clone(),
-            score: lf.ln_evidence - baseline.ln_evidence,
+            score,
+            at_prior_bound,
             predictor: c.predictor.as_str().into(),
             delta_chi2: baseline.chi2 - lf.chi2,
             chi2: lf.chi2,
@@ -240,7 +259,8 @@ pub fn discover(
         after = Some(af);
     }
     let mut order: Vec<usize> = (0..scores.len()).collect();
-    order.sort_by(|&a, &b| scores[b].score.total_cmp(&scores[a].score));
+    // Candidates without a ln B (a mode at a prior bound) after every scored one.
+    order.sort_by(|&a, &b| ranked(scores[b].score).total_cmp(&ranked(scores[a].score)));
     let verdict = verdict(&disagreement, &scores, chosen, settings, &inp.start.name);
     let summary = DiscoverySummary {
         start_model: inp.start.name.clone(),
@@ -315,8 +335,9 @@ fn verdict(
         None => {
             let best = scores
                 .iter()
+                .filter(|s| s.score.is_finite())
                 .max_by(|a, b| a.score.total_cmp(&b.score))
-                .map_or("no entry applies".to_string(), |s| {
+                .map_or("no entry has a valid ln B".to_string(), |s| {
                     format!("the best entry, `{}`, scores ln B = {:.1}", s.name, s.score)
                 });
             format!(
@@ -324,5 +345,15 @@ fn verdict(
                 settings.min_ln_bayes
             )
         }
+    }
+}
+
+/// A score for ordering: a missing ln B (NaN: the candidate's mode at a prior bound) below
+/// every valid one.
+fn ranked(score: f64) -> f64 {
+    if score.is_finite() {
+        score
+    } else {
+        f64::NEG_INFINITY
     }
 }

@@ -31,8 +31,13 @@ pub struct Disagreement {
 pub struct CandidateScore {
     /// The entry's name.
     pub name: String,
-    /// Laplace ln Bayes factor against the start model (same predictor): ln Z_c - ln Z_0.
+    /// Laplace ln Bayes factor against the start model (same predictor): ln Z_c - ln Z_0; null
+    /// (NaN) where the candidate's optimum lies at a prior bound (`at_prior_bound`): the Laplace
+    /// approximation does not hold there, and the candidate is not chosen.
     pub score: f64,
+    /// The candidate's parameters whose optimum lies within 1% of the support's width of a
+    /// prior bound (`summary::near_bound`), worded; empty where none does.
+    pub at_prior_bound: Vec<String>,
     /// What computed its curves (`surrogate`, `exact`).
     pub predictor: String,
     /// chi^2 drop at the optimum (start model's chi^2 minus the candidate's).

@@ -12,7 +12,7 @@ use crate::numerics::nelder_mead_until;
 use crate::posterior::{NoiseSettings, Posterior};
 use crate::rejection::Latch;
 use crate::sampler::{LogDensity, SampleSettings, Samples, Status, sample};
-use crate::summary::{find_modes, marginal_mode, smallest_intervals};
+use crate::summary::{bound_flags, find_modes, marginal_mode, smallest_intervals};
 
 /// Settings of a fit.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -145,12 +145,18 @@ pub fn fit(
         let si = smallest_intervals(&all, None, Some(ess), range, settings.bins, &LEVELS);
         let width = (range[1] - range[0]) / settings.bins as f64;
         let si: Vec<Vec<[f64; 2]>> = si.into_iter().map(|v| close_gaps(v, 2.0 * width)).collect();
+        let marginal = marginal_mode(&all, None, range, settings.bins);
+        let at_prior_bound = bound_flags(
+            &[("global mode", mode[j]), ("marginal mode", marginal)],
+            &si[0],
+            p.support,
+        );
         parameters.push(ParameterSummary {
             name: p.name.clone(),
             mean,
             std,
             global_mode: mode[j],
-            marginal_mode: marginal_mode(&all, None, range, settings.bins),
+            marginal_mode: marginal,
             smallest_intervals: LEVELS
                 .iter()
                 .zip(si)
@@ -162,6 +168,7 @@ pub fn fit(
             unit: p.unit.clone(),
             prior: p.distribution,
             support: p.support,
+            at_prior_bound,
         });
     }
     let all = samples.all();

@@ -41,6 +41,10 @@ pub struct ParameterSummary {
     pub prior: PriorDistribution,
     /// Where the prior is positive.
     pub support: [f64; 2],
+    /// The modes and 68.3% interval ends within 1% of the support's width of a finite bound
+    /// (`summary::bound_flags`, issue 63), worded; empty where none is. A mode at a bound is the
+    /// bound, not a maximum: the posterior presses against the prior there.
+    pub at_prior_bound: Vec<String>,
 }
 
 /// One mode of the posterior (a component of a Gaussian mixture over the draws).

@@ -88,11 +88,19 @@ pub fn write_report(path: &Path, d: &Discovery, figures: &[PathBuf]) -> Result<(
             .iter()
             .filter_map(|n| c.optimum.get(n).map(|v| format!("{n} = {v:.4}")))
             .collect();
+        let score = if c.at_prior_bound.is_empty() {
+            format!("{:.2}", c.score)
+        } else {
+            format!(
+                "none: optimum at a prior bound ({})",
+                c.at_prior_bound.join("; ")
+            )
+        };
         let _ = writeln!(
             m,
-            "| {} | {:.2} | {:.2} | {} | {} | {} |",
+            "| {} | {} | {:.2} | {} | {} | {} |",
             c.name,
-            c.score,
+            score,
             c.delta_chi2,
             c.predictor,
             added.join(", "),

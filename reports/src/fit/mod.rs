@@ -372,6 +372,14 @@ pub fn summary_text(fit: &Fit, out: &Path) -> String {
             p.ess_tail
         );
     }
+    for p in s.parameters.iter().filter(|p| !p.at_prior_bound.is_empty()) {
+        let _ = writeln!(
+            t,
+            "AT A PRIOR BOUND: {}: {} (the posterior presses against the prior there: the mode is the bound, not a maximum)",
+            p.name,
+            p.at_prior_bound.join("; ")
+        );
+    }
     if s.modes.len() > 1 {
         for (i, m) in s.modes.iter().enumerate() {
             let loc: Vec<String> = m.location.iter().map(|v| format!("{v:.4}")).collect();

@@ -144,6 +144,18 @@ pub fn write_report(
         );
     }
     let _ = writeln!(r);
+    for p in sm
+        .parameters
+        .iter()
+        .filter(|p| !p.at_prior_bound.is_empty())
+    {
+        let _ = writeln!(
+            r,
+            "**At a prior bound: {}**: {}. The posterior presses against the prior there: the mode is the bound, not a maximum, and an interval quoted as mode +- sd does not hold.\n",
+            p.name,
+            p.at_prior_bound.join("; ")
+        );
+    }
     if sm.modes.len() > 1 {
         let _ = writeln!(
             r,

@@ -17,10 +17,17 @@ pub(super) fn grid(n: usize, cols: usize) -> (usize, usize) {
 }
 
 /// "name [unit]", or the name alone for a dimensionless parameter (unit "1" or empty).
+/// A parameter whose mode or 68.3% interval lies at a prior bound (`at_prior_bound`, issue 63)
+/// says so in its label: "(at prior bound)".
 pub(super) fn axis_label(p: &ParameterSummary) -> String {
-    match p.unit.trim() {
+    let name = match p.unit.trim() {
         "" | "1" => p.name.clone(),
         u => format!("{} [{u}]", p.name),
+    };
+    if p.at_prior_bound.is_empty() {
+        name
+    } else {
+        format!("{name} (at prior bound)")
     }
 }
 

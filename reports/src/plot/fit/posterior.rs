@@ -157,7 +157,12 @@ impl PanelView for ZetaView<'_> {
         self.p
     }
     fn label(&self) -> String {
-        format!("zeta of {} [1e10 cm^-3]", self.p.name)
+        let bound = if self.p.at_prior_bound.is_empty() {
+            ""
+        } else {
+            " (at prior bound)"
+        };
+        format!("zeta of {} [1e10 cm^-3]{bound}", self.p.name)
     }
     fn map(&self, y: f64) -> f64 {
         self.t.zeta_cm3_of_y(y) / 1e10

@@ -133,6 +133,7 @@ fn synthetic_fit(d: usize, chains: usize) -> Fit {
                 unit: unit.into(),
                 prior,
                 support,
+                at_prior_bound: Vec::new(),
             }
         })
         .collect();

@@ -1,0 +1,89 @@
+"""Issue 64's table: the full-depletion and pinch-off voltages with their error bars against
+grids with every interval divided into 4, from the results files beside this script:
+
+  depletion-error.jsonl   `PARTS=4 NO_FINE_PINCH=1 cargo run --release -p hpge-validation
+                          --example depletion_error` (one line per detector in detectors/)
+  pinch-off-fine.jsonl    `cargo run --release -p hpge-validation --example pinch_off_fine --
+                          DETECTOR DEPLETED_V PARTS LO_V HI_V` (one line per detector and PARTS)
+  depletion-error.json    the runs' date, commit, machine and commands
+
+    python3 reports/accuracy/depletion_table.py > reports/accuracy/depletion-table.md
+
+Prints the Markdown table and the count of rows whose error bar bounds the finer value.
+"""
+import json
+import os
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+
+
+def lines(name):
+    path = os.path.join(HERE, name)
+    if not os.path.exists(path):
+        return []
+    with open(path) as f:
+        return [json.loads(x) for x in f if x.strip()]
+
+
+def main():
+    meta = json.load(open(os.path.join(HERE, "depletion-error.json")))
+    fine = {}
+    for r in lines("pinch-off-fine.jsonl"):
+        name = os.path.basename(r["detector"])
+        fine.setdefault(name, {})[r["parts"]] = r
+    rows, bounded, total = [], 0, 0
+    for d in lines("depletion-error.jsonl"):
+        name = d["detector"]
+        e = d.get("u_fd_estimate")
+        if e is None:
+            rows.append(f"| {name} | not depleted below 6000 V | | | | | | | |")
+            continue
+        diff = abs(e["voltage_v"] - d["u_fd_fine4_V"])
+        ok = diff <= e["err_v"]
+        bounded += ok
+        total += 1
+        cells = [
+            name,
+            f"{e['voltage_v']:.2f} +- {e['err_v']:.2f}",
+            f"{d['u_fd_fine4_V']:.2f}",
+            f"{diff:.2f}",
+            "yes" if ok else "**no**",
+        ]
+        pinch = [p for p in d.get("pinch_off", []) if p["grid"] == "reference"]
+        if pinch and pinch[0]["estimate"]:
+            p = pinch[0]["estimate"]
+            ref = fine.get(name, {}).get(4) or fine.get(name, {}).get(2)
+            cells.append(f"{p['voltage_v']:.2f} +- {p['err_v']:.2f} ({pinch[0]['seconds']:.0f} s)")
+            if ref and ref["bracketed"]:
+                pdiff = abs(p["voltage_v"] - ref["pinch_off_V"])
+                pok = pdiff <= p["err_v"]
+                bounded += pok
+                total += 1
+                cells += [
+                    f"{ref['pinch_off_V']:.2f} ({ref['parts']}x, {ref['nodes']} nodes)",
+                    f"{pdiff:.2f}",
+                    "yes" if pok else "**no**",
+                ]
+            elif ref:
+                cells += [f"not in [{ref['pinch_off_V'] or 'bracket'}]", "", "no bracket"]
+            else:
+                cells += ["not run", "", ""]
+        else:
+            cells += ["no pocket", "", "", ""]
+        rows.append("| " + " | ".join(cells) + " |")
+    print(
+        f"Made {meta['date']} with commit {meta['commit']} ({meta['machine']}); "
+        f"solver revision \"{meta['solver_revision']}\"; default settings (tolerance 0.2%).\n"
+    )
+    print(
+        "| detector | U_fd +- err (V) | U_fd, 4x finer | \\|diff\\| | bounded | "
+        "pinch-off +- err (V) (search time) | pinch-off, finer grid | \\|diff\\| | bounded |"
+    )
+    print("|---|---|---|---|---|---|---|---|---|")
+    for r in rows:
+        print(r)
+    print(f"\nError bars that bound the finer grid's value: {bounded} of {total}.")
+
+
+if __name__ == "__main__":
+    main()
