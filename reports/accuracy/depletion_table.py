@@ -6,6 +6,7 @@ grids with every interval divided into 4, from the results files beside this scr
   pinch-off-fine.jsonl    `cargo run --release -p hpge-validation --example pinch_off_fine --
                           DETECTOR DEPLETED_V PARTS LO_V HI_V` (one line per detector and PARTS)
   depletion-error.json    the runs' date, commit, machine and commands
+  depletion-bench.json    `cargo bench -p hpge-benches -- 'depletion/u_fd'` (criterion medians)
 
     python3 reports/accuracy/depletion_table.py > reports/accuracy/depletion-table.md
 
@@ -83,6 +84,17 @@ def main():
     for r in rows:
         print(r)
     print(f"\nError bars that bound the finer grid's value: {bounded} of {total}.")
+    bench_file = os.path.join(HERE, "depletion-bench.json")
+    if os.path.exists(bench_file):
+        b = json.load(open(bench_file))
+        print(
+            f"\nCriterion benchmark of U_fd with its error bar on the reference grid "
+            f"(`{b['command']}`; {b['date']}, commit {b['commit']}; {b['machine']}):\n"
+        )
+        print("| detector | median time (s) |")
+        print("|---|---|")
+        for name, t in b["median_s"].items():
+            print(f"| {name} | {t:.3f} |")
 
 
 if __name__ == "__main__":
