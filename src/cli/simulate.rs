@@ -156,6 +156,8 @@ pub fn run(o: &SimulateOptions<'_>) -> Result<()> {
             100.0 * settings.grid.tolerance,
             if p.pockets.is_empty() {
                 ""
+            } else if !p.pockets.iter().any(|k| k.resolved()) {
+                ": an unresolved line of trapped carriers (one grid line wide, e.g. at a contact's corner; not counted as a pinch-off)"
             } else {
                 ": a pocket's neck at pinch-off, where c12 changes faster than any grid resolves"
             }
