@@ -4,7 +4,7 @@ use hpge_solver::drift::{
     AdlModel, AdlParameters, DriftSettings, ElectricField, check_interaction_point, field_line,
     normalise_signals, reference_contact, rise_time_10_90_ns,
 };
-use hpge_solver::field::{curve_pinch_off_voltage, normalise_voltages};
+use hpge_solver::field::{curve_depletion_voltage, curve_pinch_off_voltage, normalise_voltages};
 use hpge_solver::{cv_curve, solve_point};
 use numpy::PyArray1;
 use pyo3::prelude::*;
@@ -42,11 +42,12 @@ pub(crate) fn simulate<'py>(
     let volts = normalise_voltages(&voltages).map_err(err)?;
     det.check_bias_contact().map_err(err)?;
     let settings = field_settings(det, tolerance, grid)?;
-    let (curve, pinch) = py
+    let (curve, pinch, depletion) = py
         .detach(|| {
             let c = cv_curve(det, &volts, &settings, |k, n| progress.report(k, n))?;
             let p = curve_pinch_off_voltage(det, &c, &settings)?;
-            Ok::<_, hpge_solver::Error>((c, p))
+            let d = curve_depletion_voltage(det, &c, &settings)?;
+            Ok::<_, hpge_solver::Error>((c, p, d))
         })
         .map_err(err)?;
     let d = PyDict::new(py);
@@ -73,7 +74,7 @@ pub(crate) fn simulate<'py>(
     d.set_item("depletion_voltage_V", curve.depletion_voltage_v)?;
     d.set_item(
         "depletion_voltage_err_V",
-        finite(curve.depletion_voltage_err_v),
+        finite(depletion.map(|e| e.err_v)),
     )?;
     d.set_item("pinch_off_voltage_V", pinch.map(|e| e.voltage_v))?;
     d.set_item("pinch_off_voltage_err_V", finite(pinch.map(|e| e.err_v)))?;

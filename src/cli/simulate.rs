@@ -5,7 +5,9 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 use hpge_reports::plot;
-use hpge_solver::field::{VoltageEstimate, curve_pinch_off_voltage, normalise_voltages};
+use hpge_solver::field::{
+    VoltageEstimate, curve_depletion_voltage, curve_pinch_off_voltage, normalise_voltages,
+};
 use hpge_solver::gpu::gpu_adapter;
 use hpge_solver::{
     Backend, CvCurve, Error, FieldSettings, Precision, cv_curve, solve_point, solve_potential,
@@ -167,12 +169,13 @@ pub fn run(o: &SimulateOptions<'_>) -> Result<()> {
         eprintln!("note: the detector is not fully depleted at any listed voltage");
     }
     let pinch_off_v = curve_pinch_off_voltage(&det, &curve, &settings)?;
+    let depletion_err_v = curve_depletion_voltage(&det, &curve, &settings)?.map(|e| e.err_v);
     let seconds = start.elapsed().as_secs_f64();
     // The CSV under its name only once every figure is drawn too.
     let mut staged = hpge_files::Staged::new();
     if let Some(path) = o.out {
         staged
-            .write_with(path, |f| write_csv(f, &curve, pinch_off_v))
+            .write_with(path, |f| write_csv(f, &curve, depletion_err_v, pinch_off_v))
             .with_context(|| format!("--out {}: cannot write the file", path.display()))?;
     }
     if let Some(path) = o.plot {
@@ -203,7 +206,7 @@ pub fn run(o: &SimulateOptions<'_>) -> Result<()> {
                 "adaptive": settings.grid.adaptive,
                 "fully_depleted": curve.points.iter().map(|p| p.fully_depleted).collect::<Vec<_>>(),
                 "depletion_voltage_V": curve.depletion_voltage_v,
-                "depletion_voltage_err_V": finite_or_null(curve.depletion_voltage_err_v),
+                "depletion_voltage_err_V": finite_or_null(depletion_err_v),
                 "pinch_off_voltage_V": pinch_off_v.map(|e| e.voltage_v),
                 "pinch_off_voltage_err_V": finite_or_null(pinch_off_v.map(|e| e.err_v)),
                 "pockets": curve.points.iter().map(|p| p.pockets.iter().map(|k| json!({
@@ -269,7 +272,7 @@ pub fn run(o: &SimulateOptions<'_>) -> Result<()> {
         match curve.depletion_voltage_v {
             Some(v) => outln!(
                 "full-depletion voltage {v:.1} +- {} V",
-                plus_minus(curve.depletion_voltage_err_v.unwrap_or(f64::INFINITY))
+                plus_minus(depletion_err_v.unwrap_or(f64::INFINITY))
             ),
             None => outln!("not fully depleted at any listed bias"),
         }
@@ -322,6 +325,7 @@ pub(super) fn backend_json(settings: &FieldSettings) -> Result<serde_json::Value
 fn write_csv(
     f: &mut impl Write,
     curve: &CvCurve,
+    depletion_err_v: Option<f64>,
     pinch_off: Option<VoltageEstimate>,
 ) -> std::io::Result<()> {
     writeln!(
@@ -331,7 +335,7 @@ fn write_csv(
     let cell = |x: Option<f64>| x.map_or(String::new(), |v| v.to_string());
     let tail = [
         cell(curve.depletion_voltage_v),
-        cell(curve.depletion_voltage_err_v),
+        cell(depletion_err_v),
         cell(pinch_off.map(|e| e.voltage_v)),
         cell(pinch_off.map(|e| e.err_v)),
     ]

@@ -3,7 +3,7 @@
 //! The error bars against grids with every interval divided into 4 on every shipped type:
 //! `cargo run --release -p hpge-validation --example depletion_error` (reports/accuracy/).
 
-use hpge_solver::field::{Seed, curve_pinch_off_voltage, cv_curve};
+use hpge_solver::field::{Seed, curve_depletion_voltage, curve_pinch_off_voltage, cv_curve};
 use hpge_solver::{Detector, FieldSettings, Parameters, solve_point};
 use hpge_validation::{LongCoax, repo_path};
 
@@ -65,7 +65,10 @@ fn the_full_depletion_voltage_error_bar_bounds_the_closed_form() {
         let curve = cv_curve(&det, &volts, &FieldSettings::default(), |_, _| {}).unwrap();
         let (u, err) = (
             curve.depletion_voltage_v.unwrap(),
-            curve.depletion_voltage_err_v.unwrap(),
+            curve_depletion_voltage(&det, &curve, &FieldSettings::default())
+                .unwrap()
+                .unwrap()
+                .err_v,
         );
         eprintln!("{volts:?}: U_fd {u:.2} +- {err:.2} V, closed form {want:.2} V");
         assert!((u - want).abs() <= err, "{u} +- {err} vs {want}");
@@ -74,7 +77,10 @@ fn the_full_depletion_voltage_error_bar_bounds_the_closed_form() {
     // The planar p-n wafer depletes uniformly in one dimension: every grid agrees.
     let det = detector("detectors/planar-pn.toml");
     let curve = cv_curve(&det, &[100.0, 1000.0], &FieldSettings::default(), |_, _| {}).unwrap();
-    let err = curve.depletion_voltage_err_v.unwrap();
+    let err = curve_depletion_voltage(&det, &curve, &FieldSettings::default())
+        .unwrap()
+        .unwrap()
+        .err_v;
     assert!(err < 1e-4 * curve.depletion_voltage_v.unwrap(), "{err}");
 }
 

@@ -3,7 +3,7 @@
 use serde::Serialize;
 
 use super::depleted;
-use super::full_depletion::full_depletion_voltage_estimate;
+use super::full_depletion::full_depletion_on_grid;
 use super::pockets::Pocket;
 use super::point::{Seed, pair, solve_point_with};
 use super::settings::FieldSettings;
@@ -48,14 +48,10 @@ pub struct CvCurve {
     /// Full-depletion voltage (V): the lowest bias at which no semiconductor is undepleted,
     /// from the unconstrained potential on the fully depleted reference's grid (`field::depleted`:
     /// the grid of every fully depleted point, the same for any voltage list), searched from
-    /// the last listed bias that is not fully depleted (or 0 V) and the first that is
-    /// ([`super::full_depletion_voltage_estimate`]); None when no listed bias depletes the
-    /// detector.
+    /// the last listed bias that is not fully depleted (or 0 V) and the first that is; None when
+    /// no listed bias depletes the detector. Its error bar:
+    /// [`super::curve_depletion_voltage`].
     pub depletion_voltage_v: Option<f64>,
-    /// Estimated error of `depletion_voltage_v`, V: the larger difference to the same search on
-    /// the grid's two complementary coarsenings plus the bisection's width (`field::threshold`;
-    /// infinite where a coarsening does not deplete near it).
-    pub depletion_voltage_err_v: Option<f64>,
 }
 
 /// Checks a voltage list: every value finite and positive; returns it sorted and deduplicated.
@@ -188,19 +184,21 @@ pub(crate) fn curve_keeping(
     }
     // U_fd on the fully depleted reference's grid, which every fully depleted point uses: the
     // listed points only bracket the search.
-    let estimate = match points.iter().position(|p| p.fully_depleted) {
+    let depletion_voltage_v = match points.iter().position(|p| p.fully_depleted) {
         Some(k) => {
-            let lo = if k > 0 { points[k - 1].voltage_v } else { 0.0 };
+            let (lo, hi) = (
+                if k > 0 { points[k - 1].voltage_v } else { 0.0 },
+                points[k].voltage_v,
+            );
             let grid = &depleted::reference(det, settings, pair(det)?)?.grid;
-            full_depletion_voltage_estimate(det, grid, lo, points[k].voltage_v)?
+            full_depletion_on_grid(det, grid, (lo, hi), 4.0 * hi)?.map(|(u, _)| u)
         }
         None => None,
     };
     Ok((
         CvCurve {
             points,
-            depletion_voltage_v: estimate.map(|e| e.voltage_v),
-            depletion_voltage_err_v: estimate.map(|e| e.err_v),
+            depletion_voltage_v,
         },
         kept,
     ))

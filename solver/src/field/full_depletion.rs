@@ -26,7 +26,9 @@ use super::depletion::potential_dofs;
 use super::mesh::{Mesh, NodeKind};
 use super::pockets::{CARRIERS, deepest_depression_v};
 use super::system::{Dof, System};
-use super::threshold::{VoltageEstimate, bisect_threshold, threshold_with_error};
+use super::threshold::{
+    VoltageEstimate, bisect_threshold, error_of_threshold, threshold_with_error,
+};
 use crate::detector::Detector;
 use crate::error::Result;
 use crate::grid::Grid;
@@ -177,6 +179,22 @@ pub fn full_depletion_voltage(mesh: &Mesh, det: &Detector, lo_v: f64, hi_v: f64)
     Ok(hi)
 }
 
+/// U_fd (V) on `grid` alone and the bisection's width: searched from [lo_v, hi_v], widened
+/// where the mesh puts U_fd outside it (never above `ceiling_v`); None when the detector is not
+/// fully depleted on `grid` up to the ceiling. Two linear solves, then flood fills.
+pub(crate) fn full_depletion_on_grid(
+    det: &Detector,
+    grid: &Grid,
+    bracket: (f64, f64),
+    ceiling_v: f64,
+) -> Result<Option<(f64, f64)>> {
+    let mesh = Mesh::new(det, grid.clone());
+    let a = affine(&mesh, det)?;
+    bisect_threshold(bracket, (0.0, ceiling_v), RELATIVE_TOLERANCE, |u| {
+        Ok(a.depleted(&mesh, u))
+    })
+}
+
 /// The full-depletion voltage U_fd (V) on `grid` with its error bar (`field::threshold`): the
 /// lowest bias at which the detector is fully depleted on that grid's mesh (see the module
 /// docs), searched from the bracket [lo_v, hi_v] (widened where the mesh puts U_fd outside it,
@@ -192,13 +210,31 @@ pub fn full_depletion_voltage_estimate(
     lo_v: f64,
     hi_v: f64,
 ) -> Result<Option<VoltageEstimate>> {
-    let ceiling = 4.0 * hi_v;
     let ticks = det.ticks();
     threshold_with_error(grid, (&ticks.0, &ticks.1), (lo_v, hi_v), |g, bracket| {
-        let mesh = Mesh::new(det, g.clone());
-        let a = affine(&mesh, det)?;
-        bisect_threshold(bracket, (0.0, ceiling), RELATIVE_TOLERANCE, |u| {
-            Ok(a.depleted(&mesh, u))
-        })
+        full_depletion_on_grid(det, g, bracket, 4.0 * hi_v)
     })
+}
+
+/// The error bar of a C-V curve's full-depletion voltage (V), as [`full_depletion_voltage_estimate`]
+/// gives it, for the value the curve already holds (`CvCurve::depletion_voltage_v`, found on the
+/// fully depleted reference's grid): only the two coarsenings are searched. Asked for where the
+/// value is reported (`hpge-cv simulate`), not part of every [`super::cv_curve`] (the training
+/// rows and the fits' exact solves do not need it: it triples the linear solves). None when the
+/// curve has no full-depletion voltage.
+pub fn curve_depletion_voltage(
+    det: &Detector,
+    curve: &super::curve::CvCurve,
+    settings: &super::settings::FieldSettings,
+) -> Result<Option<VoltageEstimate>> {
+    let Some(u) = curve.depletion_voltage_v else {
+        return Ok(None);
+    };
+    let grid = &super::depleted::reference(det, settings, super::point::pair(det)?)?.grid;
+    let ticks = det.ticks();
+    let width = RELATIVE_TOLERANCE * u.abs().max(1.0);
+    let e = error_of_threshold(grid, (&ticks.0, &ticks.1), (u, width), |g, bracket| {
+        full_depletion_on_grid(det, g, bracket, 4.0 * u)
+    })?;
+    Ok(Some(e))
 }

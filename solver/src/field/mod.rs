@@ -44,7 +44,9 @@ pub use convergence::{ConvergenceRow, convergence_study};
 pub use curve::{Continuation, CvCurve, CvPoint, cv_curve, cv_curve_with, normalise_voltages};
 pub use depleted::{CARRY_POWER, Carried, carried_weight};
 pub use depletion::{MAX_POCKET_ROUNDS, PotentialSolution, solve_fast, solve_fast_with};
-pub use full_depletion::{full_depletion_voltage, full_depletion_voltage_estimate};
+pub use full_depletion::{
+    curve_depletion_voltage, full_depletion_voltage, full_depletion_voltage_estimate,
+};
 pub use mesh::{Mesh, NodeKind};
 pub use near::{NearCurves, NearEach, NearSeeding, SeedChain, cv_curves_near, cv_curves_near_each};
 pub use pinch_off::{curve_pinch_off_voltage, pinch_off_voltage, pinch_off_voltage_estimate};

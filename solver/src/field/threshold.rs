@@ -92,37 +92,70 @@ pub(crate) fn bisect_threshold(
 /// threshold near the bracket.
 pub(crate) fn threshold_with_error(
     grid: &Grid,
-    (keep_r, keep_z): (&[f64], &[f64]),
+    keep: (&[f64], &[f64]),
     bracket: (f64, f64),
     mut threshold: impl FnMut(&Grid, (f64, f64)) -> Result<Option<(f64, f64)>>,
 ) -> Result<Option<VoltageEstimate>> {
-    let around = |u: f64, share: f64| {
-        let d = share * u.abs().max(1.0);
-        ((u - d).max(0.0), u + d)
-    };
-    let first = match grid.coarsened_phase(keep_r, keep_z, 0) {
-        Some(h) => threshold(&h, bracket)?,
+    let h0 = grid.coarsened_phase(keep.0, keep.1, 0);
+    let first = match &h0 {
+        Some(h) => threshold(h, bracket)?,
         None => None,
     };
     let start = first.map_or(bracket, |(u0, _)| around(u0, 0.005));
     let Some((u, width)) = threshold(grid, start)? else {
         return Ok(None);
     };
-    let differs = |found: Option<(f64, f64)>| match found {
-        Some((uh, w)) => (u - uh).abs() + w,
-        None => f64::INFINITY,
-    };
-    let mut err = match grid.coarsened_phase(keep_r, keep_z, 0) {
-        Some(_) => differs(first),
-        None => 0.0,
-    };
-    if let Some(h) = grid.coarsened_phase(keep_r, keep_z, 1) {
-        err = err.max(differs(threshold(&h, around(u, 0.01))?));
-    }
+    let err0 = h0.map_or(0.0, |_| difference(u, first));
+    let err1 = coarse_difference(grid, keep, 1, u, &mut threshold)?;
     Ok(Some(VoltageEstimate {
         voltage_v: u,
-        err_v: err + width,
+        err_v: err0.max(err1) + width,
     }))
+}
+
+/// The error bar of a threshold `u` already found on `grid` (to within `width`): the larger
+/// difference to the same search on the grid's two coarsenings, each started 1% around `u`,
+/// plus `width`.
+pub(crate) fn error_of_threshold(
+    grid: &Grid,
+    keep: (&[f64], &[f64]),
+    (u, width): (f64, f64),
+    mut threshold: impl FnMut(&Grid, (f64, f64)) -> Result<Option<(f64, f64)>>,
+) -> Result<VoltageEstimate> {
+    let mut err = 0.0f64;
+    for phase in 0..2 {
+        err = err.max(coarse_difference(grid, keep, phase, u, &mut threshold)?);
+    }
+    Ok(VoltageEstimate {
+        voltage_v: u,
+        err_v: err + width,
+    })
+}
+
+/// A bracket of `share` (relative) on each side of `u`, never below 0.
+fn around(u: f64, share: f64) -> (f64, f64) {
+    let d = share * u.abs().max(1.0);
+    ((u - d).max(0.0), u + d)
+}
+
+/// |u - the coarse grid's threshold| plus that search's width; infinite where it found none.
+fn difference(u: f64, found: Option<(f64, f64)>) -> f64 {
+    found.map_or(f64::INFINITY, |(uh, w)| (u - uh).abs() + w)
+}
+
+/// [`difference`] on the coarsening `phase` of `grid`, searched 1% around `u` (0 where the
+/// grid has no such coarsening).
+fn coarse_difference(
+    grid: &Grid,
+    (keep_r, keep_z): (&[f64], &[f64]),
+    phase: usize,
+    u: f64,
+    threshold: &mut impl FnMut(&Grid, (f64, f64)) -> Result<Option<(f64, f64)>>,
+) -> Result<f64> {
+    Ok(match grid.coarsened_phase(keep_r, keep_z, phase) {
+        Some(h) => difference(u, threshold(&h, around(u, 0.01))?),
+        None => 0.0,
+    })
 }
 
 #[cfg(test)]
