@@ -11,7 +11,8 @@
 //! posterior), [`sampler`] (adaptive Metropolis and NUTS), [`diagnostics`] (R-hat, ESS),
 //! [`summary`] (intervals, modes, Pareto-smoothed importance sampling), [`mod@fit`] (a whole fit,
 //! its predictive and the exact-solver check), [`mod@discover`] (model discovery) and [`numerics`]
-//! (the small dense linear algebra and optimiser they share).
+//! (the small dense linear algebra and optimiser they share); [`depletion`] fits an impurity
+//! scale factor to a measured depletion voltage (`hpge-cv depletion`).
 //!
 //! A model error at one point (a failed solve, a point outside the model's domain;
 //! [`Error::is_recoverable`]) is a rejected proposal of zero posterior density; any other error
@@ -84,6 +85,7 @@
 //! ```
 
 #![warn(missing_docs)]
+pub mod depletion;
 pub mod diagnostics;
 pub mod discover;
 mod error;

@@ -12,6 +12,7 @@ use pyo3::create_exception;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
+mod depletion;
 mod detector;
 mod fit;
 mod legend;
@@ -56,6 +57,8 @@ fn hpge_cv(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<detector::PyDetector>()?;
     m.add_function(wrap_pyfunction!(solve::simulate, m)?)?;
     m.add_function(wrap_pyfunction!(solve::capacitance, m)?)?;
+    m.add_function(wrap_pyfunction!(depletion::depletion_voltages, m)?)?;
+    m.add_function(wrap_pyfunction!(depletion::depletion_records, m)?)?;
     m.add_function(wrap_pyfunction!(solve::pulse, m)?)?;
     m.add_function(wrap_pyfunction!(solve::field, m)?)?;
     m.add_function(wrap_pyfunction!(surrogate::predict, m)?)?;

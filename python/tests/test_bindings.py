@@ -222,3 +222,23 @@ def test_discover_equals_the_command_line(cli_json, tmp_path):
     )
     assert got["candidates"] and got["settings"]["fit"]["sample"]["max_seconds"] == 1e9
     assert _without_seconds(got) == _without_seconds(ref)
+
+
+def test_depletion_equals_the_command_line(cli_json):
+    # Issue 64: U_fd with its error bar and the impurity scale factor given a measured depletion
+    # voltage, as `hpge-cv depletion --json`; the coax has no pocket, so no pinch-off.
+    det = hpge_cv.Detector(COAX)
+    got = hpge_cv.depletion(det, measured=(3800.0, 50.0), curve=False)
+    ref = cli_json("depletion", "--detector", COAX, "--measured", "3800+-50", "--json")
+    assert got["depletion_voltage_V"] == pytest.approx(ref["depletion_voltage_V"], rel=1e-12)
+    assert got["depletion_voltage_err_V"] == pytest.approx(ref["depletion_voltage_err_V"], rel=1e-12)
+    assert got["pinch_off_voltage_V"] is None
+    f = got["factor"]
+    assert f["median"] == pytest.approx(ref["factor"]["median"], rel=1e-9)
+    # U_fd is proportional to the density's scale: the median is the ratio of the voltages.
+    assert f["median"] == pytest.approx(3800.0 / got["depletion_voltage_V"], rel=0.01)
+    assert f["interval_68"][0] < f["median"] < f["interval_68"][1]
+    table = got["factor_table"]
+    assert len(table["f"]) == len(table["density"]) > 1000
+    with pytest.raises(Exception, match="measured"):
+        hpge_cv.depletion(det, measured=(-1.0, 10.0))

@@ -2,6 +2,7 @@
 
 mod args;
 mod convergence;
+mod depletion;
 mod detector;
 mod discover;
 #[cfg(test)]
@@ -51,6 +52,10 @@ enum Command {
     Simulate(SimulateArgs),
     /// The full Maxwell capacitance matrix at one bias.
     Capacitance(CapacitanceArgs),
+    /// Full-depletion and pinch-off voltages with error bars; with a measured depletion voltage,
+    /// the posterior of an impurity scale factor; with --records, a folder of LEGEND diode
+    /// records into one table.
+    Depletion(Box<depletion::DepletionArgs>),
     /// Grid convergence of c12 at one bias: fixed grids from coarse to fine, each with its error
     /// estimate, beside the adaptive answer at the tolerance.
     Convergence(convergence::ConvergenceArgs),
@@ -426,6 +431,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Report(a) => crate::report::run(&a),
         Command::Pulse(a) => pulse::run(&a),
         Command::Convergence(a) => convergence::run(&a),
+        Command::Depletion(a) => depletion::run(&a),
         Command::Field(a) => field::run(&a),
         Command::PaperSection9(o) => {
             for f in hpge_reports::paper::section9_compute::section9(

@@ -45,4 +45,18 @@ impl Detector {
     pub fn set_impurity(&mut self, spec: &ImpuritySpec, file: &Path) -> Result<()> {
         build::set_impurity(self, spec, file)
     }
+
+    /// The detector with its impurity density multiplied by `factor` everywhere (the model's
+    /// `scale` key times `factor`): zeta'(r, z) = factor * zeta(r, z).
+    ///
+    /// # Errors
+    /// A factor that is not positive and finite ([`Error::Invalid`] naming `scale`).
+    pub fn with_impurity_scale(&self, factor: f64) -> Result<Self> {
+        let mut spec = self.semiconductor.impurity_spec().clone();
+        spec.scale = Some(spec.scale.unwrap_or(1.0) * factor);
+        let file = self.semiconductor.impurity_file().to_path_buf();
+        let mut det = self.clone();
+        det.set_impurity(&spec, &file)?;
+        Ok(det)
+    }
 }

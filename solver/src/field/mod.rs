@@ -26,6 +26,7 @@ mod space_charge;
 mod system;
 mod threshold;
 mod union_find;
+mod voltages;
 mod weighting;
 
 /// Names the solver's physics: changed whenever a change of the solver moves computed numbers
@@ -34,8 +35,12 @@ mod weighting;
 /// 2026-11-29, the space charge integrated over each control volume (`field::space_charge`;
 /// before it, zeta at the node times the node's volume: files of that solver carry no name);
 /// 2026-12-06, the fully depleted reference carried over to every undepleted point's grid
-/// (`field::depleted`: no step in c12 at full depletion).
-pub const PHYSICS_REVISION: &str = "2026-12-06 depleted reference";
+/// (`field::depleted`: no step in c12 at full depletion); 2026-12-06, depressions on one grid
+/// line of the crystal's surface no longer tied or counted as pockets (`pockets::resolution`,
+/// issue 64: of 120 rows of the uniform-900000 training run solved again, 116 identical, 3
+/// within 1e-15 and one 1.9e-5 relative apart; every c12 of `reports/accuracy/detector-sweep.md`
+/// and every U_fd of `reports/accuracy/depletion-table.md` unchanged).
+pub const PHYSICS_REVISION: &str = "2026-12-06 surface line depressions";
 
 pub use adaptive::Accuracy;
 pub use capacitance::CapacitanceMatrix;
@@ -50,7 +55,9 @@ pub use full_depletion::{
 pub use mesh::{Mesh, NodeKind};
 pub use near::{NearCurves, NearEach, NearSeeding, SeedChain, cv_curves_near, cv_curves_near_each};
 pub use pinch_off::{curve_pinch_off_voltage, pinch_off_voltage, pinch_off_voltage_estimate};
-pub use pockets::{Pocket, deepest_depression_v, deepest_empty_depression_v, find_pockets};
+pub use pockets::{
+    Depression, Pocket, deepest_depression_v, deepest_empty_depression_v, depressions, find_pockets,
+};
 pub use point::{
     PointResult, PotentialPoint, Seed, solve_point, solve_point_on_grid, solve_potential,
 };
@@ -60,6 +67,9 @@ pub use sor::{
     SorSettings, solve_sor, solve_sor_wgpu, solve_sor_wgpu_with, weighting_potentials_wgpu,
 };
 pub use threshold::VoltageEstimate;
+pub use voltages::{
+    CEILING_V, DepletionVoltages, POCKET_SCAN, depletion_voltages, scales_with_density,
+};
 pub use weighting::{
     PAPER_EPSILON_FACTOR, WeightingMode, WeightingPotentials, weighting_potentials,
 };

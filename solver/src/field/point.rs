@@ -46,7 +46,6 @@ pub struct PointResult {
 }
 
 impl PointResult {
-    /// True when no semiconductor node is undepleted.
     /// True when no semiconductor is undepleted: no undepleted node and no sub-cell layer in
     /// front of a contact.
     pub fn fully_depleted(&self) -> bool {

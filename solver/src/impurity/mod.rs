@@ -15,7 +15,9 @@ mod spec;
 mod spline;
 mod transform;
 
-pub use model::{ConstantModel, ImpurityModel, LinearZModel, PointDensity, ZTableModel};
+pub use model::{
+    ConstantModel, ImpurityModel, LinearZModel, PointDensity, ScaledModel, ZTableModel,
+};
 pub use rz::RzModel;
 pub use spec::{ImpurityContext, ImpuritySpec, ModelKind};
 pub use spline::ClampedNaturalSpline;

@@ -224,3 +224,25 @@ mod tests {
         assert_eq!(models[1].density_cm3(0.0, 0.5), 1.5);
     }
 }
+
+/// Another model's density times a positive factor (the `scale` key of any model):
+/// zeta(r, z) = factor * zeta_inner(r, z); y and x are not defined for the product.
+#[derive(Debug)]
+pub struct ScaledModel {
+    /// The model scaled.
+    pub inner: Box<dyn ImpurityModel>,
+    /// The factor (positive).
+    pub factor: f64,
+}
+
+impl ImpurityModel for ScaledModel {
+    fn name(&self) -> &'static str {
+        self.inner.name()
+    }
+    fn density_cm3(&self, r_mm: f64, z_mm: f64) -> f64 {
+        self.factor * self.inner.density_cm3(r_mm, z_mm)
+    }
+    fn knots_r_mm(&self) -> Vec<f64> {
+        self.inner.knots_r_mm()
+    }
+}

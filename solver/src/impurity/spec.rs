@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use super::model::{ConstantModel, ImpurityModel, LinearZModel, ZTableModel};
+use super::model::{ConstantModel, ImpurityModel, LinearZModel, ScaledModel, ZTableModel};
 use super::rz::RzModel;
 use super::transform::LogTransform;
 use crate::error::{Error, Result};
@@ -94,6 +94,11 @@ pub struct ImpuritySpec {
     /// `z-table`: the signed density (cm^-3) at each of `z_mm`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub values_cm3: Option<Vec<f64>>,
+    /// Any model: a positive factor multiplying its density everywhere (default 1), the impurity
+    /// scale factor LEGEND's workflow matches to a measured depletion voltage (`hpge-cv
+    /// depletion`, issue 64).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub scale: Option<f64>,
 }
 
 /// What a model needs from the detector: the crystal's z range and default knots.
@@ -168,6 +173,26 @@ impl ImpuritySpec {
             prefix: key_prefix,
         };
         self.check_foreign_keys(keys)?;
+        let model = self.build_unscaled(ctx, keys)?;
+        match self.scale {
+            None => Ok(model),
+            Some(f) if f.is_finite() && f > 0.0 => Ok(Box::new(ScaledModel {
+                inner: model,
+                factor: f,
+            })),
+            Some(f) => Err(keys.err(
+                "scale",
+                format!("must be a positive finite factor, got {f}"),
+            )),
+        }
+    }
+
+    /// [`Self::build`] without the scale factor.
+    fn build_unscaled(
+        &self,
+        ctx: &ImpurityContext,
+        keys: Keys<'_>,
+    ) -> Result<Box<dyn ImpurityModel>> {
         let model_key = "model";
         match self.model {
             ModelKind::Constant => {

@@ -136,16 +136,41 @@ pub fn read_json(text: &str, file: &Path, o: &LegendOptions) -> Result<LegendDio
     diode(&v, file, o)
 }
 
-/// Reads a record file.
+/// Reads and converts a record in YAML (legend-metadata's current layout, e.g. legend-testdata's
+/// `data/legend/.../diodes/V99000A.yaml`) to a [`LegendDiode`]: the same keys as the JSON
+/// records.
 ///
 /// # Errors
-/// As [`convert_json`], and a file that cannot be read.
+/// Malformed YAML, and as [`convert_json`].
+pub fn read_yaml(text: &str, file: &Path, o: &LegendOptions) -> Result<LegendDiode> {
+    let v: Value = yaml_serde::from_str(text).map_err(|e| Error::Parse {
+        file: file.to_path_buf(),
+        message: format!("not a YAML diode record: {e}"),
+    })?;
+    diode(&v, file, o)
+}
+
+/// Reads a record file: YAML where the name ends in `.yaml` or `.yml`, JSON otherwise.
+///
+/// # Errors
+/// As [`convert_json`] and [`read_yaml`], and a file that cannot be read.
 pub fn read_file(path: &Path, o: &LegendOptions) -> Result<LegendDiode> {
     let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
         file: PathBuf::from(path),
         source,
     })?;
-    read_json(&text, path, o)
+    if is_yaml(path) {
+        read_yaml(&text, path, o)
+    } else {
+        read_json(&text, path, o)
+    }
+}
+
+/// True for a file name ending in `.yaml` or `.yml` (any case).
+pub fn is_yaml(path: &Path) -> bool {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("yaml") || e.eq_ignore_ascii_case("yml"))
 }
 
 fn check_options(o: &LegendOptions) -> Result<()> {

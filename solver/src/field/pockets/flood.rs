@@ -174,27 +174,20 @@ pub(crate) fn flood(
 
 /// The deepest depression of `side`'s landscape among nodes whose fixed charge has the sign of
 /// that carrier's material (p-type for holes, n-type for electrons), V: max over those nodes of
-/// |F(n) - phi_n|, 0 when there is none. A potential with depletion and pockets solved right has
-/// none deeper than round-off: every trapped-carrier pocket is flat at its spill level.
-/// Independent of the solvers (used by tests and reports as a check).
+/// |F(n) - phi_n|, 0 when there is none, with the deepest node. Depressions the grid does not
+/// resolve (on one grid line of the surface, `resolution.rs`) do not count. A potential with depletion and
+/// pockets solved right has none deeper than round-off: every trapped-carrier pocket is flat at
+/// its spill level. Independent of the solvers (used by tests and reports as a check).
 pub fn deepest_depression_v(
     mesh: &Mesh,
     phi_v: &[f64],
     side: Carrier,
     bounds_v: (f64, f64),
 ) -> (f64, Option<usize>) {
-    let f = flood(mesh, phi_v, side, bounds_v, None, 0.0);
-    let mut best = (0.0, None);
-    for (n, (&fill, &phi)) in f.fill_v.iter().zip(phi_v).enumerate() {
-        if !super::holds(side, mesh.charge_c[n]) || !fill.is_finite() {
-            continue;
-        }
-        let d = (fill - phi).abs();
-        if d > best.0 {
-            best = (d, Some(n));
-        }
-    }
-    best
+    super::depressions(mesh, phi_v, side, bounds_v)
+        .into_iter()
+        .find(|d| d.resolved)
+        .map_or((0.0, None), |d| (d.depth_v, Some(d.deepest_node)))
 }
 
 /// The deepest *empty well* of `side`'s carriers, V: a depleted node (`undepleted[n]` false) of
@@ -202,8 +195,8 @@ pub fn deepest_depression_v(
 /// drain) that the carriers of an undepleted region can flow into. For holes, those of an
 /// undepleted p-type node s at phi_s reach every node joined to s by a conducting path on which
 /// phi <= phi_s; with W(n) the highest such phi_s, the basin at n fills to min(F(n), W(n)), and
-/// the well's depth is min(F(n), W(n)) - phi_n (electrons: mirrored). None may remain in any
-/// solution. It differs
+/// the well's depth is min(F(n), W(n)) - phi_n (electrons: mirrored). Wells in depressions the
+/// grid does not resolve (`resolution.rs`) do not count. None may remain in any solution. It differs
 /// from [`deepest_depression_v`] only where a basin is not filled to its brim: where a hole pocket
 /// and an electron pocket touch (a p-n junction inside the crystal) the junction may sit reverse
 /// biased, the n side above the p side, and each pocket holds its carriers below the barrier the
@@ -249,9 +242,14 @@ pub fn deepest_empty_depression_v(
             }
         }
     }
-    let fill = flood(mesh, phi_v, side, bounds_v, None, 0.0).fill_v;
+    let f = flood(mesh, phi_v, side, bounds_v, None, 0.0);
+    let lines = super::line_depressions(mesh, side, &f.pour);
+    let fill = f.fill_v;
     let mut best = (0.0, None);
     for n in (0..phi_v.len()).filter(|&n| holds(n) && !undepleted[n]) {
+        if f.pour[n].is_some_and(|s| lines.contains(&s)) {
+            continue;
+        }
         let d = level[n].min(sign * fill[n]) - v(n);
         if d > best.0 {
             best = (d, Some(n));

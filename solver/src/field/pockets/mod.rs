@@ -29,8 +29,12 @@ use crate::carrier::Carrier;
 use crate::field::mesh::{Mesh, NodeKind};
 use crate::field::union_find::UnionFind;
 
+mod resolution;
+
 pub(crate) use flood::flood;
 pub use flood::{deepest_depression_v, deepest_empty_depression_v};
+pub(crate) use resolution::line_depressions;
+pub use resolution::{Depression, depressions};
 
 /// True when a node with fixed charge `charge_c` (C) is of the material whose majority carriers
 /// are `carrier`: p-type (negative fixed charge) for holes, n-type for electrons.
@@ -80,6 +84,8 @@ pub(crate) type Ties = Vec<Option<Tie>>;
 /// The ties for the potential `phi_v`: every node of a carrier's material inside that carrier's
 /// depression is tied to its pour point. `occupied` marks the nodes that held trapped carriers in
 /// the solve that produced `phi_v` (so that a pocket at its spill level keeps its tie).
+/// A depression confined to one grid line on the crystal's surface is not tied
+/// (`resolution.rs`: the grid does not resolve it, and it vanishes on a finer one; issue 64).
 pub(crate) fn ties(
     mesh: &Mesh,
     phi_v: &[f64],
@@ -94,9 +100,11 @@ pub(crate) fn ties(
         }
         let f = flood(mesh, phi_v, side, bounds_v, Some(occupied), tol_v);
         let pour = merge_touching(mesh, phi_v, side, occupied, &f.pour);
+        let lines = line_depressions(mesh, side, &pour);
         for (n, p) in pour.iter().enumerate() {
             if let Some(s) = p
                 && holds(side, mesh.charge_c[n])
+                && !lines.contains(s)
                 && out[n].is_none()
             {
                 out[n] = Some(Tie { saddle: *s, side });

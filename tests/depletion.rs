@@ -1,0 +1,262 @@
+//! `hpge-cv depletion` as a user runs it (issue 64, item 5): one detector, one LEGEND record
+//! with its measured voltage, a folder of records (JSON and YAML) into one resumable table, and
+//! bad input. At a 1% tolerance without the pinch-off search where the pinch-off is not tested,
+//! so the whole file takes seconds.
+
+use std::path::PathBuf;
+use std::process::Command;
+
+fn hpge_cv(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_hpge-cv"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("hpge-cv-depletion-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn json(out: &std::process::Output) -> serde_json::Value {
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+#[test]
+fn a_detector_gives_both_voltages_with_error_bars() {
+    let v = json(&hpge_cv(&[
+        "depletion",
+        "--detector",
+        "detectors/icpc-example.toml",
+        "--tolerance",
+        "0.01",
+        "--json",
+    ]));
+    let (u, e) = (
+        v["depletion_voltage_V"].as_f64().unwrap(),
+        v["depletion_voltage_err_V"].as_f64().unwrap(),
+    );
+    // reports/accuracy/depletion-table.md at the defaults: 2079.5 +- 16.9 V, pinch-off
+    // 1439.2 +- 6.3 V; at 1% the reference grid is coarser.
+    assert!((u - 2079.5).abs() < 60.0 && e > 0.0 && e < 100.0, "{v}");
+    let p = v["pinch_off_voltage_V"].as_f64().unwrap();
+    assert!((p - 1439.2).abs() < 40.0, "{v}");
+    assert!(v["pinch_off_voltage_err_V"].as_f64().unwrap() > 0.0);
+    assert!(v["factor"].is_null() && v["version"].is_string(), "{v}");
+}
+
+#[test]
+fn a_record_with_a_measurement_gives_the_factor_and_the_curve() {
+    let dir = temp_dir("record");
+    let csv = dir.join("cv.csv");
+    let plot = dir.join("factor.svg");
+    let v = json(&hpge_cv(&[
+        "depletion",
+        "--record",
+        "validation/references/legend-testdata/yaml/B99000A.yaml",
+        "--measured",
+        "2500±50",
+        "--no-pinch-off",
+        "--tolerance",
+        "0.01",
+        "--out",
+        csv.to_str().unwrap(),
+        "--plot",
+        plot.to_str().unwrap(),
+        "--json",
+    ]));
+    let u = v["depletion_voltage_V"].as_f64().unwrap();
+    let f = &v["factor"];
+    let median = f["median"].as_f64().unwrap();
+    // U_fd is proportional to the factor: the median is the ratio of the voltages.
+    assert!((median - 2500.0 / u).abs() < 0.02 * median, "{v}");
+    let (lo, hi) = (
+        f["interval_68"][0].as_f64().unwrap(),
+        f["interval_68"][1].as_f64().unwrap(),
+    );
+    assert!(lo < median && median < hi, "{v}");
+    assert_eq!(v["measured"]["sigma_v"], 50.0);
+    let curve = &v["curve_at_median"];
+    assert_eq!(curve["factor"].as_f64().unwrap(), median);
+    let c: Vec<f64> = serde_json::from_value(curve["c12_pf"].clone()).unwrap();
+    assert_eq!(c.len(), 25);
+    // Falls with the bias, flat once depleted.
+    assert!(c[0] > c[24] && c.iter().all(|x| *x > 0.0), "{c:?}");
+    let text = std::fs::read_to_string(&csv).unwrap();
+    assert!(
+        text.starts_with("voltage_V,c12_pF,c12_err_pF,fully_depleted\n"),
+        "{text}"
+    );
+    assert_eq!(text.lines().count(), 26);
+    assert!(std::fs::metadata(&plot).unwrap().len() > 1000);
+}
+
+#[test]
+fn a_folder_of_records_makes_one_resumable_table_in_shards() {
+    let out = temp_dir("records");
+    let o = out.to_str().unwrap();
+    let args = |shard: &'static str| {
+        vec![
+            "depletion",
+            "--records",
+            "validation/references/legend-testdata/yaml",
+            "--no-pinch-off",
+            "--tolerance",
+            "0.01",
+            "--out",
+            o,
+            "--shard",
+            shard,
+            "--json",
+        ]
+    };
+    // Two shards, as two Slurm array tasks: the second run's table holds all four records.
+    let first = json(&hpge_cv(&args("0/2")));
+    assert_eq!(first["records"].as_array().unwrap().len(), 2, "{first}");
+    let second = json(&hpge_cv(&args("1/2")));
+    let rows = second["records"].as_array().unwrap();
+    assert_eq!(rows.len(), 4, "{second}");
+    let names: Vec<&str> = rows.iter().map(|r| r["record"].as_str().unwrap()).collect();
+    assert_eq!(
+        names,
+        [
+            "B99000A.yaml",
+            "C99000A.yaml",
+            "P99000A.yaml",
+            "V99000A.yaml"
+        ]
+    );
+    // Records with a depletion voltage (3000, 3000, 4000 V) get a factor and the gate's flag.
+    for r in rows.iter().filter(|r| r["record"] != "P99000A.yaml") {
+        assert!(r["factor"].as_f64().unwrap() > 0.0, "{r}");
+        assert!(r["exceeds_gate"].is_boolean(), "{r}");
+        assert!(r["depletion_voltage_err_v"].as_f64().unwrap() > 0.0, "{r}");
+    }
+    assert!(
+        rows[2]["note"]
+            .as_str()
+            .unwrap()
+            .contains("no depletion voltage"),
+        "{}",
+        rows[2]
+    );
+    let md = std::fs::read_to_string(out.join("table.md")).unwrap();
+    assert!(md.contains("| V99000A.yaml | V99000A | icpc |"), "{md}");
+    let csv = std::fs::read_to_string(out.join("table.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 5, "{csv}");
+    // Resumed: the rows are read back, not solved again (a row file's mtime is unchanged).
+    let row = out.join("rows/B99000A.yaml.json");
+    let before = std::fs::metadata(&row).unwrap().modified().unwrap();
+    let again = json(&hpge_cv(&args("0/1")));
+    assert_eq!(again["records"], second["records"]);
+    assert_eq!(std::fs::metadata(&row).unwrap().modified().unwrap(), before);
+}
+
+#[test]
+fn the_legend_test_records_folder_skips_what_is_not_a_diode() {
+    // validation/references/legend-testdata/ holds a crystal record (V99000.json) beside the
+    // diode records: a row with its reason, not the end of the run.
+    let v = json(&hpge_cv(&[
+        "depletion",
+        "--records",
+        "validation/references/legend-testdata",
+        "--no-pinch-off",
+        "--tolerance",
+        "0.01",
+        "--json",
+    ]));
+    let rows = v["records"].as_array().unwrap();
+    let crystal = rows.iter().find(|r| r["record"] == "V99000.json").unwrap();
+    assert!(
+        crystal["note"].as_str().unwrap().contains("type"),
+        "{crystal}"
+    );
+    let diode = rows.iter().find(|r| r["record"] == "V99000A.json").unwrap();
+    assert!(
+        diode["depletion_voltage_v"].as_f64().unwrap() > 1000.0,
+        "{diode}"
+    );
+}
+
+#[test]
+fn bad_input_is_a_clear_error() {
+    for (args, needle) in [
+        (vec!["depletion"], "--detector"),
+        (
+            vec![
+                "depletion",
+                "--detector",
+                "detectors/ppc.toml",
+                "--measured",
+                "abc",
+            ],
+            "--measured",
+        ),
+        (
+            vec![
+                "depletion",
+                "--detector",
+                "detectors/ppc.toml",
+                "--measured",
+                "-3000",
+            ],
+            "--measured",
+        ),
+        (
+            vec![
+                "depletion",
+                "--detector",
+                "detectors/ppc.toml",
+                "--factor-range",
+                "2:1",
+            ],
+            "--factor-range",
+        ),
+        (
+            vec![
+                "depletion",
+                "--detector",
+                "detectors/ppc.toml",
+                "--gate",
+                "-1",
+            ],
+            "--gate",
+        ),
+        (
+            vec!["depletion", "--records", "no/such/folder"],
+            "no/such/folder",
+        ),
+        (
+            vec!["depletion", "--records", "detectors/impurities"],
+            "no record file",
+        ),
+        (
+            vec!["depletion", "--record", "detectors/ppc.toml"],
+            "ppc.toml",
+        ),
+        (
+            vec![
+                "depletion",
+                "--detector",
+                "detectors/ppc.toml",
+                "--shard",
+                "1/2",
+            ],
+            "--shard",
+        ),
+    ] {
+        let out = hpge_cv(&args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(needle), "{args:?}: {err}");
+        assert!(!err.contains("panicked"), "{args:?}: {err}");
+    }
+}
