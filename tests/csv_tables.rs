@@ -64,7 +64,19 @@ fn simulate_sensitivity_field_and_pulse_write_plain_tables() {
     ]));
     plain_table(
         &cv,
-        Some(&["voltage_V", "c12_pF", "fully_depleted", "c12_err_pF"]),
+        // Issue 64 added the flags and the depletion voltages with their error bars after the
+        // first four columns (unchanged).
+        Some(&[
+            "voltage_V",
+            "c12_pF",
+            "fully_depleted",
+            "c12_err_pF",
+            "tolerance_reached",
+            "depletion_voltage_V",
+            "depletion_voltage_err_V",
+            "pinch_off_voltage_V",
+            "pinch_off_voltage_err_V",
+        ]),
         2,
     );
     let scan = d.join("scan.csv");

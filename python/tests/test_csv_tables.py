@@ -33,7 +33,9 @@ def test_simulate_field_pulse_tables_load_as_they_are(cli, tmp_path):
 
     cv = tmp_path / "cv.csv"
     ok("simulate", "--detector", COAX, "--voltages", "500,1500", "--out", cv)
-    df, a = check(cv, ["voltage_V", "c12_pF", "fully_depleted", "c12_err_pF"], 2)
+    df, a = check(cv, ["voltage_V", "c12_pF", "fully_depleted", "c12_err_pF",
+                       "tolerance_reached", "depletion_voltage_V", "depletion_voltage_err_V",
+                       "pinch_off_voltage_V", "pinch_off_voltage_err_V"], 2)
     assert np.allclose(a["c12_pF"], df["c12_pF"])
     assert (df["c12_pF"] > 0).all()
 
