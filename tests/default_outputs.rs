@@ -156,6 +156,17 @@ fn every_command_with_its_default_outputs_leaves_the_tracked_files_alone() {
             &[0],
         ),
         (
+            "depletion",
+            vec![
+                "--detector",
+                DETECTOR,
+                "--no-pinch-off",
+                "--tolerance",
+                "0.05",
+            ],
+            &[0],
+        ),
+        (
             "pulse",
             vec![
                 "--detector",

@@ -260,6 +260,13 @@ fn heldout_row_104700_pocket_rounds_end_at_their_limit() {
 /// 19.8 V does (one round holds its levels): 416.764 pF with an estimated error of 7.3%, 6.5% from
 /// 391.35 pF interpolated between 396.037 pF at 19.5 V and 389.323 pF at 20.0 V (`space_point`,
 /// release build, 19.5-21 V).
+///
+/// Since the solver revision "2026-12-06 surface line depressions" (issue 64: depressions on one
+/// grid line of the crystal's surface are not tied) no round of this row cycles at any bias of
+/// 19.5-21 V in steps of 0.1 V (scanned in a release build; c12 387-421 pF with estimated errors
+/// of 3-17%): the pockets that poured into each other included such lines. The test keeps the
+/// accuracy checks; the fixed-level path of `field::round` is exercised by no test now (noted in
+/// issue 64).
 #[test]
 fn training_row_34554_active_set_cycle_holds_the_levels() {
     let ex = exact();
@@ -277,7 +284,7 @@ fn training_row_34554_active_set_cycle_holds_the_levels() {
     ];
     let p = solve_row(&ex, &x, "training row 34554 at 19.8 V");
     let fixed: usize = p.reports.iter().map(|r| r.fixed_level_rounds).sum();
-    assert!(fixed > 0, "the cycle's path is exercised");
+    eprintln!("rounds with fixed levels: {fixed}");
     assert_no_empty_well(&p, 1e-4 * x[9]);
     let interpolated = 396.037 + (389.323 - 396.037) * (x[9] - 19.5) / (20.0 - 19.5);
     let rel_err = p.accuracy.c12_err_pf / p.c12_pf;
