@@ -3,23 +3,9 @@
 //! bad input. At a 1% tolerance without the pinch-off search where the pinch-off is not tested,
 //! so the whole file takes seconds.
 
-use std::path::PathBuf;
-use std::process::Command;
+mod common;
 
-fn hpge_cv(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_hpge-cv"))
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .args(args)
-        .output()
-        .unwrap()
-}
-
-fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("hpge-cv-depletion-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
+use common::{bad, run as hpge_cv, temp as temp_dir};
 
 fn json(out: &std::process::Output) -> serde_json::Value {
     assert!(
@@ -253,10 +239,6 @@ fn bad_input_is_a_clear_error() {
             "--shard",
         ),
     ] {
-        let out = hpge_cv(&args);
-        let err = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
-        assert!(err.contains(needle), "{args:?}: {err}");
-        assert!(!err.contains("panicked"), "{args:?}: {err}");
+        bad(&hpge_cv(&args), &[needle]);
     }
 }
