@@ -13,7 +13,7 @@ pub mod scale;
 
 use serde::Serialize;
 
-use hpge_solver::field::{DepletionVoltages, VoltageEstimate, depletion_voltages};
+use hpge_solver::field::{DepletionVoltages, depletion_voltages};
 use hpge_solver::{Detector, FieldSettings, cv_curve};
 
 pub use records::{RecordRow, RecordsOptions, run_records};
@@ -86,11 +86,6 @@ pub struct DepletionReport {
 }
 
 impl DepletionReport {
-    /// U_fd with its error bar, if the detector depletes.
-    pub fn full_depletion(&self) -> Option<VoltageEstimate> {
-        self.voltages.full_depletion
-    }
-
     /// The report as `hpge-cv depletion --json` prints it (and Python's `depletion` returns
     /// it): `depletion_voltage_V`, `depletion_voltage_err_V`, `pinch_off_voltage_V`,
     /// `pinch_off_voltage_err_V` (null where there is none or no error bar could be
