@@ -120,20 +120,20 @@ fn a_folder_of_records_makes_one_resumable_table_in_shards() {
             "V99000A.yaml"
         ]
     );
-    // Records with a depletion voltage (3000, 3000, 4000 V) get a factor and the gate's flag.
-    for r in rows.iter().filter(|r| r["record"] != "P99000A.yaml") {
+    // Every record has a depletion voltage (3000, 3000, 3000, 4000 V: P99000A's `l200_site`
+    // value of 0 V is a placeholder, its manufacturer's 3000 V counts) and depletes (P99000A
+    // did not before 2026-12-07): each gets a factor, the gate's flag and the halved grid's check.
+    for r in rows {
         assert!(r["factor"].as_f64().unwrap() > 0.0, "{r}");
         assert!(r["exceeds_gate"].is_boolean(), "{r}");
         assert!(r["depletion_voltage_err_v"].as_f64().unwrap() > 0.0, "{r}");
+        assert!(
+            r["depletion_voltage_halved_v"].as_f64().unwrap() > 0.0,
+            "{r}"
+        );
+        assert!(r["depletion_voltage_converged"].is_boolean(), "{r}");
     }
-    assert!(
-        rows[2]["note"]
-            .as_str()
-            .unwrap()
-            .contains("no depletion voltage"),
-        "{}",
-        rows[2]
-    );
+    assert_eq!(rows[2]["measured_v"].as_f64(), Some(3000.0), "{}", rows[2]);
     let md = std::fs::read_to_string(out.join("table.md")).unwrap();
     assert!(md.contains("| V99000A.yaml | V99000A | icpc |"), "{md}");
     let csv = std::fs::read_to_string(out.join("table.csv")).unwrap();

@@ -56,13 +56,21 @@ def main():
             ref = fine.get(name, {}).get(4) or fine.get(name, {}).get(2)
             cells.append(f"{p['voltage_v']:.2f} +- {p['err_v']:.2f} ({pinch[0]['seconds']:.0f} s)")
             if ref and ref["bracketed"]:
-                pdiff = abs(p["voltage_v"] - ref["pinch_off_V"])
+                # The finer value lies in (lo_V, hi_V]; a bracket wider than the bisection's
+                # 1e-4 (a run given WIDTH_V) is shown as such and its far end is the diff.
+                lo, hi = ref.get("lo_V", ref["pinch_off_V"]), ref["pinch_off_V"]
+                pdiff = max(abs(p["voltage_v"] - lo), abs(p["voltage_v"] - hi))
                 pok = pdiff <= p["err_v"]
                 bounded += pok
                 total += 1
+                value = (
+                    f"{hi:.2f}"
+                    if hi - lo <= 1e-3 * hi
+                    else f"({lo:.2f}, {hi:.2f}]"
+                )
                 cells += [
-                    f"{ref['pinch_off_V']:.2f} ({ref['parts']}x, {ref['nodes']} nodes)",
-                    f"{pdiff:.2f}",
+                    f"{value} ({ref['parts']}x, {ref['nodes']} nodes)",
+                    f"{pdiff:.2f}" if hi - lo <= 1e-3 * hi else f"<= {pdiff:.2f}",
                     "yes" if pok else "**no**",
                 ]
             elif ref:

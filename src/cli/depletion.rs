@@ -206,6 +206,12 @@ fn print_report(det: &Detector, r: &DepletionReport, pinch_searched: bool) -> Re
             hpge_solver::field::CEILING_V
         ),
     }
+    if r.voltages.full_depletion_converged == Some(false) {
+        eprintln!(
+            "warning: {}",
+            hpge_inference::depletion::not_converged(r.voltages.full_depletion_halved_v)
+        );
+    }
     match r.voltages.pinch_off {
         Some(u) => outln!(
             "pinch-off voltage {:.1} ± {:.1} V (a pocket of trapped carriers forms)",

@@ -1,9 +1,12 @@
 //! Issue 64, item 4: only depressions the grid resolves are pockets. LEGEND's test record
 //! V99000A (converted with `detector --from-legend`) has a one-node depression at the convex
 //! corner of its p+ contact's recess; it must not keep the detector "not fully depleted". A
-//! genuine pocket of the same depth order, just past an ICPC's pinch-off, must stay one.
+//! genuine pocket of the same depth order, just past an ICPC's pinch-off, must stay one. And
+//! LEGEND's P99000A, a PPC whose n+ contact runs along a 30 degree taper, must deplete: the
+//! staircase of a slanted contact bends the potential along single grid lines, which read as an
+//! undepleted layer of p-type material at the n+ contact's bound (no such layer can exist).
 
-use hpge_solver::detector::legend::{LegendOptions, convert_json};
+use hpge_solver::detector::legend::{LegendOptions, convert_json, read_file, to_toml};
 use hpge_solver::drift::Carrier;
 use hpge_solver::field::{PotentialPoint, depressions, solve_potential};
 use hpge_solver::{Detector, FieldSettings, Parameters};
@@ -118,4 +121,32 @@ fn a_corner_artefact_is_no_pocket_and_a_genuine_pocket_of_its_depth_is_one() {
             p.potential.pockets
         );
     }
+}
+
+#[test]
+fn a_slanted_n_plus_contact_holds_no_layer_of_p_type_material() {
+    // Before 2026-12-07 P99000A (legend-testdata's PPC, 30 mm x 50 mm, a 30 degree bottom
+    // taper under n+) was "not fully depleted" at every bias up to 100 kV: two contact lines
+    // leaving the taper's staircase along -r had a parabola rising above the bias. At 3000 V
+    // (its data sheet) it is fully depleted, no layer in front of any contact; at 1500 V it is
+    // not, and the undepleted region is p-type bulk (the affine U_fd on the defaults' grid:
+    // 2130 V, `reports/accuracy/legend-records/`).
+    let file = repo_path("validation/references/legend-testdata/yaml/P99000A.yaml");
+    let o = LegendOptions::default();
+    let toml = to_toml(&read_file(&file, &o).unwrap(), &file, &o);
+    let det = Detector::from_toml_str(&toml, &file, &Parameters::new()).unwrap();
+    let s = FieldSettings::default().for_detector(&det);
+    let depleted = hpge_solver::solve_point(&det, 3000.0, &s, None).unwrap();
+    assert!(
+        depleted.fully_depleted() && depleted.contact_layers == 0,
+        "3000 V: undepleted {} layers {}",
+        depleted.undepleted_nodes,
+        depleted.contact_layers
+    );
+    let undepleted = hpge_solver::solve_point(&det, 1500.0, &s, None).unwrap();
+    assert!(
+        !undepleted.fully_depleted() && undepleted.undepleted_nodes > 100,
+        "1500 V: undepleted {}",
+        undepleted.undepleted_nodes
+    );
 }

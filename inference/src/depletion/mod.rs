@@ -16,7 +16,7 @@ use serde::Serialize;
 use hpge_solver::field::{DepletionVoltages, depletion_voltages};
 use hpge_solver::{Detector, FieldSettings, cv_curve};
 
-pub use records::{RecordRow, RecordsOptions, run_records};
+pub use records::{RecordRow, RecordsOptions, not_converged, run_records};
 pub use scale::{Measured, ScalePosterior, ScalePrior, scale_posterior};
 
 use crate::error::{Error, Result};
@@ -89,7 +89,8 @@ impl DepletionReport {
     /// The report as `hpge-cv depletion --json` prints it (and Python's `depletion` returns
     /// it): `depletion_voltage_V`, `depletion_voltage_err_V`, `pinch_off_voltage_V`,
     /// `pinch_off_voltage_err_V` (null where there is none or no error bar could be
-    /// estimated), `grid`, `measured`, `gate_V`, `exceeds_gate`, `factor` (the posterior's
+    /// estimated), `depletion_voltage_halved_V` and `depletion_voltage_converged` (U_fd on the
+    /// grid with halved spacings, and whether the error bar bounds it), `grid`, `measured`, `gate_V`, `exceeds_gate`, `factor` (the posterior's
     /// summaries) and `curve_at_median`.
     pub fn to_json(&self) -> serde_json::Value {
         let finite = |x: Option<f64>| x.filter(|v| v.is_finite());
@@ -97,6 +98,8 @@ impl DepletionReport {
         serde_json::json!({
             "depletion_voltage_V": fd.map(|u| u.voltage_v),
             "depletion_voltage_err_V": finite(fd.map(|u| u.err_v)),
+            "depletion_voltage_halved_V": self.voltages.full_depletion_halved_v,
+            "depletion_voltage_converged": self.voltages.full_depletion_converged,
             "pinch_off_voltage_V": po.map(|u| u.voltage_v),
             "pinch_off_voltage_err_V": finite(po.map(|u| u.err_v)),
             "grid": {"nr": self.voltages.grid.0, "nz": self.voltages.grid.1},

@@ -63,6 +63,13 @@ pub struct RecordRow {
     pub depletion_voltage_v: Option<f64>,
     /// Its error bar, V.
     pub depletion_voltage_err_v: Option<f64>,
+    /// U_fd on the reference grid with every interval halved, V (the error bar's check).
+    #[serde(default)]
+    pub depletion_voltage_halved_v: Option<f64>,
+    /// Whether U_fd converges with the grid (`DepletionVoltages::full_depletion_converged`);
+    /// false: not to be quoted.
+    #[serde(default)]
+    pub depletion_voltage_converged: Option<bool>,
     /// Pinch-off voltage, V.
     pub pinch_off_voltage_v: Option<f64>,
     /// Its error bar, V.
@@ -229,6 +236,8 @@ fn one_record(file: &Path, o: &RecordsOptions, settings: &FieldSettings) -> Reco
         kind: None,
         depletion_voltage_v: None,
         depletion_voltage_err_v: None,
+        depletion_voltage_halved_v: None,
+        depletion_voltage_converged: None,
         pinch_off_voltage_v: None,
         pinch_off_voltage_err_v: None,
         measured_v: None,
@@ -271,6 +280,8 @@ fn fill(
         row.depletion_voltage_v = Some(u.voltage_v);
         row.depletion_voltage_err_v = Some(u.err_v);
     }
+    row.depletion_voltage_halved_v = r.voltages.full_depletion_halved_v;
+    row.depletion_voltage_converged = r.voltages.full_depletion_converged;
     if let Some(u) = r.voltages.pinch_off {
         row.pinch_off_voltage_v = Some(u.voltage_v);
         row.pinch_off_voltage_err_v = Some(u.err_v);
@@ -282,6 +293,9 @@ fn fill(
             "not fully depleted up to {} V",
             hpge_solver::field::CEILING_V
         ));
+    }
+    if r.voltages.full_depletion_converged == Some(false) {
+        notes.push(not_converged(r.voltages.full_depletion_halved_v));
     }
     if let Some(p) = &r.posterior {
         row.factor = Some(p.median);
@@ -297,6 +311,23 @@ fn fill(
         row.note = Some(notes.join("; "));
     }
     Ok(())
+}
+
+/// The note of a U_fd that the grid with halved spacings does not confirm.
+pub fn not_converged(halved_v: Option<f64>) -> String {
+    let there = halved_v.map_or_else(
+        || {
+            format!(
+                "is not fully depleted up to {} V",
+                hpge_solver::field::CEILING_V
+            )
+        },
+        |h| format!("gives {h:.0} V"),
+    );
+    format!(
+        "U_fd not converged with the grid (the grid with halved spacings {there}: the step \
+         does not shrink): not to be quoted (reports/accuracy/depletion.md)"
+    )
 }
 
 fn opt(x: Option<f64>, digits: usize) -> String {
@@ -347,13 +378,13 @@ pub fn markdown_table(rows: &[RecordRow], gate_v: f64) -> String {
 /// The rows as CSV (one header line; empty cells where a value is missing).
 pub fn csv_table(rows: &[RecordRow]) -> String {
     let mut s = String::from(
-        "record,detector,type,depletion_voltage_V,depletion_voltage_err_V,pinch_off_voltage_V,pinch_off_voltage_err_V,measured_V,factor,factor_lo_68,factor_hi_68,exceeds_gate,note\n",
+        "record,detector,type,depletion_voltage_V,depletion_voltage_err_V,pinch_off_voltage_V,pinch_off_voltage_err_V,measured_V,factor,factor_lo_68,factor_hi_68,exceeds_gate,note,depletion_voltage_halved_V,depletion_voltage_converged\n",
     );
     let c = |x: Option<f64>| x.map_or_else(String::new, |v| format!("{v}"));
     for r in rows {
         let q = |t: &str| format!("\"{}\"", t.replace('"', "\"\""));
         s.push_str(&format!(
-            "{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
             q(&r.record),
             q(r.name.as_deref().unwrap_or("")),
             q(r.kind.as_deref().unwrap_or("")),
@@ -367,6 +398,9 @@ pub fn csv_table(rows: &[RecordRow]) -> String {
             c(r.factor_68.map(|i| i.1)),
             r.exceeds_gate.map_or_else(String::new, |b| b.to_string()),
             q(r.note.as_deref().unwrap_or("")),
+            c(r.depletion_voltage_halved_v),
+            r.depletion_voltage_converged
+                .map_or_else(String::new, |b| b.to_string()),
         ));
     }
     s

@@ -31,6 +31,21 @@ pub(crate) struct Crossing {
     pub at_contact: bool,
 }
 
+/// True when the material at semiconductor node `n` can hold an undepleted layer at the upper
+/// bound (`upper`) or at the lower one: n-type (positive fixed charge when depleted) or neutral
+/// material at the upper, p-type or neutral at the lower. Free holes sit at the lowest potential
+/// they reach, free electrons at the highest; and depleted p-type material has
+/// laplacian(phi) = -rho/eps > 0, so its potential cannot rise above the contacts' maximum
+/// (maximum principle, discrete too on this M-matrix scheme). A sub-cell "layer" of p-type
+/// material at the upper bound is then a staircase artefact: on a slanted contact the first node
+/// off a contact node has a second contact neighbour, which bends the potential along one grid
+/// line although no layer exists (LEGEND's P99000A, a PPC with a 30 degree taper of its n+
+/// contact, was "not fully depleted" up to 100 kV because of it).
+pub(crate) fn can_hold_layer(mesh: &Mesh, n: usize, upper: bool) -> bool {
+    let q = mesh.charge_c[n];
+    if upper { q >= 0.0 } else { q <= 0.0 }
+}
+
 /// Front position along a line through p (u = 0), q1 and q2 (depleted), u = |B - phi|: the vertex
 /// of the parabola through the three points, or None when the data are not parabola-like.
 fn vertex(b: f64, xp: f64, x1: f64, x2: f64, p1: f64, p2: f64) -> Option<f64> {
@@ -87,6 +102,9 @@ pub(crate) fn crossings(
             let q1 = ((j + dj) as usize) * nr + (i + di) as usize;
             let q2 = (j2 as usize) * nr + i2 as usize;
             if !(depleted(q1) && depleted(q2)) {
+                continue;
+            }
+            if at_contact && !can_hold_layer(mesh, q1, b == bounds_v.1) {
                 continue;
             }
             let radial = di != 0;

@@ -23,6 +23,7 @@
 //! from the contacts); the detector is fully depleted only when the last pocket is gone.
 
 use super::depletion::potential_dofs;
+use super::front::can_hold_layer;
 use super::mesh::{Mesh, NodeKind};
 use super::pockets::{CARRIERS, deepest_depression_v};
 use super::system::{Dof, System};
@@ -138,7 +139,7 @@ impl Affine {
                 let (Some((_, x0)), Some((n1, x1)), Some((n2, x2))) = (at(0), at(1), at(2)) else {
                     continue;
                 };
-                if !(semi(n1) && semi(n2)) {
+                if !(semi(n1) && semi(n2) && can_hold_layer(mesh, n1, bound > 0.0)) {
                     continue;
                 }
                 // Slope at x0 of the parabola through (x0, pc), (x1, phi1), (x2, phi2), along

@@ -39,8 +39,13 @@ mod weighting;
 /// line of the crystal's surface no longer tied or counted as pockets (`pockets::resolution`,
 /// issue 64: of 120 rows of the uniform-900000 training run solved again, 116 identical, 3
 /// within 1e-15 and one 1.9e-5 relative apart; every c12 of `reports/accuracy/detector-sweep.md`
-/// and every U_fd of `reports/accuracy/depletion-table.md` unchanged).
-pub const PHYSICS_REVISION: &str = "2026-12-06 surface line depressions";
+/// and every U_fd of `reports/accuracy/depletion-table.md` unchanged); 2026-12-07, no undepleted
+/// layer of p-type material at the upper bound nor of n-type at the lower one in front of a
+/// contact (`front::can_hold_layer`: LEGEND's P99000A, whose slanted n+ contact's staircase read
+/// as such a layer, depletes at 2130 V instead of never; of 40 rows of `heldout-300000.csv`
+/// solved again, 39 identical and one 7.8e-5 relative apart; every c12 of the detector sweep and
+/// every U_fd of the depletion table unchanged).
+pub const PHYSICS_REVISION: &str = "2026-12-07 no layer of majority carriers at the opposite bound";
 
 pub use adaptive::Accuracy;
 pub use capacitance::CapacitanceMatrix;
@@ -68,7 +73,8 @@ pub use sor::{
 };
 pub use threshold::VoltageEstimate;
 pub use voltages::{
-    CEILING_V, DepletionVoltages, POCKET_SCAN, depletion_voltages, scales_with_density,
+    CEILING_V, CONVERGED_RATIO, DepletionVoltages, POCKET_SCAN, depletion_voltages,
+    scales_with_density,
 };
 pub use weighting::{
     PAPER_EPSILON_FACTOR, WeightingMode, WeightingPotentials, weighting_potentials,

@@ -28,6 +28,32 @@ pub(super) fn find_number(v: Option<&Value>, key: &str) -> Option<(f64, String)>
     None
 }
 
+/// The record's depletion voltage (V) and where it was found: the first positive
+/// `depletion_voltage_in_V` under `characterization`, the site's measurement (`l200_site`)
+/// before the manufacturer's data sheet (`manufacturer`) before any other sub-table. A zero or
+/// negative value is a placeholder (the public test records carry `l200_site` values of 0) and
+/// is passed over, never returned as a depletion voltage.
+pub(super) fn depletion_voltage(characterization: Option<&Value>) -> Option<(f64, String)> {
+    let obj = characterization?.as_object()?;
+    let key = "depletion_voltage_in_V";
+    let preferred = ["l200_site", "manufacturer"];
+    let positive = |found: Option<(f64, String)>| found.filter(|(u, _)| u.is_finite() && *u > 0.0);
+    if let Some(found) = positive(
+        obj.get(key)
+            .and_then(Value::as_f64)
+            .map(|u| (u, key.into())),
+    ) {
+        return Some(found);
+    }
+    let rest = obj.keys().filter(|k| !preferred.contains(&k.as_str()));
+    for k in preferred.iter().copied().chain(rest.map(String::as_str)) {
+        if let Some((u, path)) = positive(find_number(obj.get(k), key)) {
+            return Some((u, format!("{k}.{path}")));
+        }
+    }
+    None
+}
+
 pub(super) fn n_plus_thickness(
     rd: &Reader<'_>,
     v: &Value,

@@ -26,8 +26,9 @@
 //!   [`LegendOptions::default_impurity_cm3`] and the file says so.
 //! - `characterization`: the n+ dead-layer thickness (the first of `*.fccd_in_mm` (a number or
 //!   `{value}`) and `*.dl_thickness_in_mm` found in its sub-tables), else
-//!   [`LegendOptions::n_plus_thickness_mm`]; the depletion voltage (`*.depletion_voltage_in_V`) is
-//!   reported by [`LegendDiode::depletion_voltage_v`].
+//!   [`LegendOptions::n_plus_thickness_mm`]; the depletion voltage (the first positive `*.depletion_voltage_in_V`,
+//!   `l200_site` before `manufacturer`; zeros are placeholders) is reported by
+//!   [`LegendDiode::depletion_voltage_v`].
 //!
 //! The environment (documented default): the crystal alone in a grounded can (vacuum),
 //! [`LegendOptions::can_gap_mm`] from the crystal on every side; the n+ layer (every n+ surface
@@ -47,7 +48,7 @@ use std::path::{Path, PathBuf};
 use serde_json::Value;
 
 use crate::error::{Error, Result};
-use impurity::{find_number, impurity, n_plus_thickness};
+use impurity::{impurity, n_plus_thickness};
 use outline::{check_outline, outline};
 use reader::Reader;
 pub use toml::to_toml;
@@ -243,7 +244,7 @@ pub fn diode(v: &Value, file: &Path, o: &LegendOptions) -> Result<LegendDiode> {
     let radius_mm = outline.iter().map(|p| p[0]).fold(0.0, f64::max);
     let n_plus = n_plus_thickness(&rd, v, o)?;
     let impurity = impurity(&rd, v, height_mm, o)?;
-    let depletion = find_number(v.get("characterization"), "depletion_voltage_in_V");
+    let depletion = impurity::depletion_voltage(v.get("characterization"));
     Ok(LegendDiode {
         name,
         kind,

@@ -136,3 +136,23 @@ fn bad_records_name_the_key() {
     let e = read_json("{", f, &o).unwrap_err().to_string();
     assert!(e.contains("D.json") && e.contains("JSON"), "{e}");
 }
+
+#[test]
+fn a_zero_depletion_voltage_is_a_placeholder() {
+    // legend-testdata's P99000A: `l200_site` 0 V (placeholder), `manufacturer` 3000 V. The
+    // site's measurement comes first when it is a value.
+    let o = LegendOptions::default();
+    let mut v = icpc();
+    v["characterization"] = serde_json::json!({
+        "l200_site": {"depletion_voltage_in_V": 0},
+        "manufacturer": {"depletion_voltage_in_V": 3000.0},
+    });
+    let d = diode(&v, Path::new("D.json"), &o).unwrap();
+    assert_eq!(d.depletion_voltage_v, Some(3000.0));
+    v["characterization"]["l200_site"]["depletion_voltage_in_V"] = serde_json::json!(3500);
+    let d = diode(&v, Path::new("D.json"), &o).unwrap();
+    assert_eq!(d.depletion_voltage_v, Some(3500.0));
+    v["characterization"] = serde_json::json!({"l200_site": {"depletion_voltage_in_V": 0}});
+    let d = diode(&v, Path::new("D.json"), &o).unwrap();
+    assert_eq!(d.depletion_voltage_v, None);
+}

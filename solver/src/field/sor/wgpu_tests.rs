@@ -182,11 +182,19 @@ fn solve_point_on_wgpu_matches_cpu() {
         method: Method::Sor,
         ..FieldSettings::default()
     };
+    // The default precision is f64 where the adapter has shader-f64. Without it (Mesa's
+    // lavapipe on the project machine since 2026-12-07) the device solves in f32: potentials
+    // within about 4e-7 of the bias, c12 within 1.05e-6 measured, so 1e-5 there.
+    let tol = if gpu::shared().unwrap().report.shader_f64 {
+        1e-6
+    } else {
+        1e-5
+    };
     for v in [25.0, 1025.0] {
         let a = solve_point(&det, v, &cpu, None).unwrap();
         let b = solve_point(&det, v, &wrong, None).unwrap();
         let rel = (b.c12_pf / a.c12_pf - 1.0).abs();
-        assert!(rel <= 1e-6, "{v} V: c12 {} vs {} pF", b.c12_pf, a.c12_pf);
+        assert!(rel <= tol, "{v} V: c12 {} vs {} pF", b.c12_pf, a.c12_pf);
         assert_eq!(a.mesh.grid.r_mm(), b.mesh.grid.r_mm());
         assert_eq!(a.mesh.grid.z_mm(), b.mesh.grid.z_mm());
         assert!(b.reports.iter().all(|r| r.backend == Backend::Wgpu));
