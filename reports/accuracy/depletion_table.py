@@ -6,7 +6,7 @@ grids with every interval divided into 4, from the results files beside this scr
   pinch-off-fine.jsonl    `cargo run --release -p hpge-validation --example pinch_off_fine --
                           DETECTOR DEPLETED_V PARTS LO_V HI_V` (one line per detector and PARTS)
   depletion-error.json    the runs' date, commit, machine and commands
-  depletion-bench.json    `cargo bench -p hpge-benches -- 'depletion/u_fd'` (criterion medians)
+  depletion-bench.json    `cargo bench -p hpge-benches --bench bench_main -- 'depletion/u_fd'` (criterion medians)
 
     python3 reports/accuracy/depletion_table.py > reports/accuracy/depletion-table.md
 
