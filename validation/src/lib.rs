@@ -39,7 +39,7 @@ pub use error::{Error, Result};
 pub use problems::coax::{COAX_REFERENCE_TABLE, LongCoax};
 pub use problems::planar::PlanarPn;
 pub use problems::radial1d::{RadialReference, RadialSolution};
-pub use repo::{repo_path, shipped_fit_files};
+pub use repo::{legend_detector, repo_path, shipped_fit_files};
 pub use studies::accuracy::{AccuracyCase, AccuracyRow, accuracy_cases, accuracy_row};
 pub use studies::coverage::{
     CoverageModels, CoverageOutcome, CoverageReport, CoverageRun, CoverageSettings, coverage,

@@ -19,3 +19,21 @@ pub fn shipped_fit_files() -> hpge_inference::fit::FitFiles {
         detector: repo_path(DEFAULT_DETECTOR),
     }
 }
+
+/// A LEGEND diode record shipped in the repository (JSON or YAML, e.g.
+/// `validation/references/legend-testdata/yaml/P99000A.yaml`) converted with the default
+/// options, as `hpge-cv detector --from-legend` converts it.
+///
+/// # Errors
+/// An unreadable or malformed record, or a conversion the detector loader refuses.
+pub fn legend_detector(relative: &str) -> crate::Result<hpge_solver::Detector> {
+    use hpge_solver::detector::legend::{LegendOptions, read_file, to_toml};
+    let file = repo_path(relative);
+    let o = LegendOptions::default();
+    let toml = to_toml(&read_file(&file, &o)?, &file, &o);
+    Ok(hpge_solver::Detector::from_toml_str(
+        &toml,
+        &file,
+        &hpge_solver::Parameters::new(),
+    )?)
+}

@@ -4,10 +4,9 @@
 //! undepleted sliver at every bias (`hpge_solver::field::voltages` docs): U_fd grows by about
 //! 400 V per halving of the spacing. A shipped coax without that corner converges.
 
-use hpge_solver::detector::legend::{LegendOptions, read_file, to_toml};
 use hpge_solver::field::depletion_voltages;
 use hpge_solver::{Detector, FieldSettings, Parameters};
-use hpge_validation::repo_path;
+use hpge_validation::{legend_detector, repo_path};
 
 fn converged(det: &Detector) -> (f64, f64, Option<f64>, Option<bool>) {
     let s = FieldSettings::default().for_detector(det);
@@ -27,10 +26,7 @@ fn converged(det: &Detector) -> (f64, f64, Option<f64>, Option<bool>) {
 
 #[test]
 fn a_u_fd_that_grows_with_the_resolution_is_flagged() {
-    let file = repo_path("validation/references/legend-testdata/yaml/C99000A.yaml");
-    let o = LegendOptions::default();
-    let toml = to_toml(&read_file(&file, &o).unwrap(), &file, &o);
-    let det = Detector::from_toml_str(&toml, &file, &Parameters::new()).unwrap();
+    let det = legend_detector("validation/references/legend-testdata/yaml/C99000A.yaml").unwrap();
     // Measured 2026-12-07: 5088 +- 428 V, 5502 V halved, 5924 V on the grid divided into 4.
     let (u, err, halved, ok) = converged(&det);
     assert_eq!(ok, Some(false));

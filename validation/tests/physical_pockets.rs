@@ -6,11 +6,11 @@
 //! staircase of a slanted contact bends the potential along single grid lines, which read as an
 //! undepleted layer of p-type material at the n+ contact's bound (no such layer can exist).
 
-use hpge_solver::detector::legend::{LegendOptions, convert_json, read_file, to_toml};
+use hpge_solver::detector::legend::{LegendOptions, convert_json};
 use hpge_solver::drift::Carrier;
 use hpge_solver::field::{PotentialPoint, depressions, solve_potential};
 use hpge_solver::{Detector, FieldSettings, Parameters};
-use hpge_validation::repo_path;
+use hpge_validation::{legend_detector, repo_path};
 
 fn v99000a() -> Detector {
     let file = repo_path("validation/references/legend-testdata/V99000A.json");
@@ -131,10 +131,7 @@ fn a_slanted_n_plus_contact_holds_no_layer_of_p_type_material() {
     // (its data sheet) it is fully depleted, no layer in front of any contact; at 1500 V it is
     // not, and the undepleted region is p-type bulk (the affine U_fd on the defaults' grid:
     // 2130 V, `reports/accuracy/legend-records/`).
-    let file = repo_path("validation/references/legend-testdata/yaml/P99000A.yaml");
-    let o = LegendOptions::default();
-    let toml = to_toml(&read_file(&file, &o).unwrap(), &file, &o);
-    let det = Detector::from_toml_str(&toml, &file, &Parameters::new()).unwrap();
+    let det = legend_detector("validation/references/legend-testdata/yaml/P99000A.yaml").unwrap();
     let s = FieldSettings::default().for_detector(&det);
     let depleted = hpge_solver::solve_point(&det, 3000.0, &s, None).unwrap();
     assert!(

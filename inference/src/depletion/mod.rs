@@ -90,8 +90,9 @@ impl DepletionReport {
     /// it): `depletion_voltage_V`, `depletion_voltage_err_V`, `pinch_off_voltage_V`,
     /// `pinch_off_voltage_err_V` (null where there is none or no error bar could be
     /// estimated), `depletion_voltage_halved_V` and `depletion_voltage_converged` (U_fd on the
-    /// grid with halved spacings, and whether the error bar bounds it), `grid`, `measured`, `gate_V`, `exceeds_gate`, `factor` (the posterior's
-    /// summaries) and `curve_at_median`.
+    /// grid with halved spacings, and whether U_fd converges:
+    /// `hpge_solver::field::CONVERGED_RATIO`), `grid`, `measured`, `gate_V`, `exceeds_gate`,
+    /// `factor` (the posterior's summaries) and `curve_at_median`.
     pub fn to_json(&self) -> serde_json::Value {
         let finite = |x: Option<f64>| x.filter(|v| v.is_finite());
         let (fd, po) = (self.voltages.full_depletion, self.voltages.pinch_off);

@@ -16,12 +16,11 @@
 //! halved (four times the nodes; two more linear solves). Where U_fd converges at order one or
 //! more, the step from the reference grid to the halved one is about half the step from the
 //! coarsenings to the reference (the error bar) or less; where it is above [`CONVERGED_RATIO`]
-//! of it,
-//! [`DepletionVoltages::full_depletion_converged`] is false and the value is not to be quoted.
-//! The check is necessary, not sufficient: a feature the halved grid does not yet resolve can
-//! still move U_fd on a finer one (LEGEND's V99000A: 1686 +- 612 V, 1628 V halved, not depleted
-//! below 3500 V on the grid divided into 4; `reports/accuracy/depletion.md`). Measured on LEGEND's test record C99000A (a coax whose p+ contact lines the
-//! bore and an annulus of the bottom face): the last undepleted nodes sit in the 90 degree
+//! of it, [`DepletionVoltages::full_depletion_converged`] is false and the value is not to be
+//! quoted. The check is necessary, not sufficient: a feature the halved grid does not yet
+//! resolve can still move U_fd on a finer one (LEGEND's V99000A: 1686 +- 612 V, 1628 V halved,
+//! not depleted below 3500 V on the grid divided into 4; `reports/accuracy/depletion.md`).
+//! Measured on LEGEND's test record C99000A (a coax whose p+ contact lines the bore and an annulus of the bottom face): the last undepleted nodes sit in the 90 degree
 //! corner between the two, and U_fd grows by about 400 V per halving of the spacing (4660-5159,
 //! 5088, 5924 V on the coarsenings, the reference grid and the grid divided into 4). That is
 //! the continuum's answer, not a defect of the grid: in a wedge of opening alpha bounded by a

@@ -26,9 +26,9 @@
 //!   [`LegendOptions::default_impurity_cm3`] and the file says so.
 //! - `characterization`: the n+ dead-layer thickness (the first of `*.fccd_in_mm` (a number or
 //!   `{value}`) and `*.dl_thickness_in_mm` found in its sub-tables), else
-//!   [`LegendOptions::n_plus_thickness_mm`]; the depletion voltage (the first positive `*.depletion_voltage_in_V`,
-//!   `l200_site` before `manufacturer`; zeros are placeholders) is reported by
-//!   [`LegendDiode::depletion_voltage_v`].
+//!   [`LegendOptions::n_plus_thickness_mm`]; the depletion voltage (the first positive
+//!   `*.depletion_voltage_in_V`, `l200_site` before `manufacturer`; zeros are placeholders) is
+//!   reported by [`LegendDiode::depletion_voltage_v`].
 //!
 //! The environment (documented default): the crystal alone in a grounded can (vacuum),
 //! [`LegendOptions::can_gap_mm`] from the crystal on every side; the n+ layer (every n+ surface
