@@ -23,7 +23,6 @@ macro_rules! out {
 }
 
 mod cli;
-mod report;
 
 use std::process::ExitCode;
 

@@ -10,6 +10,9 @@ pub enum Error {
     /// A failure in the surrogate layer (or, through it, the solver).
     #[error(transparent)]
     Surrogate(#[from] hpge_surrogate::Error),
+    /// A lock, shard or file error of the shared utilities (`hpge_foundation`).
+    #[error(transparent)]
+    Foundation(#[from] hpge_foundation::Error),
     /// A file could not be read or written.
     #[error("{}: {action}: {source}", file.display())]
     Io {
@@ -128,6 +131,7 @@ impl Error {
     pub fn is_recoverable(&self) -> bool {
         match self {
             Error::Surrogate(e) => e.is_recoverable(),
+            Error::Foundation(e) => e.is_recoverable(),
             Error::Numerical { .. } | Error::Extension { .. } => true,
             Error::Io { .. }
             | Error::Format { .. }

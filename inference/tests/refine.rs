@@ -417,7 +417,7 @@ impl CvModel for GridFlaky {
         x: &[f64],
         near: &[Vec<f64>],
         _: &(dyn Fn(usize, usize) + Sync),
-    ) -> Result<hpge_inference::model::NearCurves> {
+    ) -> Result<hpge_inference::model::CurvesNear> {
         let mut c = vec![0.0; VOLTS.len()];
         exact_curve(x, &mut c, None);
         let others = near

@@ -1,10 +1,10 @@
 //! Depletion voltages and the impurity scale factor from Python, as `hpge-cv depletion`.
 
+use hpge_foundation::Shard;
 use hpge_inference::depletion::{
     DEFAULT_GATE_V, DepletionOptions, Measured, RecordsOptions, ScalePrior, depletion, run_records,
 };
 use hpge_solver::detector::legend::LegendOptions;
-use hpge_surrogate::Shard;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 

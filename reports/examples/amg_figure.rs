@@ -1,7 +1,7 @@
 //! The multigrid figure of reports/solver-performance.md: seconds against unknowns on log-log
 //! axes for the sparse Cholesky and the smoothed-aggregation multigrid with CG, a cold solve and
-//! an active-set step each, from the CSV of the solver's `amg_timing` test
-//! (`cargo test --release -p hpge-solver --lib amg_timing -- --ignored --nocapture`).
+//! an active-set step each, from the CSV of the `amg_timing` example
+//! (`RAYON_NUM_THREADS=1 cargo run --release -p hpge-benches --example amg_timing`).
 //! `cargo run --release -p hpge-reports --example amg_figure -- CSV OUT_STEM` writes
 //! OUT_STEM.svg and OUT_STEM.png.
 

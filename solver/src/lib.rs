@@ -64,6 +64,17 @@ pub mod material;
 pub mod options;
 pub mod scan;
 
+/// Solver internals for measurements outside the product (`hpge-benches`: the multigrid
+/// solver measured against the sparse Cholesky, `reports/solver-performance.md`): the assembled
+/// field systems, their factorisation and the weighting problem's unknowns. Not a stable API.
+#[cfg(feature = "internals")]
+#[doc(hidden)]
+pub mod internals {
+    pub use crate::field::cholesky::{Factor, Symbolic};
+    pub use crate::field::system::{Dof, System};
+    pub use crate::field::weighting::{Owner, owners, weighting_dofs};
+}
+
 pub use detector::Detector;
 pub use drift::{Pulse, pulse};
 pub use error::{DetectorPart, Error, Result};

@@ -6,6 +6,7 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
+use hpge_foundation::Shard;
 use hpge_inference::depletion::records::{csv_table, markdown_table};
 use hpge_inference::depletion::{
     DEFAULT_GATE_V, DepletionOptions, DepletionReport, Measured, RecordsOptions, ScalePrior,
@@ -16,7 +17,6 @@ use hpge_reports::plot::{Corner, Curve, LineFigure, line_figure};
 use hpge_solver::detector::legend::{self, LegendOptions};
 use hpge_solver::options::SolverOptions;
 use hpge_solver::{Detector, FieldSettings, Parameters};
-use hpge_surrogate::Shard;
 use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::json;
 

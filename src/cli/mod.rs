@@ -14,6 +14,7 @@ mod impurity;
 mod measure;
 mod pulse;
 mod replace;
+mod report;
 mod sensitivity;
 mod sidecar;
 mod simulate;
@@ -103,7 +104,7 @@ enum Command {
     /// Validation studies of the inference (simulation-based calibration).
     Validate(ValidateArgs),
     /// Reports made of several commands' results: `report paper` remakes the paper's figures.
-    Report(crate::report::ReportArgs),
+    Report(report::ReportArgs),
 }
 
 #[derive(Debug, clap::Args)]
@@ -428,7 +429,7 @@ pub fn run(cli: Cli) -> Result<()> {
         }
         Command::Fit(a) => fit::run(&a.options, a.json, a.allow_unconverged),
         Command::Discover(a) => discover::run(&a),
-        Command::Report(a) => crate::report::run(&a),
+        Command::Report(a) => report::run(&a),
         Command::Pulse(a) => pulse::run(&a),
         Command::Convergence(a) => convergence::run(&a),
         Command::Depletion(a) => depletion::run(&a),

@@ -9,6 +9,9 @@ pub enum Error {
     /// A solver-side failure (bad detector, failed solve) while building a data set.
     #[error(transparent)]
     Solver(#[from] hpge_solver::Error),
+    /// A lock, shard or file error of the foundation's utilities (`hpge_foundation`).
+    #[error(transparent)]
+    Foundation(#[from] hpge_foundation::Error),
     /// A file could not be read or written.
     #[error("{}: {action}: {source}", file.display())]
     Io {
@@ -130,20 +133,6 @@ pub enum Error {
         /// Name of the model's parameter space.
         space: String,
     },
-    /// An output folder another process is writing (the one-writer lock of `generate` and
-    /// `fit`).
-    #[error(
-        "{}: another `{command}` process is writing this folder ({holder}); wait for it to finish or use another --out",
-        folder.display()
-    )]
-    Locked {
-        /// The folder.
-        folder: PathBuf,
-        /// The command whose lock it is (`generate`, `fit`).
-        command: String,
-        /// Who holds the lock (pid, host, start time), as it wrote itself into the lock file.
-        holder: String,
-    },
     /// A parameter list (NAME=VALUE pairs, or bare values in the model's order) that does not
     /// fit the model's inputs.
     #[error("{message}")]
@@ -163,6 +152,7 @@ impl Error {
     pub fn is_recoverable(&self) -> bool {
         match self {
             Error::Solver(e) => e.is_recoverable(),
+            Error::Foundation(e) => e.is_recoverable(),
             Error::OutsideDomain { .. } => true,
             Error::OutsideSupport { .. } => false,
             Error::Io { .. }
@@ -174,7 +164,6 @@ impl Error {
             | Error::ModelPath { .. }
             | Error::Checkpoint { .. }
             | Error::DataForModel { .. }
-            | Error::Locked { .. }
             | Error::Parameters { .. } => false,
         }
     }

@@ -46,7 +46,10 @@
 mod error;
 
 pub mod generate;
-pub mod hash;
+/// The stable hash of inputs (`hpge_foundation::hash`; here for the paths that named it first).
+pub mod hash {
+    pub use hpge_foundation::hash::fnv1a;
+}
 pub mod job;
 pub mod model;
 pub mod sequence;

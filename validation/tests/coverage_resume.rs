@@ -4,10 +4,10 @@
 
 use std::path::{Path, PathBuf};
 
+use hpge_foundation::Shard;
 use hpge_inference::fit::{ExactCheckSettings, ExactGrids, FitSettings, RefineSettings};
 use hpge_inference::sampler::{SampleSettings, SamplerKind, SamplerStop};
 use hpge_inference::{CvData, CvModel, Likelihood, NoiseSettings, Prior, PriorSpec, Result};
-use hpge_surrogate::Shard;
 use hpge_validation::studies::coverage::store::TruthStore;
 use hpge_validation::studies::coverage::{PipelineSettings, TruthEvent, TruthEvents, progress};
 use hpge_validation::{

@@ -248,7 +248,7 @@ fn heldout_row_104700_pocket_rounds_end_at_their_limit() {
 /// pockets): on the fifth adaptive grid the active sets of one pocket round cycled with period
 /// 5, through an active set whose levels' system is singular (pockets pouring into each other),
 /// until the round's 200 iterations ran out and the row failed ("the fast solver did not converge
-/// after 212 iterations"). A cycling round now holds every level at its fallback (`field::round`).
+/// after 212 iterations"). A cycling round now holds every level at its fallback (`field::active_set::round`).
 /// Checked against the same point at the neighbouring biases (`space_point`, release build):
 /// 396.394 pF at 19.5 V and 386.270 pF at 20.2 V, which interpolate to 387.72 pF here; the solver
 /// estimates its own error at 9% (a pocket's neck on the finest grid: the curve is jagged here
@@ -265,7 +265,7 @@ fn heldout_row_104700_pocket_rounds_end_at_their_limit() {
 /// grid line of the crystal's surface are not tied) no round of this row cycles at any bias of
 /// 19.5-21 V in steps of 0.1 V (scanned in a release build; c12 387-421 pF with estimated errors
 /// of 3-17%): the pockets that poured into each other included such lines. The test keeps the
-/// accuracy checks; the fixed-level path of `field::round` is exercised by no test now (noted in
+/// accuracy checks; the fixed-level path of `field::active_set::round` is exercised by no test now (noted in
 /// issue 64).
 #[test]
 fn training_row_34554_active_set_cycle_holds_the_levels() {

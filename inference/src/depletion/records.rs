@@ -20,9 +20,9 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
+use hpge_foundation::Shard;
 use hpge_solver::detector::legend::{LegendOptions, read_file, to_toml};
 use hpge_solver::{Detector, FieldSettings, Parameters};
-use hpge_surrogate::Shard;
 
 use super::{DepletionOptions, Measured, ScalePrior, depletion};
 use crate::error::{Error, Result};

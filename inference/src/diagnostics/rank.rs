@@ -1,7 +1,7 @@
 //! Split chains, rank normalisation and folding (Vehtari et al. 2021, section 4).
 
-use hpge_surrogate::model::quantile;
-use hpge_surrogate::normal_quantile;
+use hpge_foundation::normal_quantile;
+use hpge_foundation::quantile;
 
 /// Each chain cut into its first and second half (an odd draw in the middle is dropped): 2M
 /// chains of floor(N/2) draws, so that a trend within a chain shows up as between-chain

@@ -91,7 +91,7 @@ fn ranks_are_normal_scores_and_ties_share_a_rank() {
     assert_eq!(z[0][2], z[1][0]);
     assert!(z[0][1] < z[0][2] && z[0][2] < z[0][0] && z[1][2] < z[1][1]);
     let s = 6.0;
-    let expected = hpge_surrogate::normal_quantile((1.0 - 0.375) / (s + 0.25));
+    let expected = hpge_foundation::normal_quantile((1.0 - 0.375) / (s + 0.25));
     assert!((z[0][1] - expected).abs() < 1e-12);
     assert_eq!(
         split_chains(&[vec![1.0, 2.0, 3.0, 4.0, 5.0]]),

@@ -16,7 +16,7 @@
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
-use hpge_surrogate::generate::FolderLock;
+use hpge_foundation::FolderLock;
 use serde::Serialize;
 use serde::de::DeserializeOwned;
 
@@ -34,7 +34,7 @@ pub const DISCOVER_LOCK: &str = "discover.lock";
 /// returned value lives.
 ///
 /// # Errors
-/// Another process holds it (`hpge_surrogate::Error::Locked`, naming its pid, host and start),
+/// Another process holds it (`hpge_foundation::Error::Locked`, naming its pid, host and start),
 /// or the lock file cannot be opened.
 pub fn lock_output(out: &Path) -> Result<FolderLock> {
     Ok(FolderLock::acquire_named(out, DISCOVER_LOCK)?)
@@ -116,7 +116,7 @@ impl Stages {
 
     /// The file of stage `name` started from `start`.
     fn path(&self, name: &str, start: &[Vec<f64>]) -> PathBuf {
-        let key = hpge_surrogate::hash::fnv1a(format!("{start:?}").as_bytes());
+        let key = hpge_foundation::fnv1a(format!("{start:?}").as_bytes());
         let slug: String = name
             .chars()
             .map(|c| if c.is_ascii_alphanumeric() { c } else { '-' })

@@ -13,7 +13,7 @@
 
 use std::path::{Path, PathBuf};
 
-use hpge_surrogate::generate::FolderLock;
+use hpge_foundation::FolderLock;
 
 use serde::{Deserialize, Serialize};
 
@@ -30,7 +30,7 @@ pub const FIT_LOCK: &str = "fit.lock";
 /// value lives.
 ///
 /// # Errors
-/// Another process holds it (`hpge_surrogate::Error::Locked`, naming its pid, host and start),
+/// Another process holds it (`hpge_foundation::Error::Locked`, naming its pid, host and start),
 /// or the lock file cannot be opened.
 pub fn lock_output(out: &Path) -> Result<FolderLock> {
     Ok(FolderLock::acquire_named(out, FIT_LOCK)?)
@@ -54,7 +54,7 @@ pub struct SavedRound {
 /// the program version is added).
 pub fn fingerprint(parts: &[String]) -> String {
     let text = format!("{}|{}", env!("CARGO_PKG_VERSION"), parts.join("|"));
-    format!("{:016x}", hpge_surrogate::hash::fnv1a(text.as_bytes()))
+    format!("{:016x}", hpge_foundation::fnv1a(text.as_bytes()))
 }
 
 /// The rounds folder of one run.

@@ -5,8 +5,8 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
+use hpge_foundation::fnv1a;
 use hpge_solver::{Detector, FieldSettings, GridOverrides, Parameters};
-use hpge_surrogate::hash::fnv1a;
 use hpge_surrogate::{ExactSolver, Surrogate};
 
 use super::run::{Fit, FitSettings, fit};

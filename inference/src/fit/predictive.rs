@@ -5,7 +5,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::Result;
-use crate::posterior::{Evaluation, Posterior};
+use crate::posterior::{Posterior, PosteriorEvaluation};
 use crate::rejection::unless_rejected;
 use crate::sampler::Samples;
 
@@ -51,7 +51,7 @@ pub fn predictive(
     posterior: &Posterior,
     samples: &Samples,
     n: usize,
-    mode: &Evaluation,
+    mode: &PosteriorEvaluation,
     levels: &[f64],
 ) -> Result<Predictive> {
     let c_mode = &mode.c_p;

@@ -5,7 +5,7 @@ use hpge_solver::Detector;
 use hpge_solver::field::{Continuation, SeedChain, cv_curves_near_each};
 use hpge_surrogate::ExactSolver;
 
-use super::{CvModel, NearCurves};
+use super::{CurvesNear, CvModel};
 use crate::{Error, Result};
 
 /// The exact solver at the points of a parameter space, bound to the measured voltages.
@@ -104,7 +104,7 @@ impl CvModel for ExactModel {
         x: &[f64],
         near: &[Vec<f64>],
         progress: &(dyn Fn(usize, usize) + Sync),
-    ) -> Result<NearCurves> {
+    ) -> Result<CurvesNear> {
         let detector = |x: &[f64]| Ok(self.solver.detector(x)?);
         near_curves(
             self,
@@ -133,7 +133,7 @@ pub(crate) fn near_curves(
     near: &[Vec<f64>],
     detector: &dyn Fn(&[f64]) -> Result<Detector>,
     progress: &(dyn Fn(usize, usize) + Sync),
-) -> Result<NearCurves> {
+) -> Result<CurvesNear> {
     check_domain(names, domain, x)?;
     let det = detector(x)?;
     // The detectors to solve, and in each entry's place the error that stops it.

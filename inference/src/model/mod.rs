@@ -12,7 +12,7 @@ pub use surrogate::SurrogateModel;
 use crate::Result;
 
 /// c(x) and each nearby point's curve or its error ([`CvModel::curves_near`]).
-pub type NearCurves = (Vec<f64>, Vec<Result<Vec<f64>>>);
+pub type CurvesNear = (Vec<f64>, Vec<Result<Vec<f64>>>);
 
 /// [`CvModel::curve_variance`] of a constant relative uncertainty `sigma_rel`: sigma_rel^2 at
 /// every point, zero derivatives.
@@ -82,7 +82,7 @@ pub trait CvModel: Send + Sync {
         x: &[f64],
         near: &[Vec<f64>],
         progress: &(dyn Fn(usize, usize) + Sync),
-    ) -> Result<NearCurves> {
+    ) -> Result<CurvesNear> {
         use rayon::prelude::*;
         use std::sync::atomic::{AtomicUsize, Ordering};
         let nv = self.voltages().len();

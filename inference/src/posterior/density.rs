@@ -19,7 +19,7 @@ pub struct Posterior<'a> {
 
 /// One evaluation at theta.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Evaluation {
+pub struct PosteriorEvaluation {
     /// ln pi(theta) + ln L.
     pub ln_posterior: f64,
     /// ln L.
@@ -84,7 +84,7 @@ impl<'a> Posterior<'a> {
     /// ln pi(theta) + ln L(theta) and the predicted curve. Outside the prior's support the
     /// posterior is -inf (no model call); a model error (outside its domain, a failed solve) is
     /// returned for the caller to treat as a rejection.
-    pub fn evaluate(&self, theta: &[f64]) -> Result<Evaluation> {
+    pub fn evaluate(&self, theta: &[f64]) -> Result<PosteriorEvaluation> {
         self.evaluate_with(theta, None)
     }
 
@@ -93,17 +93,17 @@ impl<'a> Posterior<'a> {
     ///
     /// # Errors
     /// The model's variance fails (as [`CvModel::curve_variance`]).
-    pub fn evaluate_curve(&self, theta: &[f64], c_p: Vec<f64>) -> Result<Evaluation> {
+    pub fn evaluate_curve(&self, theta: &[f64], c_p: Vec<f64>) -> Result<PosteriorEvaluation> {
         self.evaluate_with(theta, Some(c_p))
     }
 
     /// ln pi + ln L at `theta`, the curve solved by the model unless given.
-    fn evaluate_with(&self, theta: &[f64], given: Option<Vec<f64>>) -> Result<Evaluation> {
+    fn evaluate_with(&self, theta: &[f64], given: Option<Vec<f64>>) -> Result<PosteriorEvaluation> {
         let lp = self.prior.ln_density(theta);
         let nv = self.likelihood.len();
         let mut var_rel = vec![self.model.sigma_rel().powi(2); nv];
         if !lp.is_finite() {
-            return Ok(Evaluation {
+            return Ok(PosteriorEvaluation {
                 ln_posterior: f64::NEG_INFINITY,
                 ln_likelihood: f64::NEG_INFINITY,
                 c_p: given.unwrap_or_else(|| vec![0.0; nv]),
@@ -124,7 +124,7 @@ impl<'a> Posterior<'a> {
         let ll = self
             .likelihood
             .ln_likelihood_var(&c_p, &var_rel, None, None);
-        Ok(Evaluation {
+        Ok(PosteriorEvaluation {
             ln_posterior: lp + ll,
             ln_likelihood: ll,
             c_p,

@@ -5,7 +5,7 @@ mod density;
 mod laplace;
 mod likelihood;
 
-pub use density::{Evaluation, Posterior};
+pub use density::{Posterior, PosteriorEvaluation};
 pub use laplace::{
     LaplaceFit, LaplaceSettings, VisitedCurve, fd_steps, laplace_fit, laplace_fit_guided,
 };

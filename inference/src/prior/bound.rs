@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use hpge_surrogate::normal_cdf;
+use hpge_foundation::normal_cdf;
 use rand::{Rng, RngExt};
 
 use super::{PriorDistribution, PriorSpec};

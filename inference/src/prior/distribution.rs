@@ -1,6 +1,6 @@
 //! One parameter's prior distribution (a closed set).
 
-use hpge_surrogate::{normal_cdf, normal_quantile};
+use hpge_foundation::{normal_cdf, normal_quantile};
 use serde::{Deserialize, Serialize};
 
 /// ln sqrt(2 pi).

@@ -125,7 +125,7 @@ fn draws_follow_the_prior() {
     let par = &p.parameters[1];
     let below = draws.iter().filter(|t| t[1] < 0.7062704).count() as f64 / 20000.0;
     let [a, b] = par.support;
-    let cdf = hpge_surrogate::normal_cdf;
+    let cdf = hpge_foundation::normal_cdf;
     let want = (0.5 - cdf((a - 0.7062704) / 0.4))
         / (cdf((b - 0.7062704) / 0.4) - cdf((a - 0.7062704) / 0.4));
     assert!((below - want).abs() < 0.01, "{below} vs {want}");

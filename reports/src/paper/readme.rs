@@ -4,7 +4,7 @@
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
-use hpge_surrogate::hash::fnv1a;
+use hpge_foundation::fnv1a;
 use serde_json::json;
 
 use super::criterion::{Criterion, Judgement};

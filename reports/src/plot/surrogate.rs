@@ -262,7 +262,7 @@ fn errors<DB: DrawingBackend>(
         // quantile of |c_p - c_s| for the absolute one; the caption counts what lies outside.
         let mut sorted_abs: Vec<f64> = abs.iter().map(|x| x.abs()).collect();
         sorted_abs.sort_by(f64::total_cmp);
-        let q95 = hpge_surrogate::model::quantile(&sorted_abs, 0.95).max(1e-12);
+        let q95 = hpge_foundation::quantile(&sorted_abs, 0.95).max(1e-12);
         let (values, span, xdesc, title) = if k == 0 {
             (&abs, 1.5 * q95, "c_p - c_s (pF)", "a) absolute")
         } else {

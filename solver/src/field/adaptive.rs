@@ -33,8 +33,8 @@
 //! on the bias, so neither does its c12, exactly. An undepleted point carries that reference
 //! over to its own grid as a control variate, so the curve has no step at full depletion.
 
+use super::active_set::PotentialSolution;
 use super::capacitance::CapacitanceMatrix;
-use super::depletion::PotentialSolution;
 use super::mesh::{Mesh, NodeKind};
 use super::report::Backend;
 use super::settings::FieldSettings;

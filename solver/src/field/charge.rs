@@ -24,7 +24,7 @@
 //! pulse or an AC period); below pinch-off and above full depletion the two agree, in the pinch-off
 //! window they differ (reports/pockets/).
 
-use super::depletion::{PotentialSolution, solve_fast};
+use super::active_set::{PotentialSolution, solve_fast};
 use super::mesh::{Mesh, NodeKind};
 use crate::detector::Detector;
 use crate::error::{Error, Result};

@@ -24,12 +24,12 @@ use crate::error::{Error, Result};
 
 /// The symbolic analysis of one sparsity pattern, reusable for any values.
 #[derive(Clone)]
-pub(crate) struct Symbolic {
+pub struct Symbolic {
     inner: Arc<SymbolicCholesky<usize>>,
 }
 
 /// A numeric LL^T factor.
-pub(crate) struct Factor {
+pub struct Factor {
     sym: Arc<SymbolicCholesky<usize>>,
     values: Vec<f64>,
     /// Scratch of the numeric factorisation, kept for [`Factor::refactor`].

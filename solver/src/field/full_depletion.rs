@@ -22,7 +22,7 @@
 //! must also have no depression for holes in p-type or electrons in n-type material (a flood fill
 //! from the contacts); the detector is fully depleted only when the last pocket is gone.
 
-use super::depletion::potential_dofs;
+use super::active_set::potential_dofs;
 use super::front::can_hold_layer;
 use super::mesh::{Mesh, NodeKind};
 use super::pockets::{CARRIERS, deepest_depression_v};

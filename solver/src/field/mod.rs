@@ -1,16 +1,13 @@
 //! Field solves: potential with depletion, weighting potentials, capacitance matrix.
 
+mod active_set;
 mod adaptive;
-#[cfg(test)]
-mod amg;
-mod band;
 mod capacitance;
 mod charge;
-mod cholesky;
+pub(crate) mod cholesky;
 mod convergence;
 mod curve;
 mod depleted;
-mod depletion;
 mod front;
 mod full_depletion;
 mod mesh;
@@ -19,15 +16,14 @@ mod pinch_off;
 pub(crate) mod pockets;
 mod point;
 mod report;
-mod round;
 mod settings;
 pub(crate) mod sor;
 mod space_charge;
-mod system;
+pub(crate) mod system;
 mod threshold;
 mod union_find;
 mod voltages;
-mod weighting;
+pub(crate) mod weighting;
 
 /// Names the solver's physics: changed whenever a change of the solver moves computed numbers
 /// (potentials, c12) beyond round-off, so that resumable runs built on exact solves (a fit's
@@ -47,13 +43,13 @@ mod weighting;
 /// every U_fd of the depletion table unchanged).
 pub const PHYSICS_REVISION: &str = "2026-12-07 no layer of majority carriers at the opposite bound";
 
+pub use active_set::{MAX_POCKET_ROUNDS, PotentialSolution, solve_fast, solve_fast_with};
 pub use adaptive::Accuracy;
 pub use capacitance::CapacitanceMatrix;
 pub use charge::{contact_charge_c, quasi_static_c12_pf};
 pub use convergence::{ConvergenceRow, convergence_study};
 pub use curve::{Continuation, CvCurve, CvPoint, cv_curve, cv_curve_with, normalise_voltages};
 pub use depleted::{CARRY_POWER, Carried, carried_weight};
-pub use depletion::{MAX_POCKET_ROUNDS, PotentialSolution, solve_fast, solve_fast_with};
 pub use full_depletion::{
     curve_depletion_voltage, full_depletion_voltage, full_depletion_voltage_estimate,
 };
@@ -69,7 +65,8 @@ pub use point::{
 pub use report::{Backend, Method, SolveReport, Termination};
 pub use settings::FieldSettings;
 pub use sor::{
-    SorSettings, solve_sor, solve_sor_wgpu, solve_sor_wgpu_with, weighting_potentials_wgpu,
+    SorSettings, default_omega, solve_sor, solve_sor_wgpu, solve_sor_wgpu_with, solve_sor_with,
+    weighting_potentials_wgpu,
 };
 pub use threshold::VoltageEstimate;
 pub use voltages::{

@@ -6,9 +6,9 @@
 //! bisected with full solves on one fixed mesh, each seeded by the last (the answer does not
 //! depend on the seed).
 
+use super::active_set::solve_fast;
 use super::curve::CvCurve;
 use super::depleted;
-use super::depletion::solve_fast;
 use super::mesh::Mesh;
 use super::pockets::Pocket;
 use super::point::pair;

@@ -1,11 +1,11 @@
 //! One bias point: grid refinement, potential with depletion, weighting potentials, C*.
 
+use super::active_set::{FastSeed, PotentialSolution, solve_fast_seeded};
 use super::adaptive::{
     Accuracy, Weighed, coarsened_estimate, refinement_marks, undepleted_nodes, weigh,
 };
 use super::capacitance::CapacitanceMatrix;
 use super::depleted::{self, Carried};
-use super::depletion::{FastSeed, PotentialSolution, solve_fast_seeded};
 use super::mesh::Mesh;
 use super::pockets::pocket_nodes;
 use super::report::{Backend, Method, SolveReport};

@@ -87,7 +87,7 @@ pub struct SolveReport {
     #[serde(default)]
     pub pocket_rounds: usize,
     /// Pocket rounds whose active sets cycled, so that the round held every pocket level at
-    /// the previous round's pour-point value (`field::round`): a work counter of the `fast`
+    /// the previous round's pour-point value (`field::active_set::round`): a work counter of the `fast`
     /// method, 0 almost always.
     #[serde(default)]
     pub fixed_level_rounds: usize,

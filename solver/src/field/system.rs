@@ -8,7 +8,7 @@ use crate::error::Result;
 
 /// Role of a node in one linear problem.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) enum Dof {
+pub enum Dof {
     /// Potential given (V).
     Fixed(f64),
     /// Its own unknown.
@@ -18,15 +18,18 @@ pub(crate) enum Dof {
 }
 
 /// A symmetric positive-definite system A x = f over the unknowns, stored as a full CSC matrix.
-pub(crate) struct System {
+pub struct System {
     /// Unknown of every node (None for fixed nodes).
     pub node_unknown: Vec<Option<usize>>,
     /// Fixed potential of every node (0 where free).
     pub node_fixed: Vec<f64>,
     /// Number of unknowns.
     pub n: usize,
+    /// Column pointers of the CSC matrix (both triangles stored).
     pub col_ptr: Vec<usize>,
+    /// Row index of every stored entry.
     pub row_idx: Vec<usize>,
+    /// Value of every stored entry.
     pub val: Vec<f64>,
     /// Position of the diagonal entry of every column.
     pub diag_pos: Vec<usize>,

@@ -3,7 +3,7 @@
 //! complementary coarsenings (issue 64).
 //!
 //! On a fixed mesh the state at a bias is a function of the bias alone (the potential with
-//! depletion and pockets does not depend on the solver's start, `field::depletion`), so a
+//! depletion and pockets does not depend on the solver's start, `field::active_set`), so a
 //! threshold found there depends on the mesh and on nothing else: not on which biases a C-V
 //! curve listed, nor on the order they were solved in. The list only says where to start
 //! looking: when the mesh disagrees with the listed points about which side of the threshold

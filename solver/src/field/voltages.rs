@@ -38,8 +38,8 @@
 
 use serde::Serialize;
 
+use super::active_set::solve_fast;
 use super::depleted;
-use super::depletion::solve_fast;
 use super::full_depletion::full_depletion_on_grid;
 use super::mesh::Mesh;
 use super::pinch_off::pinch_off_voltage_estimate;

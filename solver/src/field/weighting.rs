@@ -66,9 +66,12 @@ pub(crate) fn paper_epsilon_mesh(mesh: &Mesh, undepleted: &[bool], factor: f64) 
 
 /// What an undepleted node belongs to.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum Owner {
+pub enum Owner {
+    /// Contact k (its index in the detector's contacts).
     Contact(usize),
+    /// A grounded part.
     Ground,
+    /// Floating conductor g (one shared unknown).
     Floating(usize),
 }
 
@@ -83,7 +86,7 @@ pub struct WeightingPotentials {
 
 /// Labels every node: its owner if it is a conductor (contact, grounded, floating passive or an
 /// undepleted semiconductor node attached to one); `None` for free nodes.
-pub(crate) fn owners(
+pub fn owners(
     mesh: &Mesh,
     det: &Detector,
     undepleted: &[bool],
@@ -202,7 +205,7 @@ pub(crate) fn owners(
 /// The unknowns of the weighting problem: free where no conductor owns a node, fixed on contacts
 /// and grounded parts (their values per contact come with the right-hand side), one shared
 /// unknown per floating conductor.
-pub(crate) fn weighting_dofs(own: &[Option<Owner>]) -> Vec<Dof> {
+pub fn weighting_dofs(own: &[Option<Owner>]) -> Vec<Dof> {
     own.iter()
         .map(|o| match o {
             None => Dof::Free,

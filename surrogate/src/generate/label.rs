@@ -311,7 +311,7 @@ fn label_into(
     input: Input,
     input_hash: String,
 ) -> Result<LabelReport> {
-    let _lock = super::lock::FolderLock::acquire_named(out, "label.lock")?;
+    let _lock = hpge_foundation::FolderLock::acquire_named(out, "label.lock")?;
     let space_text = toml::to_string(&exact.space).unwrap_or_default();
     let settings_text = toml::to_string(&exact.settings).unwrap_or_default();
     let info = LabelInfo {

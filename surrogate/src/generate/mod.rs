@@ -3,7 +3,6 @@
 
 mod exact;
 mod label;
-mod lock;
 mod merge;
 mod regime;
 mod run;
@@ -13,8 +12,8 @@ mod setup;
 mod tests;
 
 pub use exact::{ExactSolver, SWITCH_RESOLUTION_V};
+pub use hpge_foundation::{FolderLock, LOCK_FILE};
 pub use label::{LABEL_C12_COLUMN, LabelInfo, LabelReport, SWITCH_COLUMN, SWITCH_WINDOW_V, label};
-pub use lock::{FolderLock, LOCK_FILE};
 pub use merge::{MergeReport, merge};
 pub use regime::{REGIME_COLUMNS, Regime};
 pub use run::{RunInfo, RunReport, format_row, format_row_with, read_rows, run};

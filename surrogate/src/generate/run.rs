@@ -194,7 +194,7 @@ fn run_in(
     progress: impl Fn(usize, usize) + Sync,
 ) -> Result<RunReport> {
     // One writer per folder, held until this function returns (`lock.rs`).
-    let _lock = super::lock::FolderLock::acquire(out)?;
+    let _lock = hpge_foundation::FolderLock::acquire(out)?;
     let info_path = out.join("generate.json");
     let rows_path = out.join("rows.csv");
     let mut info = RunInfo {

@@ -28,16 +28,7 @@ pub struct Figures {
     pub abs_rms_pf: f64,
 }
 
-/// Quantile q of sorted values (linear interpolation between order statistics).
-pub fn quantile(sorted: &[f64], q: f64) -> f64 {
-    if sorted.is_empty() {
-        return f64::NAN;
-    }
-    let pos = q.clamp(0.0, 1.0) * (sorted.len() - 1) as f64;
-    let i = pos.floor() as usize;
-    let j = (i + 1).min(sorted.len() - 1);
-    sorted[i] + (pos - i as f64) * (sorted[j] - sorted[i])
-}
+pub use hpge_foundation::quantile;
 
 /// Gaussian fit to a sample's histogram: the counts n_b of 60 bins spanning median +- 3 s
 /// (s = 1.4826 MAD, the robust sigma) are fitted by ln n_b = a + b x + c x^2 in weighted least

@@ -6,8 +6,8 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use super::normal::{normal_cdf, normal_quantile};
 use crate::error::{Error, Result};
+use hpge_foundation::{normal_cdf, normal_quantile};
 
 /// How a dimension is distributed over its range (a closed set).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]

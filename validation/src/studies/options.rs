@@ -5,6 +5,7 @@
 
 use std::path::PathBuf;
 
+use hpge_foundation::Shard;
 use hpge_inference::discover::WorkflowOptions;
 use hpge_inference::fit::{
     DEFAULT_DATA, DEFAULT_DETECTOR, DEFAULT_MODEL, DEFAULT_PRIOR, DEFAULT_REFINE_ROUNDS,
@@ -13,7 +14,6 @@ use hpge_inference::fit::{
 use hpge_inference::posterior::NoiseSettings;
 use hpge_inference::sampler::{DEFAULT_MODE_STARTS, DEFAULT_SEED};
 use hpge_inference::{DiscoverSettings, SamplerKind};
-use hpge_surrogate::Shard;
 
 use super::coverage::{CoverageSettings, DataFrom, PipelineSettings};
 use crate::error::Result;

@@ -4,7 +4,7 @@
 use std::sync::Arc;
 
 use crate::Result;
-use crate::model::{CvModel, NearCurves};
+use crate::model::{CurvesNear, CvModel};
 
 /// How the extra input a acts on the inner curve (a closed set).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -102,7 +102,7 @@ impl CvModel for Affine {
         x: &[f64],
         near: &[Vec<f64>],
         progress: &(dyn Fn(usize, usize) + Sync),
-    ) -> Result<NearCurves> {
+    ) -> Result<CurvesNear> {
         let n = x.len() - 1;
         let moved: Vec<usize> = (0..near.len())
             .filter(|&k| near[k][..n] != x[..n])

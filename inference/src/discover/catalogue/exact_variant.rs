@@ -6,7 +6,7 @@
 use hpge_solver::{Detector, cv_curve};
 use hpge_surrogate::ExactSolver;
 
-use crate::model::{CvModel, ExactModel, NearCurves, check_domain, near_curves};
+use crate::model::{CurvesNear, CvModel, ExactModel, check_domain, near_curves};
 use crate::{Error, Result};
 
 /// Applies an extension's values (`extra`, in the order of [`ExactVariant`]'s added inputs) to a
@@ -111,7 +111,7 @@ impl CvModel for ExactVariant {
         x: &[f64],
         near: &[Vec<f64>],
         progress: &(dyn Fn(usize, usize) + Sync),
-    ) -> Result<NearCurves> {
+    ) -> Result<CurvesNear> {
         let detector = |x: &[f64]| self.detector(x);
         let inputs = (self.names.as_slice(), self.domain.as_slice());
         near_curves(&self.base, inputs, x, near, &detector, progress)

@@ -8,7 +8,7 @@ use super::{CARRIERS, deepest_depression_v};
 use crate::carrier::Carrier;
 use crate::detector::Detector;
 use crate::expr::Parameters;
-use crate::field::depletion::{
+use crate::field::active_set::{
     FastSeed, PotentialSolution, solve_fast, solve_fast_seeded, solve_fast_with,
 };
 use crate::field::mesh::{Mesh, NodeKind};

@@ -32,11 +32,7 @@ mod wgpu;
 #[cfg(test)]
 mod wgpu_tests;
 
+pub use self::solve::solve_sor_with;
+pub use crate::relaxation::{SorSettings, default_omega};
 pub use solve::solve_sor;
 pub use wgpu::{solve_sor_wgpu, solve_sor_wgpu_with, weighting_potentials_wgpu};
-// The rest of the SOR interface, at the same paths as when this was one file; only the tests
-// use it so far (outside them the field module needs `solve_sor` alone).
-#[allow(unused_imports)]
-pub use self::solve::solve_sor_with;
-#[allow(unused_imports)]
-pub use crate::relaxation::{SorSettings, default_omega};

@@ -9,7 +9,7 @@ use super::stencil::{groups, initial, inverse_sum, undepleted_within, weights};
 use super::sweep::{Block, Coef, Layout, PARALLEL_MIN_NODES, half_sweep, to_nodes, update_blocks};
 use crate::detector::Detector;
 use crate::error::{Error, Result};
-use crate::field::depletion::{POCKET_TOL, PotentialSolution, potential_dofs};
+use crate::field::active_set::{POCKET_TOL, PotentialSolution, potential_dofs};
 use crate::field::mesh::{Mesh, NodeKind};
 use crate::field::pockets::{self, Ties, find_pockets};
 use crate::field::report::{Backend, Method, SolveReport, Termination};

@@ -1,14 +1,13 @@
 use std::path::{Path, PathBuf};
-use std::time::Instant;
 
 use super::sweep::{Coef, Layout, half_sweep};
 use super::{SorSettings, default_omega, solve_sor, solve_sor_with};
 use crate::detector::Detector;
 use crate::error::Error;
 use crate::expr::Parameters;
+use crate::field::active_set::PotentialSolution;
+use crate::field::active_set::solve_fast;
 use crate::field::capacitance::CapacitanceMatrix;
-use crate::field::depletion::PotentialSolution;
-use crate::field::depletion::solve_fast;
 use crate::field::mesh::{Mesh, NodeKind};
 use crate::field::point::pair;
 use crate::field::report::{Method, SolveReport, Termination};
@@ -376,105 +375,4 @@ fn solve_point_with_sor_matches_fast() {
         s.mesh.grid.nz(),
         s.reports.len()
     );
-}
-
-#[test]
-#[ignore = "measurement: sweeps against omega"]
-fn omega_scan() {
-    for (name, gs, biases) in [
-        ("coax-analytic.toml", coarse(), vec![25.0, 1025.0, 3600.0]),
-        ("super-siegfried-k1.toml", coarse(), vec![500.0, 2500.0]),
-        (
-            "coax-analytic.toml",
-            GridSettings::default(),
-            vec![25.0, 1025.0, 3600.0],
-        ),
-        (
-            "super-siegfried-k1.toml",
-            GridSettings::default(),
-            vec![500.0, 2500.0],
-        ),
-    ] {
-        let det = detector(name);
-        let m = mesh(&det, &gs);
-        println!(
-            "{name} {} x {} default omega {:.4}",
-            m.grid.nr(),
-            m.grid.nz(),
-            default_omega(m.grid.nr(), m.grid.nz())
-        );
-        for v in biases {
-            let f = solve_fast(&m, &det, v, None).unwrap();
-            let mut line = format!("  {v} V:");
-            for omega in [1.0, 1.5, 1.7, 1.8, 1.85, 1.9, 1.93, 1.95, 1.97, 1.98, 0.0] {
-                let s = SorSettings {
-                    omega: (omega > 0.0).then_some(omega),
-                    ..SorSettings::default()
-                };
-                let r = solve_sor_with(&m, &det, v, None, &s).unwrap();
-                let d = r
-                    .phi_v
-                    .iter()
-                    .zip(&f.phi_v)
-                    .map(|(a, b)| (a - b).abs())
-                    .fold(0.0, f64::max);
-                line += &format!(" {omega}:{}({:.0e})", r.report.iterations, d / v);
-            }
-            println!("{line}");
-        }
-    }
-}
-
-#[test]
-#[ignore = "measurement: sweeps against omega on refined meshes of solve_point"]
-fn omega_scan_refined() {
-    use crate::field::point::solve_point;
-    use crate::field::settings::FieldSettings;
-    for (name, v) in [
-        ("coax-analytic.toml", 1025.0),
-        ("coax-analytic.toml", 25.0),
-        ("super-siegfried-k1.toml", 500.0),
-        ("super-siegfried-k1.toml", 2500.0),
-    ] {
-        let det = detector(name);
-        let p = solve_point(&det, v, &FieldSettings::default(), None).unwrap();
-        let m = &p.mesh;
-        let t = Instant::now();
-        let f = solve_fast(m, &det, v, None).unwrap();
-        let tf = t.elapsed().as_secs_f64();
-        println!(
-            "{name} {v} V: {} x {} default omega {:.4}; fast {} it {tf:.3} s",
-            m.grid.nr(),
-            m.grid.nz(),
-            default_omega(m.grid.nr(), m.grid.nz()),
-            f.report.iterations
-        );
-        let mut line = String::new();
-        for omega in [1.9, 1.95, 1.98, 1.99, 0.0] {
-            let s = SorSettings {
-                omega: (omega > 0.0).then_some(omega),
-                ..SorSettings::default()
-            };
-            let r = solve_sor_with(m, &det, v, None, &s).unwrap();
-            let d = r
-                .phi_v
-                .iter()
-                .zip(&f.phi_v)
-                .map(|(a, b)| (a - b).abs())
-                .fold(0.0, f64::max);
-            let dm = r
-                .undepleted
-                .iter()
-                .zip(&f.undepleted)
-                .filter(|(a, b)| a != b)
-                .count();
-            line += &format!(
-                " {omega}:{}({:.2}s d{:.1e} m{dm})",
-                r.report.iterations,
-                r.report.seconds,
-                d / v
-            );
-        }
-        println!("{line}");
-    }
 }

@@ -9,7 +9,7 @@ use super::residual::projected_residual_within;
 use super::stencil::{device_problem, undepleted_within};
 use crate::detector::Detector;
 use crate::error::{Error, Result};
-use crate::field::depletion::{POCKET_TOL, PotentialSolution, potential_dofs};
+use crate::field::active_set::{POCKET_TOL, PotentialSolution, potential_dofs};
 use crate::field::mesh::Mesh;
 use crate::field::pockets::{self, Ties, find_pockets};
 use crate::field::report::{Backend, Method, SolveReport, Termination};

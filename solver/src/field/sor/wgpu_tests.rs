@@ -8,7 +8,7 @@ use super::wgpu::solve_sor_wgpu_with;
 use super::{SorSettings, default_omega, solve_sor, solve_sor_wgpu, weighting_potentials_wgpu};
 use crate::detector::Detector;
 use crate::error::Error;
-use crate::field::depletion::{potential_dofs, solve_fast};
+use crate::field::active_set::{potential_dofs, solve_fast};
 use crate::field::mesh::Mesh;
 use crate::field::point::solve_point;
 use crate::field::report::{Backend, Method};

@@ -10,8 +10,8 @@
 
 use std::time::Instant;
 
+use hpge_foundation::Shard;
 use hpge_inference::{Likelihood, Prior};
-use hpge_surrogate::Shard;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 

@@ -17,10 +17,10 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
+use hpge_foundation::FolderLock;
+use hpge_foundation::Shard;
 use hpge_inference::fit::{fingerprint, folder_files, remove_stale, write_whole};
 use hpge_inference::sampler::SamplerStop;
-use hpge_surrogate::Shard;
-use hpge_surrogate::generate::FolderLock;
 use serde::{Deserialize, Serialize};
 
 use super::settings::{CoverageSettings, DataFrom};

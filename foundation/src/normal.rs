@@ -5,7 +5,7 @@ use statrs::function::erf::{erfc, erfc_inv};
 /// Phi(z) = erfc(-z / sqrt 2) / 2.
 ///
 /// ```
-/// use hpge_surrogate::normal_cdf;
+/// use hpge_foundation::normal_cdf;
 /// assert_eq!(normal_cdf(0.0), 0.5);
 /// // The one-sided 2-sigma tail, 2.275%: statrs' erfc holds it to a few 1e-11 relative.
 /// assert!((normal_cdf(-2.0) / 0.022_750_131_948_179_2 - 1.0).abs() < 1e-10);
@@ -18,7 +18,7 @@ pub fn normal_cdf(z: f64) -> f64 {
 /// Newton step on Phi so that Phi(Phi^-1(u)) = u to a few ulps.
 ///
 /// ```
-/// use hpge_surrogate::{normal_cdf, normal_quantile};
+/// use hpge_foundation::{normal_cdf, normal_quantile};
 /// assert_eq!(normal_quantile(0.5), 0.0);
 /// assert!((normal_quantile(0.975) - 1.959_963_984_540_054).abs() < 1e-10);
 /// for u in [1e-6, 0.1, 0.9, 1.0 - 1e-6] {

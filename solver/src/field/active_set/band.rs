@@ -19,7 +19,7 @@
 //! proposes active sets, which the caller stops doing after a few iterations, so the plain
 //! method's finite convergence still holds.
 
-use super::system::System;
+use crate::field::system::System;
 
 /// State of a bounded unknown.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -182,8 +182,8 @@ mod tests {
     use super::BAND_STEPS;
     use crate::detector::Detector;
     use crate::expr::Parameters;
-    use crate::field::band::Bound;
-    use crate::field::depletion::{FastSeed, solve_with_band_steps};
+    use crate::field::active_set::band::Bound;
+    use crate::field::active_set::depletion::{FastSeed, solve_with_band_steps};
     use crate::field::mesh::Mesh;
     use crate::grid::{Grid, GridSettings};
 
@@ -261,7 +261,7 @@ mod tests {
     fn empty_or_nan_bounds_keep_the_plain_state() {
         let det = detector("planar-pn.toml");
         let m = mesh(&det, 0.25);
-        let (dofs, (lo, hi)) = crate::field::depletion::potential_dofs(&m, &det, 50.0);
+        let (dofs, (lo, hi)) = crate::field::active_set::potential_dofs(&m, &det, 50.0);
         let sys = super::System::assemble(&m, &dofs, &m.charge_c);
         let bounded = vec![true; sys.n];
         // A front in the middle: the first half active at the upper bound.
@@ -296,7 +296,7 @@ mod tests {
     fn band_is_the_graph_neighbourhood_of_the_seeds() {
         let det = detector("planar-pn.toml");
         let m = mesh(&det, 0.25);
-        let (dofs, _) = crate::field::depletion::potential_dofs(&m, &det, 50.0);
+        let (dofs, _) = crate::field::active_set::potential_dofs(&m, &det, 50.0);
         let sys = super::System::assemble(&m, &dofs, &m.charge_c);
         let bounded = vec![true; sys.n];
         let mid = sys.n / 2;

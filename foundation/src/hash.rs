@@ -3,7 +3,7 @@
 /// FNV-1a 64-bit hash (stable across platforms and versions; identifies inputs, not security).
 ///
 /// ```
-/// use hpge_surrogate::hash::fnv1a;
+/// use hpge_foundation::hash::fnv1a;
 /// // The published offset basis and a published test vector (Fowler, Noll, Vo).
 /// assert_eq!(fnv1a(b""), 0xcbf2_9ce4_8422_2325);
 /// assert_eq!(fnv1a(b"a"), 0xaf63_dc4c_8601_ec8c);

@@ -1,8 +1,11 @@
 //! Smoothed-aggregation algebraic multigrid (Vanek, Mandel & Brezina 1996) as the preconditioner
 //! of conjugate gradients: an O(N) linear solver for the field systems, measured against the
-//! sparse Cholesky of `cholesky.rs` (`tests::amg_timing`, reports/solver-performance.md).
+//! sparse Cholesky of the solver's `field/cholesky.rs` (the example `amg_timing` of this crate,
+//! `reports/solver-performance.md`).
 //!
-//! **Compiled for the tests only.** Measured on the project's 2-core machine on Super-Siegfried's
+//! **Not part of the product.** It lived in the solver's tests until issue 62 moved it here with
+//! its measurement; it stays as the starting point of the 3D solver's linear algebra (issue 65),
+//! where an O(N) method may win. Measured on the project's 2-core machine on Super-Siegfried's
 //! field systems from 3x10^3 to 8x10^5 unknowns, a cold solve to 1e-10 costs 1.4-1.8x faer's
 //! symbolic analysis, factorisation and solve together, and an active-set step (1% of the
 //! unknowns change) 1.9-3.0x a refactorisation and solve, even warm-started; with the previous
@@ -12,7 +15,7 @@
 //!
 //! Setup, level by level until at most `COARSE` unknowns remain:
 //! - strong couplings: -a_ij >= theta sqrt(a_ii a_jj) (the matrices are M-matrices);
-//! - aggregates of strongly coupled unknowns ([`aggregate`]); rows without off-diagonal entries
+//! - aggregates of strongly coupled unknowns (`aggregate.rs`); rows without off-diagonal entries
 //!   (active unknowns of the depletion problem are decoupled identity rows) join none: the
 //!   smoother solves them exactly;
 //! - the tentative prolongator, 1 on each unknown's aggregate, smoothed by one damped Jacobi step,
@@ -26,8 +29,10 @@
 
 mod aggregate;
 mod csr;
+mod system;
 
-pub(crate) use csr::Csr;
+pub use csr::Csr;
+pub use system::{csr, max_rel_diff, weighting_system};
 
 use aggregate::aggregate;
 
@@ -43,16 +48,16 @@ struct Level {
 }
 
 /// The multigrid hierarchy of one matrix.
-pub(crate) struct Amg {
+pub struct Amg {
     levels: Vec<Level>,
     /// Dense lower Cholesky factor of the coarsest matrix, row-major.
     coarse_l: Vec<f64>,
     coarse_n: usize,
 }
 
-/// Work of one [`pcg`] solve.
+/// Work of one [`Amg::pcg`] solve.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct PcgReport {
+pub struct PcgReport {
     /// CG iterations (one V-cycle each).
     pub iterations: usize,
     /// Final ||b - A x|| / ||b||.

@@ -12,14 +12,14 @@
 use std::time::Instant;
 
 use super::band::{BAND_STEPS, band_state};
-use super::mesh::{Mesh, NodeKind};
-use super::pockets::{self, Pocket, Ties, depression_depths_v, find_pockets};
-use super::report::{Backend, Method, SolveReport, Termination};
 use super::round::{Bound, Factored, Round, Saddle, pocket_ties};
-use super::system::{Dof, System};
 use crate::carrier::Carrier;
 use crate::detector::Detector;
 use crate::error::{Error, Result};
+use crate::field::mesh::{Mesh, NodeKind};
+use crate::field::pockets::{self, Pocket, Ties, depression_depths_v, find_pockets};
+use crate::field::report::{Backend, Method, SolveReport, Termination};
+use crate::field::system::{Dof, System};
 
 /// The potential with depletion on one mesh.
 #[derive(Debug, Clone)]
@@ -93,7 +93,7 @@ pub(crate) const POCKET_CYCLE_TOL: f64 = 1e-3;
 /// levels l_k (x = x_0 + sum_k l_k y_k, one triangular solve per pocket with the same
 /// factorisation) and l_k = x(s_k) at each pour point s_k closes the system. Its first
 /// iterations take the active set that a projected relaxation in a band around the front
-/// proposes (`field::band`), so the front crosses many grid layers per factorisation; a seeded
+/// proposes (`field::active_set::band`), so the front crosses many grid layers per factorisation; a seeded
 /// solve moves its guess's front that way before the first factorisation. The answer is the
 /// plain method's: a round ends only when a plain step leaves the active set unchanged.
 pub fn solve_fast(

@@ -3,7 +3,7 @@
 
 /// A sparse matrix in compressed sparse rows.
 #[derive(Debug, Clone, PartialEq)]
-pub(crate) struct Csr {
+pub struct Csr {
     /// Rows.
     pub rows: usize,
     /// Columns.

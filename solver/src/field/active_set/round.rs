@@ -10,12 +10,12 @@
 
 pub(crate) use super::band::Bound;
 use super::band::band_state;
-use super::cholesky::{Factor, Symbolic};
-use super::pockets::Ties;
-use super::report::Method;
-use super::system::System;
 use crate::carrier::Carrier;
 use crate::error::{Error, Result};
+use crate::field::cholesky::{Factor, Symbolic};
+use crate::field::pockets::Ties;
+use crate::field::report::Method;
+use crate::field::system::System;
 
 /// Largest number of active-set iterations in one round before giving up.
 pub(crate) const MAX_ACTIVE_SET_ITERATIONS: usize = 200;
