@@ -8,7 +8,7 @@
 
 use hpge_solver::detector::legend::{LegendOptions, convert_json};
 use hpge_solver::drift::Carrier;
-use hpge_solver::field::{PotentialPoint, depressions, solve_potential};
+use hpge_solver::field::{Mesh, PotentialPoint, depressions, solve_fast, solve_potential};
 use hpge_solver::{Detector, FieldSettings, Parameters};
 use hpge_validation::{legend_detector, repo_path};
 
@@ -59,6 +59,35 @@ fn deepest_hole(det: &Detector, u: f64, s: &FieldSettings) -> Option<(f64, bool,
         p.potential.pockets
     );
     holes(&p, &p.potential.phi_v).first().copied()
+}
+
+/// V99000A's U_fd on the reference grid and on the same grid with every interval divided into 4
+/// agree: the corner well of the recess (r 3 mm, z 0), which the finer grid's r ticks 3.9 um
+/// apart spread over two of them (4 nodes, 0.38 V deep at 3000 V), is thinner than a Debye
+/// length (24 um at 10^10 cm^-3) and holds no pocket. Measured 2026-12-07 with
+/// `validation/examples/depletion_error.rs`: 1686.0 V on the reference grid (55 550 nodes),
+/// 1630.3 V on the 4x one (883 085 nodes); before the Debye-length rule the 4x grid kept a
+/// one-node "pocket" from the active set's cycling rounds and never depleted below 3500 V.
+#[test]
+fn the_recess_corner_well_keeps_no_pocket_on_a_four_times_finer_grid() {
+    let det = v99000a();
+    let s = FieldSettings::default().for_detector(&det);
+    let q = hpge_solver::solve_point(&det, 1750.0, &s, None).unwrap();
+    assert!(q.fully_depleted(), "1750 V on the reference grid");
+    let fine = Mesh::new(&det, q.mesh.grid.subdivided(4));
+    let sol = solve_fast(&fine, &det, 3000.0, None).unwrap();
+    assert!(sol.pockets.is_empty(), "{:?}", sol.pockets);
+    assert!(
+        !sol.undepleted.iter().any(|&u| u),
+        "undepleted nodes at 3000 V"
+    );
+    let u_fd = hpge_solver::full_depletion_voltage(&fine, &det, 0.0, 3500.0).unwrap();
+    let u_ref = hpge_solver::full_depletion_voltage(&q.mesh, &det, 0.0, 3500.0).unwrap();
+    eprintln!("V99000A U_fd: reference grid {u_ref} V, 4x finer {u_fd} V");
+    assert!(
+        (u_fd - 1630.3).abs() < 1.0 && (u_ref - 1686.0).abs() < 1.0,
+        "{u_ref} {u_fd}"
+    );
 }
 
 #[test]

@@ -40,8 +40,11 @@ pub(crate) mod weighting;
 /// contact (`front::can_hold_layer`: LEGEND's P99000A, whose slanted n+ contact's staircase read
 /// as such a layer, depletes at 2130 V instead of never; of 40 rows of `heldout-300000.csv`
 /// solved again, 39 identical and one 7.8e-5 relative apart; every c12 of the detector sweep and
-/// every U_fd of the depletion table unchanged).
-pub const PHYSICS_REVISION: &str = "2026-12-07 no layer of majority carriers at the opposite bound";
+/// every U_fd of the depletion table unchanged); 2026-12-07, a depression on the crystal's
+/// surface thinner than a Debye length along r or z is no pocket (`pockets::resolution`, before
+/// it: one grid line; LEGEND's V99000A, whose recess-corner well covered two r ticks 3.9 um
+/// apart on the 4x grid, depletes there at 1630.3 V instead of above 3500 V).
+pub const PHYSICS_REVISION: &str = "2026-12-07 surface wells thinner than a Debye length";
 
 pub use active_set::{MAX_POCKET_ROUNDS, PotentialSolution, solve_fast, solve_fast_with};
 pub use adaptive::Accuracy;

@@ -175,7 +175,7 @@ pub(crate) fn flood(
 /// The deepest depression of `side`'s landscape among nodes whose fixed charge has the sign of
 /// that carrier's material (p-type for holes, n-type for electrons), V: max over those nodes of
 /// |F(n) - phi_n|, 0 when there is none, with the deepest node. Depressions the grid does not
-/// resolve (on one grid line of the surface, `resolution.rs`) do not count. A potential with depletion and
+/// resolve (on the surface and thinner than a Debye length, `resolution.rs`) do not count. A potential with depletion and
 /// pockets solved right has none deeper than round-off: every trapped-carrier pocket is flat at
 /// its spill level. Independent of the solvers (used by tests and reports as a check).
 pub fn deepest_depression_v(

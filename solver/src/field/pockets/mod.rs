@@ -84,8 +84,8 @@ pub(crate) type Ties = Vec<Option<Tie>>;
 /// The ties for the potential `phi_v`: every node of a carrier's material inside that carrier's
 /// depression is tied to its pour point. `occupied` marks the nodes that held trapped carriers in
 /// the solve that produced `phi_v` (so that a pocket at its spill level keeps its tie).
-/// A depression confined to one grid line on the crystal's surface is not tied
-/// (`resolution.rs`: the grid does not resolve it, and it vanishes on a finer one; issue 64).
+/// A depression on the crystal's surface thinner than a Debye length is not tied
+/// (`resolution.rs`: it holds no neutral region; issue 64).
 pub(crate) fn ties(
     mesh: &Mesh,
     phi_v: &[f64],
