@@ -5,8 +5,9 @@ use plotters::style::RGBColor;
 
 use crate::error::Error;
 
-/// One colour per chain, profile or parameter (tab10); the coverage figures use it too.
-pub(crate) const PALETTE: [RGBColor; 10] = [
+/// One colour per chain, profile or parameter (tab10, then black and dark magenta for the 11th
+/// and 12th series); the coverage figures use it too.
+pub(crate) const PALETTE: [RGBColor; 12] = [
     RGBColor(31, 119, 180),
     RGBColor(255, 127, 14),
     RGBColor(44, 160, 44),
@@ -17,6 +18,8 @@ pub(crate) const PALETTE: [RGBColor; 10] = [
     RGBColor(127, 127, 127),
     RGBColor(188, 189, 34),
     RGBColor(23, 190, 207),
+    RGBColor(0, 0, 0),
+    RGBColor(139, 0, 139),
 ];
 
 /// The legend most figures use: a framed, slightly transparent box at `position`.
