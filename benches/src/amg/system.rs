@@ -1,8 +1,6 @@
 //! The solver's field systems as test matrices for the multigrid: the weighting problem of a
 //! shipped detector, assembled by the solver itself (`hpge_solver::internals`).
 
-use std::path::Path;
-
 use hpge_solver::Result;
 use hpge_solver::detector::Detector;
 use hpge_solver::expr::Parameters;
@@ -19,9 +17,7 @@ use super::Csr;
 /// # Errors
 /// The detector file does not load or its contacts cannot be labelled.
 pub fn weighting_system(name: &str, h_mm: f64, k: usize) -> Result<(System, Vec<f64>)> {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../detectors")
-        .join(name);
+    let path = hpge_validation::repo_path(&format!("detectors/{name}"));
     let det = Detector::from_file(&path, &Parameters::new())?;
     let s = GridSettings {
         max_spacing_semiconductor_mm: h_mm,

@@ -67,16 +67,15 @@ struct Extent {
 /// where [`crate::constants::EPS_R_GERMANIUM`] is given (78 K).
 const DEBYE_TEMPERATURE_K: f64 = 78.0;
 
-/// Boltzmann's constant, J/K (exact, SI 2019).
-const BOLTZMANN_J_PER_K: f64 = 1.380_649e-23;
-
 /// The extrinsic Debye length (mm) of germanium with `density_m3` ionised impurities at 78 K:
 /// L_D = sqrt(eps_0 eps_r k T / (q^2 N)), about 24 um at 10^10 cm^-3 (10^16 m^-3). Free carriers
 /// screen a potential over L_D, so an undepleted region thinner than it has no neutral core: the
 /// depletion approximation that the active set solves does not hold across it. Infinite where
 /// there is no charge.
 pub(crate) fn debye_length_mm(density_m3: f64) -> f64 {
-    use crate::constants::{ELEMENTARY_CHARGE_C, EPS_R_GERMANIUM, VACUUM_PERMITTIVITY_F_PER_M};
+    use crate::constants::{
+        BOLTZMANN_J_PER_K, ELEMENTARY_CHARGE_C, EPS_R_GERMANIUM, VACUUM_PERMITTIVITY_F_PER_M,
+    };
     if density_m3 <= 0.0 {
         return f64::INFINITY;
     }
@@ -133,7 +132,7 @@ fn extents(mesh: &Mesh, side: Carrier, pour: &[Option<usize>]) -> HashMap<usize,
 /// True when a depression is resolved (module docs): it has a node inside the crystal, or it is
 /// at least a Debye length thick along both r and z (a depression on one grid line has no
 /// thickness at all).
-fn spans_a_cell(e: &Extent) -> bool {
+fn is_resolved(e: &Extent) -> bool {
     let l_mm = debye_length_mm(e.density_m3);
     !e.surface || (e.r_mm.1 - e.r_mm.0 >= l_mm && e.z_mm.1 - e.z_mm.0 >= l_mm)
 }
@@ -147,7 +146,7 @@ pub(crate) fn line_depressions(
 ) -> HashSet<usize> {
     extents(mesh, side, pour)
         .into_iter()
-        .filter(|(_, e)| !spans_a_cell(e))
+        .filter(|(_, e)| !is_resolved(e))
         .map(|(s, _)| s)
         .collect()
 }
@@ -201,7 +200,7 @@ pub fn depressions(
             nodes: ext[&s].nodes,
             depth_v: d,
             deepest_node: n,
-            resolved: spans_a_cell(&ext[&s]),
+            resolved: is_resolved(&ext[&s]),
         })
         .collect();
     out.sort_by(|a, b| {
