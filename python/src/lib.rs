@@ -47,8 +47,8 @@ fn matrix<'py>(py: Python<'py>, rows: &[Vec<f64>]) -> PyResult<Bound<'py, PyArra
     PyArray2::from_vec2(py, rows).map_err(err)
 }
 
-/// hpge-cv from Python: detectors, C-V curves, capacitance, pulses and fields from the field
-/// solver; surrogate predictions; measurement of raw pulser data; Bayesian fits. Units: mm, V,
+/// hpge-cv from Python: detectors, C-V curves, capacitance, pulses, fields, sensitivity scans
+/// and grid convergence from the field solver (the command line's jobs, the same records); surrogate predictions; measurement of raw pulser data; Bayesian fits. Units: mm, V,
 /// cm^-3 (signed, positive n-type), pF, ns, V/cm.
 #[pymodule]
 fn hpge_cv(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -61,6 +61,8 @@ fn hpge_cv(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(depletion::depletion_records, m)?)?;
     m.add_function(wrap_pyfunction!(solve::pulse, m)?)?;
     m.add_function(wrap_pyfunction!(solve::field, m)?)?;
+    m.add_function(wrap_pyfunction!(solve::sensitivity, m)?)?;
+    m.add_function(wrap_pyfunction!(solve::convergence, m)?)?;
     m.add_function(wrap_pyfunction!(surrogate::predict, m)?)?;
     m.add_function(wrap_pyfunction!(measure::measure, m)?)?;
     m.add_function(wrap_pyfunction!(fit::fit, m)?)?;

@@ -216,6 +216,18 @@ pub enum Error {
         /// What is wrong (the text the user sees; it quotes the expression where that helps).
         reason: String,
     },
+    /// An option of a solver job ([`crate::jobs`]) that the job refuses, named by its library
+    /// name (the Python argument's, e.g. `voltage`, `phi_deg`); a face spells it its own way with
+    /// [`Error::respell`] (the command line: `--voltage`, `--phi`).
+    #[error("{option}{}: {message}", value.as_ref().map_or(String::new(), |v| format!(" {v}")))]
+    JobOption {
+        /// The option's name.
+        option: String,
+        /// The value as given, where there is one to quote.
+        value: Option<String>,
+        /// What is wrong with it.
+        message: String,
+    },
     /// A value built in code or given through the API is invalid (settings, model parameters,
     /// spline knots, grid ticks) where no file is involved; callers that know the file or the
     /// command-line flag put it in front of the message.
@@ -251,6 +263,24 @@ impl DetectorPart {
 pub type Result<T, E = Error> = std::result::Result<T, E>;
 
 impl Error {
+    /// The error with a job option's name spelt by a face: `spell` maps the library name of an
+    /// [`Error::JobOption`] (e.g. `voltage`) to the face's (e.g. `--voltage`); other errors are
+    /// returned unchanged.
+    pub fn respell(self, spell: impl Fn(&str) -> String) -> Self {
+        match self {
+            Error::JobOption {
+                option,
+                value,
+                message,
+            } => Error::JobOption {
+                option: spell(&option),
+                value,
+                message,
+            },
+            e => e,
+        }
+    }
+
     /// Whether a sampler may treat this error as a rejected proposal (zero posterior density):
     /// a solve at one point that failed (not converged, singular, an undepleted bridge between
     /// contacts). Bad files, settings, arguments and GPU failures are not: they end a run.
@@ -274,7 +304,8 @@ impl Error {
             | Error::InteractionOutside { .. }
             | Error::NoNetCharge { .. }
             | Error::Expression { .. }
-            | Error::InvalidValue { .. } => false,
+            | Error::InvalidValue { .. }
+            | Error::JobOption { .. } => false,
             Error::ScanPointFailed { source, .. } => source.is_recoverable(),
         }
     }

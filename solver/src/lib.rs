@@ -17,6 +17,9 @@
 //! - [`field`]: field solves: potential with depletion, weighting potentials, capacitances,
 //!   C-V curves, depletion and pinch-off voltages.
 //! - [`drift`]: the electric field of a solved point, charge drift and pulses.
+//! - [`jobs`]: one library call per solver command (`simulate`, `capacitance`, `field`,
+//!   `pulse`, `sensitivity`, `convergence`) with its options, record and table: the pipeline
+//!   the command line and the Python module both run.
 //! - [`gpu`]: the wgpu backend's adapter and precision.
 //! - [`options`]: the options of the commands that load a detector and solve fields
 //!   ([`options::DetectorInput`], [`options::SolverOptions`], [`GridOverrides`]), declared once
@@ -60,6 +63,7 @@ pub mod geometry;
 pub mod gpu;
 pub mod grid;
 pub mod impurity;
+pub mod jobs;
 pub mod material;
 pub mod options;
 pub mod scan;

@@ -150,6 +150,21 @@ pub fn with_detector_provenance(mut v: serde_json::Value, det: &Detector) -> ser
     v
 }
 
+/// The command line's spelling of a solver job's option (`hpge_solver::jobs`; its library name
+/// is the Python argument's): `voltage` -> `--voltage`, `phi_deg` -> `--phi`, `z_mm` -> `--z`,
+/// `r_mm` -> `--r-range`, `zetas_cm3` -> `--zeta-range`, `method/backend` ->
+/// `--method/--backend`; otherwise `--` and the name with `-` for `_`.
+pub fn flag(option: &str) -> String {
+    match option {
+        "phi_deg" => "--phi".into(),
+        "z_mm" => "--z".into(),
+        "r_mm" => "--r-range".into(),
+        "zetas_cm3" => "--zeta-range".into(),
+        "method/backend" => "--method/--backend".into(),
+        o => format!("--{}", o.replace('_', "-")),
+    }
+}
+
 /// The input files of a [`DetectorInput`] as (flag, path).
 pub fn detector_inputs(input: &DetectorInput) -> Vec<(&'static str, &std::path::Path)> {
     let mut v = vec![("--detector", input.detector.as_path())];

@@ -2,10 +2,9 @@
 
 use std::path::PathBuf;
 
-use anyhow::{Result, bail};
+use anyhow::Result;
 use hpge_reports::plot;
-use hpge_solver::field::convergence_study;
-use serde_json::json;
+use hpge_solver::jobs;
 
 use super::DetectorInput;
 use super::args::load_detector;
@@ -34,27 +33,22 @@ pub struct ConvergenceArgs {
 
 /// Runs the study and prints (and draws) it.
 pub fn run(a: &ConvergenceArgs) -> Result<()> {
-    if !(a.voltage.is_finite() && a.voltage > 0.0) {
-        bail!(
-            "--voltage {}: the bias must be a positive number of volts",
-            a.voltage
-        );
-    }
-    if !(1..=8).contains(&a.levels) {
-        bail!("--levels {}: give 1 to 8 fixed grids", a.levels);
-    }
     if let Some(p) = &a.plot {
         plot::check_output(p, "--plot")?;
     }
     let det = load_detector(&a.input)?;
-    det.check_bias_contact()?;
-    let settings = a.solver.grid.apply(
-        &a.solver
-            .field_settings(WeightingOptions::default().weighting),
-        &det,
-    )?;
-    super::simulate::backend_json(&settings)?;
-    let rows = convergence_study(&det, a.voltage, &settings, a.levels)?;
+    let options = jobs::ConvergenceOptions {
+        voltage_v: a.voltage,
+        levels: a.levels,
+        settings: a.solver.grid.apply(
+            &a.solver
+                .field_settings(WeightingOptions::default().weighting),
+            &det,
+        )?,
+    };
+    let (rows, record) =
+        jobs::convergence(&det, &options).map_err(|e| e.respell(super::args::flag))?;
+    let settings = &options.settings;
     let finest = rows
         .iter()
         .filter(|r| !r.adaptive)
@@ -71,23 +65,7 @@ pub fn run(a: &ConvergenceArgs) -> Result<()> {
         plot::convergence(&rows, &title, p)?;
     }
     if a.json {
-        let v = json!({
-            "detector": det.file.display().to_string(),
-            "voltage_V": a.voltage,
-            "tolerance": settings.grid.tolerance,
-            "rows": rows.iter().map(|r| json!({
-                "scale": r.scale,
-                "spacing_mm": r.spacing_mm,
-                "nodes": r.nodes,
-                "c12_pF": r.c12_pf,
-                "c12_err_pF": r.c12_err_pf,
-                "adaptive": r.adaptive,
-                "seconds": r.seconds,
-            })).collect::<Vec<_>>(),
-            "grid": settings.grid,
-            "parameters": det.parameters.iter().collect::<std::collections::BTreeMap<_, _>>(),
-            "version": env!("CARGO_PKG_VERSION"),
-        });
+        let v = serde_json::to_value(&record)?;
         outln!("{v}");
     } else {
         outln!(

@@ -1,22 +1,17 @@
 //! `hpge-cv field`: the electric-field strength |E| along r at one (phi, z) and bias (paper
 //! Fig. 29a, section 9); null where the volume is undepleted, a contact or outside the crystal.
+//! The face of `hpge_solver::jobs::field`.
 
-use std::io::Write as _;
 use std::path::PathBuf;
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use hpge_reports::plot;
-use hpge_solver::drift::ElectricField;
-use hpge_solver::drift::field_line;
+use hpge_solver::jobs;
 use serde_json::json;
 
 use super::DetectorInput;
 use super::args::{RadiusRange, load_detector, parse_r_range};
-use super::simulate::backend_json;
 use hpge_solver::options::{SolverOptions, WeightingOptions};
-
-/// V/m per V/cm.
-const V_PER_M_PER_V_PER_CM: f64 = 100.0;
 
 #[derive(Debug, clap::Args)]
 pub struct FieldArgs {
@@ -55,75 +50,28 @@ pub fn run(a: &FieldArgs) -> Result<()> {
     if let Some(p) = &a.plot {
         plot::check_output(p, "--plot")?;
     }
-    if !(a.voltage.is_finite() && a.voltage > 0.0) {
-        bail!(
-            "--voltage {}: the bias must be a positive number of volts",
-            a.voltage
-        );
-    }
-    for (flag, v) in [("--phi", a.phi), ("--z", a.z)] {
-        if !v.is_finite() {
-            bail!("{flag} {v}: must be a finite number");
-        }
-    }
     let det = load_detector(&a.input)?;
-    det.check_bias_contact()?;
-    let b = det.semiconductor.geometry.bbox();
-    if a.z < b.z_min_mm || a.z > b.z_max_mm {
-        bail!(
-            "--z {}: the crystal spans z in [{}, {}] mm",
-            a.z,
-            b.z_min_mm,
-            b.z_max_mm
-        );
-    }
-    let r_mm = match &a.r_range {
-        Some(RadiusRange(r)) => r.clone(),
-        None => (0..201)
-            .map(|k| b.r_min_mm + (b.r_max_mm - b.r_min_mm) * k as f64 / 200.0)
-            .collect(),
+    let options = jobs::FieldOptions {
+        voltage_v: a.voltage,
+        phi_deg: a.phi,
+        z_mm: a.z,
+        r_mm: a.r_range.as_ref().map(|RadiusRange(r)| r.clone()),
+        settings: a.solver.grid.apply(
+            &a.solver
+                .field_settings(WeightingOptions::default().weighting),
+            &det,
+        )?,
     };
-    let settings = a.solver.grid.apply(
-        &a.solver
-            .field_settings(WeightingOptions::default().weighting),
-        &det,
-    )?;
-    backend_json(&settings)?;
-    let point = hpge_solver::solve_point(&det, a.voltage, &settings, None)?;
-    let field = ElectricField::new(&det, &point);
-    let line = field_line(&det, &field, a.phi.to_radians(), a.z, &r_mm);
-    let v_cm: Vec<Option<f64>> = line
-        .e_v_per_m
-        .iter()
-        .map(|e| e.map(|e| e / V_PER_M_PER_V_PER_CM))
-        .collect();
-    let provenance = format!(
-        "hpge-cv {} field: detector {} impurity {} parameters [{}] U_B {} V, phi {} deg, z {} mm",
-        env!("CARGO_PKG_VERSION"),
-        det.file.display(),
-        det.semiconductor.impurity_file().display(),
-        det.parameters
-            .iter()
-            .map(|(k, v)| format!("{k}={v}"))
-            .collect::<Vec<_>>()
-            .join(" "),
-        a.voltage,
-        a.phi,
-        a.z
-    );
+    let run = jobs::field(&det, &options).map_err(|e| e.respell(super::args::flag))?;
+    let line = &run.line;
+    let v_cm = &run.e_v_per_cm;
+    let provenance = run.provenance_line();
     // The CSV and its sidecar under their names only once the figure is drawn too.
     let mut staged = hpge_files::Staged::new();
     if let Some(path) = &a.out {
         let ctx = || format!("--out {}: cannot write the file", path.display());
         staged
-            .write_with(path, |f| -> std::io::Result<()> {
-                writeln!(f, "r_mm,e_V_per_cm,status")?;
-                for ((r, e), s) in line.r_mm.iter().zip(&v_cm).zip(&line.status) {
-                    let e = e.map_or(String::new(), |e| e.to_string());
-                    writeln!(f, "{r},{e},{}", s.as_str())?;
-                }
-                Ok(())
-            })
+            .write_with(path, |f| run.write_csv(f))
             .with_context(ctx)?;
         super::sidecar::stage(
             &mut staged,
@@ -167,19 +115,7 @@ pub fn run(a: &FieldArgs) -> Result<()> {
     }
     super::args::commit(staged)?;
     if a.json {
-        let v = super::args::with_detector_provenance(
-            json!({
-                "r_mm": line.r_mm,
-                "e_V_per_m": line.e_v_per_m,
-                "e_V_per_cm": v_cm,
-                "status": line.status.iter().map(|s| s.as_str()).collect::<Vec<_>>(),
-                "phi_deg": a.phi,
-                "z_mm": a.z,
-                "voltage_V": a.voltage,
-                "fully_depleted": point.fully_depleted(),
-            }),
-            &det,
-        );
+        let v = serde_json::to_value(run.record())?;
         outln!("{v}");
     } else {
         outln!(
@@ -190,7 +126,7 @@ pub fn run(a: &FieldArgs) -> Result<()> {
             det.name
         );
         outln!("{:>10} {:>14} {:>11}", "r (mm)", "|E| (V/cm)", "status");
-        for ((r, e), s) in line.r_mm.iter().zip(&v_cm).zip(&line.status) {
+        for ((r, e), s) in line.r_mm.iter().zip(v_cm).zip(&line.status) {
             let e = e.map_or("-".to_string(), |e| format!("{e:.1}"));
             outln!("{r:>10.3} {e:>14} {:>11}", s.as_str());
         }

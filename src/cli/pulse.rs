@@ -1,26 +1,17 @@
 //! `hpge-cv pulse`: the charge signals of one interaction (paper section 9): the field at one
 //! bias, an electron and a hole drifted with the ADL model, Shockley-Ramo signals on every
-//! contact.
+//! contact. The face of `hpge_solver::jobs::pulse`.
 
-use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 use hpge_reports::plot;
-use hpge_solver::drift::AdlModel;
 use hpge_solver::drift::AdlParameters;
-use hpge_solver::drift::DriftSettings;
-use hpge_solver::drift::ElectricField;
-use hpge_solver::drift::check_interaction_point;
-use hpge_solver::drift::normalise_signals;
-use hpge_solver::drift::reference_contact;
-use hpge_solver::drift::rise_time_10_90_ns;
-use hpge_solver::{Detector, Pulse};
+use hpge_solver::{Detector, Error, jobs};
 use serde_json::json;
 
 use super::DetectorInput;
 use super::args::{load_detector, parse_cylindrical};
-use super::simulate::backend_json;
 use hpge_solver::options::{SolverOptions, WeightingOptions};
 
 #[derive(Debug, clap::Args)]
@@ -79,154 +70,56 @@ pub fn run(a: &PulseArgs) -> Result<()> {
             dir.display()
         );
     }
-    if !(a.voltage.is_finite() && a.voltage > 0.0) {
-        bail!(
-            "--voltage {}: the bias must be a positive number of volts",
-            a.voltage
-        );
-    }
     let adl = match &a.drift_parameters {
-        Some(p) => read_adl_parameters(p, "--drift-parameters")?,
+        Some(p) => jobs::read_adl_parameters(p).context("--drift-parameters")?,
         None => AdlParameters::default(),
     };
-    let model =
-        AdlModel::new(adl.clone()).map_err(|m| anyhow::anyhow!("--drift-parameters: {m}"))?;
     let det = load_detector(&a.input)?;
-    det.check_bias_contact()?;
-    let (r_mm, phi_deg, z_mm) = a.at;
-    let flag = format!("--at {r_mm},{phi_deg},{z_mm}");
-    // Cheap geometric checks before the field solve.
-    if let hpge_solver::detector::Region::Contact(i) = det.classify(r_mm, z_mm) {
-        let e = hpge_solver::Error::InteractionInContact {
-            r_mm,
-            z_mm,
-            contact: det.contacts[i].name.clone(),
-        };
-        return Err(anyhow::Error::new(e).context(flag));
-    }
-    let settings = a.solver.grid.apply(
-        &a.solver
-            .field_settings(WeightingOptions::default().weighting),
-        &det,
-    )?;
-    backend_json(&settings)?;
-    let point = hpge_solver::solve_point(&det, a.voltage, &settings, None)?;
-    let field = ElectricField::new(&det, &point);
-    check_interaction_point(&det, &point, &field, (r_mm, z_mm)).context(flag)?;
-    let drift = DriftSettings::default();
-    let mut p = hpge_solver::pulse(
-        &det,
-        &point,
-        &model,
-        (r_mm, phi_deg.to_radians(), z_mm),
-        &drift,
-    )?;
-    let k_ref = reference_contact(&det);
-    let divisor = if a.normalise {
-        Some(normalise_signals(&mut p, k_ref).context("--normalise")?)
-    } else {
-        None
-    };
-    let provenance = Provenance {
-        det: &det,
+    let options = jobs::PulseOptions {
         voltage_v: a.voltage,
         at: a.at,
-        drift_file: a.drift_parameters.as_deref(),
-        normalised: a.normalise,
+        adl,
+        drift_file: a.drift_parameters.clone(),
+        normalise: a.normalise,
+        settings: a.solver.grid.apply(
+            &a.solver
+                .field_settings(WeightingOptions::default().weighting),
+            &det,
+        )?,
     };
+    let (r_mm, phi_deg, z_mm) = a.at;
+    let run = jobs::pulse(&det, &options).map_err(|e| match e {
+        // Where the point cannot start a drift, the message names the flag and the point.
+        e @ (Error::InteractionInContact { .. }
+        | Error::InteractionUndepleted { .. }
+        | Error::InteractionOutside { .. }) => {
+            anyhow::Error::new(e).context(format!("--at {r_mm},{phi_deg},{z_mm}"))
+        }
+        e => e.respell(super::args::flag).into(),
+    })?;
     // The CSV and its sidecar under their names only once the figure is drawn too.
     let mut staged = hpge_files::Staged::new();
     if let Some(path) = &a.out {
-        write_csv(&mut staged, path, &p, &provenance)?;
+        write_csv(&mut staged, path, &run, &det)?;
     }
     if let Some(path) = &a.plot {
-        plot::line_figure(&pulse_figure(&p, &provenance), path)?;
+        plot::line_figure(&pulse_figure(&run), path)?;
     }
     super::args::commit(staged)?;
-    let rise = rise_time_10_90_ns(&p.t_ns, &p.signals[k_ref].charge);
     if a.json {
-        let v = super::args::with_detector_provenance(
-            json!({
-                "t_ns": p.t_ns,
-                "contacts": p.signals.iter().map(|s| json!({"name": s.name, "signal": s.charge})).collect::<Vec<_>>(),
-                "collection_time_ns": p.collection_time_ns,
-                "electron": p.electron.outcome(&det),
-                "hole": p.hole.outcome(&det),
-                "normalised": a.normalise,
-                "normalised_by": divisor,
-                "reference_contact": det.contacts[k_ref].name,
-                "rise_time_10_90_ns": rise,
-                "at": {"r_mm": r_mm, "phi_deg": phi_deg, "z_mm": z_mm},
-                "voltage_V": a.voltage,
-                "fully_depleted": point.fully_depleted(),
-                "drift_model": {"name": "ADL", "file": a.drift_parameters.as_ref().map(|f| f.display().to_string()), "parameters": adl},
-                "drift_settings": drift,
-            }),
-            &det,
-        );
-        outln!("{v}");
+        outln!("{}", serde_json::to_value(run.record())?);
     } else {
-        print_summary(&det, &p, &provenance, rise, divisor)?;
+        print_summary(&det, &run)?;
     }
     Ok(())
 }
 
-/// ADL parameters from a TOML file (missing keys keep the published defaults), checked.
-fn read_adl_parameters(path: &Path, flag: &str) -> Result<AdlParameters> {
-    let text = std::fs::read_to_string(path)
-        .with_context(|| format!("{flag} {}: cannot read the file", path.display()))?;
-    let p: AdlParameters = toml::from_str(&text)
-        .with_context(|| format!("{flag} {}: not a valid ADL parameter file", path.display()))?;
-    p.validate()
-        .map_err(|m| anyhow::anyhow!("{flag} {}: {m}", path.display()))?;
-    Ok(p)
-}
-
-/// The inputs every output records.
-struct Provenance<'a> {
-    det: &'a Detector,
-    voltage_v: f64,
-    at: (f64, f64, f64),
-    drift_file: Option<&'a Path>,
-    normalised: bool,
-}
-
-impl Provenance<'_> {
-    fn line(&self) -> String {
-        let (r, phi, z) = self.at;
-        let params: Vec<String> = self
-            .det
-            .parameters
-            .iter()
-            .map(|(k, v)| format!("{k}={v}"))
-            .collect();
-        format!(
-            "hpge-cv {} pulse: detector {} impurity {} parameters [{}] U_B {} V at r {r} mm phi {phi} deg z {z} mm; ADL {}{}",
-            env!("CARGO_PKG_VERSION"),
-            self.det.file.display(),
-            self.det.semiconductor.impurity_file().display(),
-            params.join(" "),
-            self.voltage_v,
-            self.drift_file
-                .map_or("published defaults".to_string(), |f| f
-                    .display()
-                    .to_string()),
-            if self.normalised { "; normalised" } else { "" }
-        )
-    }
-}
-
-fn print_summary(
-    det: &Detector,
-    p: &Pulse,
-    prov: &Provenance<'_>,
-    rise: Option<f64>,
-    divisor: Option<f64>,
-) -> Result<()> {
-    let (r, phi, z) = prov.at;
+fn print_summary(det: &Detector, run: &jobs::PulseRun) -> Result<()> {
+    let (r, phi, z) = run.options.at;
+    let p = &run.pulse;
     outln!(
         "pulse at r = {r} mm, phi = {phi} deg, z = {z} mm; U_B = {} V ({})",
-        prov.voltage_v,
+        run.options.voltage_v,
         det.name
     );
     for d in [&p.electron, &p.hole] {
@@ -241,7 +134,7 @@ fn print_summary(
         );
     }
     outln!("collection time {:.1} ns", p.collection_time_ns);
-    let unit = if divisor.is_some() {
+    let unit = if run.normalised_by.is_some() {
         "normalised"
     } else {
         "units of the pair charge"
@@ -252,10 +145,10 @@ fn print_summary(
         .map(|s| format!("{} {:+.4}", s.name, s.charge.last().unwrap_or(&0.0)))
         .collect();
     outln!("end charges ({unit}): {}", ends.join(", "));
-    if let Some(t) = rise {
+    if let Some(t) = run.rise_time_10_90_ns {
         outln!(
             "10-90% rise time of {}: {t:.1} ns",
-            det.contacts[reference_contact(det)].name
+            p.signals[run.reference_contact].name
         );
     }
     Ok(())
@@ -264,55 +157,44 @@ fn print_summary(
 fn write_csv(
     staged: &mut hpge_files::Staged,
     path: &Path,
-    p: &Pulse,
-    prov: &Provenance<'_>,
+    run: &jobs::PulseRun,
+    det: &Detector,
 ) -> Result<()> {
     let ctx = || format!("--out {}: cannot write the file", path.display());
-    let head: Vec<String> = prov
-        .det
-        .contacts
-        .iter()
-        .map(|c| format!("q{}", c.id))
-        .collect();
     staged
-        .write_with(path, |f| -> std::io::Result<()> {
-            writeln!(f, "t_ns,{}", head.join(","))?;
-            for (i, t) in p.t_ns.iter().enumerate() {
-                let row: Vec<String> = p.signals.iter().map(|s| s.charge[i].to_string()).collect();
-                writeln!(f, "{t},{}", row.join(","))?;
-            }
-            Ok(())
-        })
+        .write_with(path, |f| run.write_csv(f))
         .with_context(ctx)?;
-    let (r, phi, z) = prov.at;
+    let (r, phi, z) = run.options.at;
+    let normalised = run.options.normalise;
     super::sidecar::stage(
         staged,
         path,
         super::args::with_detector_provenance(
             json!({
-                "provenance": prov.line(),
-                "voltage_V": prov.voltage_v,
+                "provenance": run.provenance_line(),
+                "voltage_V": run.options.voltage_v,
                 "at": {"r_mm": r, "phi_deg": phi, "z_mm": z},
-                "drift_parameters": prov.drift_file.map(|f| f.display().to_string()),
-                "normalised": prov.normalised,
-                "columns": prov.det.contacts.iter().map(|c| (format!("q{}", c.id), serde_json::Value::from(c.name.clone()))).collect::<serde_json::Map<_, _>>(),
-                "unit": if prov.normalised { "normalised" } else { "units of the pair charge" },
+                "drift_parameters": run.options.drift_file.as_ref().map(|f| f.display().to_string()),
+                "normalised": normalised,
+                "columns": det.contacts.iter().map(|c| (format!("q{}", c.id), serde_json::Value::from(c.name.clone()))).collect::<serde_json::Map<_, _>>(),
+                "unit": if normalised { "normalised" } else { "units of the pair charge" },
             }),
-            prov.det,
+            det,
         ),
     )?;
     Ok(())
 }
 
-fn pulse_figure(p: &Pulse, prov: &Provenance<'_>) -> plot::LineFigure {
-    let (r, phi, z) = prov.at;
+fn pulse_figure(run: &jobs::PulseRun) -> plot::LineFigure {
+    let (r, phi, z) = run.options.at;
+    let p = &run.pulse;
     plot::LineFigure {
         title: format!(
             "{}: signals of an interaction at r = {r} mm, phi = {phi} deg, z = {z} mm, U_B = {} V",
-            prov.det.name, prov.voltage_v
+            run.detector_name, run.options.voltage_v
         ),
         x_desc: "time (ns)".into(),
-        y_desc: if prov.normalised {
+        y_desc: if run.options.normalise {
             "induced charge (normalised: bias contact ends at 1)".into()
         } else {
             "induced charge (units of the pair charge)".into()
@@ -332,6 +214,6 @@ fn pulse_figure(p: &Pulse, prov: &Provenance<'_>) -> plot::LineFigure {
             .collect(),
         y_from_zero: false,
         legend: plot::Corner::UpperLeft,
-        footnotes: vec![prov.line()],
+        footnotes: vec![run.provenance_line()],
     }
 }
