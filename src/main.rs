@@ -2,7 +2,8 @@
 //!
 //! Every error is printed as one message naming the file, key or value at fault, and the program
 //! exits with code 2 (bad input); it never panics on user input. A fit that did not converge
-//! exits with code 3, a fit whose exact-solver check fails after refinement with code 4.
+//! exits with code 3, a fit whose exact-solver check fails after refinement with code 4, and a
+//! validation study that fails its own criteria with code 1.
 
 /// `println!` for what a command prints on stdout, returning (`?`) a
 /// [`cli::stdout::StdoutError`] instead of panicking when stdout cannot be written.
@@ -44,6 +45,11 @@ fn main() -> ExitCode {
         Err(err) if err.downcast_ref::<cli::Unconverged>().is_some() => {
             eprintln!("error: {}", message(&err));
             ExitCode::from(3)
+        }
+        // A study that failed its own criteria: its report is written; exit code 1.
+        Err(err) if err.downcast_ref::<cli::StudyFailed>().is_some() => {
+            eprintln!("{}", message(&err));
+            ExitCode::from(1)
         }
         Err(err) if err.downcast_ref::<cli::ExactMismatch>().is_some() => {
             eprintln!("error: {}", message(&err));

@@ -24,6 +24,10 @@
 //! raw-data directory or a curve. [`synthesize_voltage`] generates raw-like pulses from a known
 //! curve, to test the pipeline end to end.
 //!
+//! The commands' jobs ([`jobs`]) run the pipeline as `hpge-cv measure` and `hpge-cv
+//! synthesize` do and write their files ([`jobs::measure_raw`] with [`jobs::MeasureRun::stage`],
+//! [`jobs::synthesize_folder`]), for the command line and the Python module alike.
+//!
 //! Every error ([`Error`]) names the file and key, or the step, at fault.
 //!
 //! ## Example
@@ -74,6 +78,7 @@
 pub mod circuit;
 mod error;
 pub mod formats;
+pub mod jobs;
 pub mod measure;
 mod options;
 pub mod peak;

@@ -3,6 +3,7 @@ through the command line (`hpge-cv COMMAND --json`) and through Python (`hpge_cv
 the two records are compared field by field: the same keys, the same values (wall times
 aside)."""
 
+import json
 import math
 
 import numpy as np
@@ -112,3 +113,24 @@ def test_job_errors_name_the_python_argument():
         hpge_cv.convergence(det, 1000.0, levels=9)
     with pytest.raises(hpge_cv.HpgeError, match=r"^at -1,0,5: R must be"):
         hpge_cv.pulse(det, 1000.0, (-1.0, 0.0, 5.0))
+
+
+def test_measure_writes_the_command_lines_files(cli_json, tmp_path):
+    # The measurement's job (hpge_measurement::jobs) behind both faces: the same curve,
+    # covariance and report, byte for byte apart from the report's `command`.
+    raw = ROOT / "data" / "super-siegfried-k1" / "raw"
+    (tmp_path / "py").mkdir()
+    (tmp_path / "cli").mkdir()
+    py = hpge_cv.measure(raw, out=tmp_path / "py" / "cv.csv")
+    cli = cli_json("measure", "--raw", raw, "--out", tmp_path / "cli" / "cv.csv", "--json")
+    for name in ("cv.csv", "cv.covariance.csv"):
+        assert (tmp_path / "py" / name).read_bytes() == (tmp_path / "cli" / name).read_bytes(), name
+    written = json.loads((tmp_path / "py" / "cv.measure.json").read_text())
+    assert written == py["report"]
+    assert written["command"][0] == "hpge_cv.measure"
+    for record in (written, cli):
+        record.pop("command")
+    same_record(written, cli)
+    assert py["report"]["covariance_file"] == "cv.covariance.csv"
+    # Without `out` nothing is written and no covariance file is named.
+    assert hpge_cv.measure(raw)["report"]["covariance_file"] is None

@@ -25,6 +25,12 @@ pub struct Unconverged(pub String);
 )]
 pub struct ExactMismatch(pub String);
 
+/// A validation study that ran to the end and failed its own criteria (exit code 1; the
+/// report, already written, says where).
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct StudyFailed(pub String);
+
 pub use hpge_inference::fit::FitOptions;
 
 /// Everything a fit was set up from (the library's fit job).

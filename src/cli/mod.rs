@@ -31,7 +31,7 @@ pub use hpge_solver::options::DetectorInput;
 use hpge_solver::options::{SolverOptions, WeightingOptions};
 
 pub use args::{parse_point, parse_voltages};
-pub use fit::{ExactMismatch, Unconverged};
+pub use fit::{ExactMismatch, StudyFailed, Unconverged};
 
 /// Impurity densities of HPGe detectors from capacitance-voltage curves: field solver, neural
 /// surrogate and Bayesian inference (Abt et al., EPJ C 2023).

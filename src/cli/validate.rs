@@ -194,7 +194,11 @@ pub fn coverage(o: &CoverageOptions, as_json: bool, force: bool) -> Result<()> {
         outln!("outputs in {}", out.display());
     }
     if !report.pass {
-        std::process::exit(1);
+        return Err(super::fit::StudyFailed(format!(
+            "validate coverage: FAILED (see {}/coverage.json)",
+            out.display()
+        ))
+        .into());
     }
     Ok(())
 }

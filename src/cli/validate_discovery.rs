@@ -228,11 +228,11 @@ pub fn run(a: &DiscoveryArgs) -> Result<()> {
     }
     eprintln!("outputs in {}", o.out.display());
     if !study.pass {
-        eprintln!(
+        return Err(super::fit::StudyFailed(format!(
             "validate discovery: FAILED (see {}/summary.md)",
             o.out.display()
-        );
-        std::process::exit(1);
+        ))
+        .into());
     }
     Ok(())
 }
