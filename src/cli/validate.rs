@@ -1,7 +1,5 @@
 //! `hpge-cv validate coverage`: simulation-based calibration of the fit.
 
-use std::io::Write as _;
-
 use anyhow::{Context, Result};
 use hpge_inference::{CvModel, ExactModel};
 use hpge_validation::studies::coverage::store::{TRUTHS_DIR, TruthStore, study_fingerprint};
@@ -143,44 +141,20 @@ pub fn coverage(o: &CoverageOptions, as_json: bool, force: bool) -> Result<()> {
             return Ok(());
         }
     };
-    let mut json = serde_json::to_value(&report)?;
-    if let Some(obj) = json.as_object_mut() {
-        obj.insert("program_version".into(), env!("CARGO_PKG_VERSION").into());
-        obj.insert("inputs".into(), serde_json::to_value(&s.inputs)?);
-        obj.insert("data_from".into(), o.data_from().as_str().into());
-        obj.insert("shard".into(), o.shard.clone().into());
-        obj.insert("settings".into(), serde_json::to_value(settings)?);
-        // ranks.csv's provenance (it is a plain table: one header row, no comment lines).
-        obj.insert(
-            "ranks_csv".into(),
-            serde_json::json!({
-                "file": "ranks.csv",
-                "columns": "truth, then each parameter's rank of the truth among the draws",
-                "rank_among_draws": o.ranks,
-                "prior": o.prior.display().to_string(),
-                "model": o.model.display().to_string(),
-                "seed": o.seed,
-            }),
-        );
-    }
-    let path = out.join("coverage.json");
-    hpge_files::write(&path, serde_json::to_string_pretty(&json)? + "\n")
-        .with_context(|| format!("cannot write {}", path.display()))?;
-    let path = out.join("ranks.csv");
-    let names: Vec<&str> = report.parameters.iter().map(|p| p.name.as_str()).collect();
-    hpge_files::write_with(&path, |w| -> std::io::Result<()> {
-        writeln!(w, "truth,{}", names.join(","))?;
-        for i in 0..report.n_truths {
-            let r: Vec<String> = report
-                .parameters
-                .iter()
-                .map(|p| p.ranks[i].to_string())
-                .collect();
-            writeln!(w, "{i},{}", r.join(","))?;
-        }
-        Ok(())
-    })
-    .with_context(|| format!("cannot write {}", path.display()))?;
+    hpge_validation::studies::coverage::write_outputs(
+        out,
+        &report,
+        &hpge_validation::studies::coverage::CoverageProvenance {
+            inputs: &s.inputs,
+            data_from: o.data_from().as_str(),
+            shard: &o.shard,
+            settings: &settings,
+            ranks: o.ranks,
+            prior: &o.prior,
+            model: &o.model,
+            seed: o.seed,
+        },
+    )?;
     hpge_reports::plot::coverage_figures(
         &out.join("figures"),
         &report,

@@ -3,7 +3,6 @@
 //! checks that it names the hidden effect (none in the null case) and that the fit after adding
 //! it has chi^2/ndf consistent with 1.
 
-use std::fmt::Write as _;
 use std::sync::Arc;
 
 use anyhow::{Context, Result};
@@ -11,8 +10,7 @@ use hpge_inference::posterior::NoiseKind;
 use hpge_inference::{CvModel, PriorSpec};
 use hpge_measurement::write_curve;
 use hpge_validation::studies::hidden::simulate_hidden;
-use hpge_validation::{HiddenOptions, HiddenOutcome, hidden_effects, run_hidden};
-use serde::Serialize;
+use hpge_validation::{HiddenOptions, HiddenStudy, hidden_effects, run_hidden};
 
 use super::discover::Printer;
 use hpge_inference::fit::noise_settings;
@@ -32,19 +30,6 @@ pub struct DiscoveryArgs {
     /// without it such a folder is refused.
     #[arg(long)]
     pub force: bool,
-}
-
-/// The study's result.
-#[derive(Debug, Serialize)]
-struct Study {
-    pass: bool,
-    seed: u64,
-    /// What makes two studies the same run: the effects, the start model, the inputs with
-    /// their hashes and the workflow's settings (compared before a study replaces this one).
-    run: serde_json::Value,
-    program_version: String,
-    outcomes: Vec<HiddenOutcome>,
-    seconds: f64,
 }
 
 /// Runs the study; exit code 1 when a data set is misnamed or its chi^2 is inconsistent.
@@ -175,54 +160,8 @@ pub fn run(a: &DiscoveryArgs) -> Result<()> {
         );
         outcomes.push(outcome);
     }
-    let study = Study {
-        pass: outcomes.iter().all(|o| o.correct && o.consistent),
-        seed: o.seed,
-        run,
-        program_version: env!("CARGO_PKG_VERSION").into(),
-        outcomes,
-        seconds: t0.elapsed().as_secs_f64(),
-    };
-    hpge_files::write(
-        o.out.join("summary.json"),
-        serde_json::to_string_pretty(&study)? + "\n",
-    )?;
-    let mut md = String::new();
-    writeln!(
-        md,
-        "# Hidden-effect tests of model discovery\n\n`hpge-cv validate discovery --seed {} --out {}` ({:.0} s). Pass: {}.\n",
-        o.seed,
-        o.out.display(),
-        study.seconds,
-        study.pass
-    )?;
-    writeln!(
-        md,
-        "| hidden effect | noise x | expected | chosen | right | chi^2/ndf before | after | chi^2 p after | best scores (ln B) |"
-    )?;
-    writeln!(md, "|---|---|---|---|---|---|---|---|---|")?;
-    for o in &study.outcomes {
-        let scores: Vec<String> = o
-            .scores
-            .iter()
-            .take(3)
-            .map(|(n, v)| format!("{n} {v:.1}"))
-            .collect();
-        writeln!(
-            md,
-            "| {} | {} | {} | {} | {} | {:.2} | {:.2} | {:.3} | {} |",
-            o.effect,
-            o.noise_scale,
-            o.expected.as_deref().unwrap_or("none"),
-            o.chosen.as_deref().unwrap_or("none"),
-            if o.correct { "yes" } else { "**no**" },
-            o.chi2_ndf_before,
-            o.chi2_ndf_after,
-            o.chi2_p_after,
-            scores.join(", ")
-        )?;
-    }
-    hpge_files::write(o.out.join("summary.md"), md)?;
+    let study = HiddenStudy::new(o.seed, run, outcomes, t0.elapsed().as_secs_f64());
+    study.write(&o.out)?;
     if a.json {
         outln!("{}", serde_json::to_string_pretty(&study)?);
     }

@@ -45,4 +45,5 @@ pub use studies::coverage::{
     CoverageModels, CoverageOutcome, CoverageReport, CoverageRun, CoverageSettings, coverage,
 };
 pub use studies::hidden::{HiddenEffect, HiddenOutcome, hidden_effects, run_hidden};
+pub use studies::hidden_summary::HiddenStudy;
 pub use studies::options::{CoverageOptions, HiddenOptions};

@@ -15,12 +15,14 @@ use hpge_inference::{Likelihood, Prior};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+mod outputs;
 mod settings;
 pub mod store;
 pub mod subsets;
 mod truth;
 
 use hpge_inference::sampler::SamplerStop;
+pub use outputs::{CoverageProvenance, write_outputs};
 pub use settings::{COVERAGE_LEVELS, CoverageSettings, DataFrom, PipelineSettings};
 use store::{SecondsSplit, TruthCheck, TruthFit, TruthSampler, TruthStore};
 pub use subsets::{Subset, SubsetCoverage};
