@@ -1,5 +1,6 @@
 //! Small utilities that every hpge-cv library uses and that belong to none of them (issue 62):
-//! the standard normal distribution and quantiles of a sample (priors, diagnostics, held-out
+//! the standard normal distribution, the chi-squared upper tail (goodness of fit) and quantiles
+//! of a sample (priors, diagnostics, held-out
 //! figures), a stable hash that names inputs in fingerprints and model files, strided shards of
 //! an index range (Slurm array tasks of `generate`, the coverage studies, `depletion`), and the
 //! one-writer lock of an output folder.
@@ -16,6 +17,7 @@
 
 #![warn(missing_docs)]
 
+mod chi_squared;
 mod error;
 pub mod hash;
 mod lock;
@@ -23,6 +25,7 @@ mod normal;
 mod quantile;
 mod shard;
 
+pub use chi_squared::chi_squared_sf;
 pub use error::{Error, Result};
 pub use hash::fnv1a;
 pub use lock::{FolderLock, LOCK_FILE};

@@ -177,13 +177,41 @@ fn fit_rows(root: &Path, name: &str, what: &str, main: bool) -> Result<Vec<Statu
         });
     }
     if main {
-        let chi2 = num(&s, &rel, "/chi2")?;
         let ndf = num(&s, &rel, "/ndf")? as usize;
         let [lo, hi] = chi2_band(ndf, 0.99);
+        // The data's own chi^2 at the exact-checked mode (issue 60, item 5): the exact curve
+        // against the measured covariance alone. A summary made before it has the likelihood's
+        // chi^2 only, which the row then names as such.
+        let data = s
+            .pointer("/exact_check/chi2_data_at_mode")
+            .and_then(Value::as_f64)
+            .filter(|x| x.is_finite());
+        let likelihood_chi2 = num(&s, &rel, "/chi2")?;
+        let ppp = s
+            .get("posterior_predictive_p")
+            .and_then(Value::as_f64)
+            .map_or(String::new(), |p| {
+                format!(", posterior-predictive p {p:.3}")
+            });
+        let (chi2, which, result) = match data {
+            Some(x) => (
+                x,
+                "the data's chi^2 at the exact-checked mode",
+                format!(
+                    "{x:.1} for {ndf} ([why](reports/inference.md)); the likelihood's {likelihood_chi2:.2}{ppp}"
+                ),
+            ),
+            None => (
+                likelihood_chi2,
+                "the likelihood's chi^2 at the global mode",
+                format!(
+                    "{likelihood_chi2:.2} for {ndf} degrees of freedom (a summary made before the data's chi^2; [why](reports/inference.md))"
+                ),
+            ),
+        };
         rows.push(StatusRow {
-            what: format!("{what}: chi^2 at the global mode"),
-            // Why a stand-in made by the same solver gives a small chi^2: reports/inference.md.
-            result: format!("{chi2:.2} for {ndf} degrees of freedom ([why](reports/inference.md))"),
+            what: format!("{what}: {which}"),
+            result,
             target: format!("inside the central 99% of chi^2({ndf}), [{lo:.1}, {hi:.1}]"),
             verdict: Verdict::of((lo..=hi).contains(&chi2)),
             source: rel.clone(),
@@ -708,6 +736,57 @@ mod tests {
         let why = settings_differ(&record(&settings, "exact")).unwrap();
         assert!(why.contains("pipeline"), "{why}");
         assert!(settings_differ(&serde_json::json!({"n_truths": 200})).is_some());
+    }
+
+    #[test]
+    fn the_chi2_row_tests_the_datas_chi2_at_the_exact_checked_mode() {
+        let root = std::env::temp_dir().join(format!("hpge-status-chi2-{}", std::process::id()));
+        let dir = root.join("reports/fits/main");
+        std::fs::create_dir_all(&dir).unwrap();
+        let summary = |check: Value| {
+            serde_json::json!({
+                "chi2": 0.3, "ndf": 51, "posterior_predictive_p": 1.0,
+                "exact_check": check,
+            })
+        };
+        let check = serde_json::json!({
+            "pareto_k": 0.4, "max_abs_shift_sd": 0.1, "pass": true, "draws": 100,
+            "chi2_data_at_mode": 55.0,
+        });
+        let write = |v: &Value| {
+            std::fs::write(dir.join("summary.json"), v.to_string()).unwrap();
+        };
+        let chi2_row = |rows: Vec<StatusRow>| {
+            rows.into_iter()
+                .find(|r| r.what.contains("chi^2"))
+                .expect("a chi^2 row")
+        };
+        write(&summary(check.clone()));
+        let row = chi2_row(fit_rows(&root, "main", "main job", true).unwrap());
+        assert!(
+            row.what
+                .contains("the data's chi^2 at the exact-checked mode")
+        );
+        assert!(row.result.starts_with("55.0 for 51"), "{}", row.result);
+        assert!(
+            row.result.contains("the likelihood's 0.30"),
+            "{}",
+            row.result
+        );
+        assert_eq!(row.verdict, Verdict::Pass);
+        let mut far = check.clone();
+        far["chi2_data_at_mode"] = 39313.0.into();
+        write(&summary(far));
+        let row = chi2_row(fit_rows(&root, "main", "main job", true).unwrap());
+        assert_eq!(row.verdict, Verdict::Fail);
+        // A summary made before the data's chi^2: the likelihood's, named as such.
+        let mut old = check;
+        old.as_object_mut().unwrap().remove("chi2_data_at_mode");
+        write(&summary(old));
+        let row = chi2_row(fit_rows(&root, "main", "main job", true).unwrap());
+        assert!(row.what.contains("the likelihood's chi^2"), "{}", row.what);
+        assert_eq!(row.verdict, Verdict::Fail);
+        std::fs::remove_dir_all(&root).unwrap();
     }
 
     #[test]

@@ -203,6 +203,15 @@ pub struct ExactCheck {
     /// chi^2 of the exact curve at the global mode (no surrogate term in sigma).
     #[serde(deserialize_with = "super::round::f64_or_nan")]
     pub chi2_exact_at_mode: f64,
+    /// chi^2 of the exact curve at the global mode under the data's own errors alone (the
+    /// measured covariance; the paper's 3% term without one): what the measurement says of the
+    /// fitted model ([`crate::Likelihood::chi2_data`]; NaN in files made before it).
+    #[serde(default = "nan", deserialize_with = "super::round::f64_or_nan")]
+    pub chi2_data_at_mode: f64,
+    /// P(X >= chi2_data_at_mode) for X ~ chi^2(voltages - parameters): the goodness of fit of
+    /// the exact curve at the mode against the data's own errors.
+    #[serde(default = "nan", deserialize_with = "super::round::f64_or_nan")]
+    pub p_data_at_mode: f64,
     /// The largest |shift_sd|.
     #[serde(deserialize_with = "super::round::f64_or_nan")]
     pub max_abs_shift_sd: f64,
@@ -403,16 +412,18 @@ pub fn exact_check(
             shift_sd: if sd > 0.0 { (mw - m) / sd } else { 0.0 },
         });
     }
-    let (max_rel, chi2_exact) = match &at_mode.1 {
+    let (max_rel, chi2_exact, chi2_data) = match &at_mode.1 {
         Some(ce) => (
             ce.iter()
                 .zip(&at_mode.2)
                 .map(|(e, s)| ((e - s) / e).abs())
                 .fold(0.0, f64::max),
             exact_like.chi2(ce),
+            exact_like.chi2_data(ce),
         ),
-        None => (f64::NAN, f64::NAN),
+        None => (f64::NAN, f64::NAN, f64::NAN),
     };
+    let ndf = exact_like.len().saturating_sub(names.len());
     let max_abs_shift_sd = parameters
         .iter()
         .map(|p| p.shift_sd.abs())
@@ -431,6 +442,8 @@ pub fn exact_check(
         parameters,
         max_rel_diff_at_mode: max_rel,
         chi2_exact_at_mode: chi2_exact,
+        chi2_data_at_mode: chi2_data,
+        p_data_at_mode: hpge_foundation::chi_squared_sf(ndf, chi2_data),
         max_abs_shift_sd,
         seconds: start.elapsed().as_secs_f64(),
         grids,

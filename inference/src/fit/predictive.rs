@@ -27,6 +27,14 @@ pub struct Predictive {
     pub bands_pf: Vec<Vec<[f64; 2]>>,
     /// Draws used.
     pub draws: usize,
+    /// The posterior-predictive p-value of the likelihood's chi^2 (Gelman, Meng and Stern
+    /// 1996): P(T(y_rep, theta) >= T(y, theta)) over the posterior and replicated data, with
+    /// T = chi^2 under the likelihood at theta. At fixed theta the replicated T is chi^2(N)
+    /// (N voltages: a Gaussian quadratic form in its own covariance), so the p-value is the
+    /// draws' mean of P(chi^2(N) >= T(y, theta_s)), without sampling y_rep (Rao-Blackwellised).
+    /// Near 0: the data lie further from every posterior curve than the likelihood's errors
+    /// allow; near 1: closer (errors too large, or a stand-in made by the fitted model).
+    pub ppp: f64,
 }
 
 /// Quantile q of sorted values (linear interpolation).
@@ -57,16 +65,24 @@ pub fn predictive(
     let c_mode = &mode.c_p;
     let all = samples.all();
     let idx = thin_indices(all.len(), n);
-    let curves: Vec<Vec<f64>> = idx
+    let evaluations: Vec<PosteriorEvaluation> = idx
         .par_iter()
         .map(|&i| unless_rejected(posterior.evaluate(all[i])))
         .collect::<Result<Vec<_>>>()?
         .into_iter()
         .flatten()
-        .map(|e| e.c_p)
         .collect();
     let c_m = &posterior.likelihood.c_m;
     let nv = c_m.len();
+    let ppp = evaluations
+        .iter()
+        .map(|e| {
+            let chi2 = posterior.likelihood.chi2_var(&e.c_p, &e.var_rel);
+            hpge_foundation::chi_squared_sf(nv, chi2)
+        })
+        .sum::<f64>()
+        / evaluations.len() as f64;
+    let curves: Vec<Vec<f64>> = evaluations.into_iter().map(|e| e.c_p).collect();
     let mut median = vec![0.0; nv];
     let mut bands = vec![Vec::new(); nv];
     for k in 0..nv {
@@ -89,5 +105,6 @@ pub fn predictive(
         median_pf: median,
         bands_pf: bands,
         draws: curves.len(),
+        ppp,
     })
 }

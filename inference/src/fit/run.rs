@@ -198,6 +198,7 @@ pub fn fit(
         seconds: start.elapsed().as_secs_f64(),
         chi2,
         ndf: posterior.likelihood.len().saturating_sub(d),
+        posterior_predictive_p: predictive.ppp,
         parameters,
         modes,
         local_modes: samples.local_modes.clone(),

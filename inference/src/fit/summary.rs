@@ -65,10 +65,15 @@ pub struct FitSummary {
     pub converged: bool,
     /// Wall time of sampling and summary (the exact check's time is in its own record), s.
     pub seconds: f64,
-    /// chi^2 at the global mode (see `likelihood`).
+    /// The likelihood's chi^2 at the global mode: sigma with every term of the noise model
+    /// (the data's, the solver's eq. 7 and the model's sigma_p; see `likelihood`). The data's
+    /// own chi^2 at the exact-checked mode is `exact_check.chi2_data_at_mode`.
     pub chi2: f64,
     /// Degrees of freedom: voltages minus parameters.
     pub ndf: usize,
+    /// The posterior-predictive p-value of the likelihood's chi^2
+    /// ([`super::Predictive::ppp`]).
+    pub posterior_predictive_p: f64,
     /// Per parameter.
     pub parameters: Vec<ParameterSummary>,
     /// The modes found (one for a unimodal posterior).

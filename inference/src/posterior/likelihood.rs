@@ -417,6 +417,17 @@ impl Likelihood {
         self.chi2_with(c_p, ModelVar::PerPoint(var_rel))
     }
 
+    /// chi^2 of `c_p` under the data's own errors alone, what the measurement says of a model
+    /// curve: r^T V_m^-1 r with the measured covariance V_m (the covariance variant), else
+    /// sum_k (r_k / (f_m c_p,k))^2 with the paper's 3% term; the solver's eq. 7 terms and the
+    /// model's sigma_p are left out. r = c_m - c_p.
+    pub fn chi2_data(&self, c_p: &[f64]) -> f64 {
+        let mut data_only = self.clone();
+        data_only.noise.solver_rel = 0.0;
+        data_only.noise.solver_abs_pf = 0.0;
+        data_only.chi2_with(c_p, ModelVar::Constant(0.0))
+    }
+
     fn chi2_with(&self, c_p: &[f64], v: ModelVar) -> f64 {
         let n = self.len();
         match &self.covariance {

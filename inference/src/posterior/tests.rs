@@ -235,3 +235,45 @@ fn rank_one_fast_path_equals_cholesky() {
     let without = Likelihood::new(&data(None), auto, 0.015).unwrap();
     assert_eq!(without.noise.kind, NoiseKind::Paper);
 }
+
+#[test]
+fn the_data_chi2_uses_the_measurements_errors_alone() {
+    let c_p: Vec<f64> = vec![310.0, 148.0, 91.0, 59.0, 44.0, 41.0];
+    // Paper variant: the 3% term of c_p only, none of eq. 7's or the model's.
+    let l = Likelihood::new(&data(None), NoiseSettings::default(), 0.015).unwrap();
+    let want: f64 = c_p
+        .iter()
+        .zip(&l.c_m)
+        .map(|(cp, cm)| (cm - cp).powi(2) / (0.03 * cp).powi(2))
+        .sum();
+    assert!((l.chi2_data(&c_p) / want - 1.0).abs() < 1e-12);
+    assert!(l.chi2_data(&c_p) > l.chi2(&c_p));
+    // Covariance variant: r^T V_m^-1 r, here by Gaussian elimination on V_m itself.
+    let v = covariance();
+    let noise = NoiseSettings {
+        kind: NoiseKind::Covariance,
+        ..NoiseSettings::default()
+    };
+    let l = Likelihood::new(&data(Some(v.clone())), noise, 0.015).unwrap();
+    let r: Vec<f64> = l.c_m.iter().zip(&c_p).map(|(m, p)| m - p).collect();
+    let mut a: Vec<Vec<f64>> = v
+        .iter()
+        .zip(&r)
+        .map(|(row, x)| row.iter().copied().chain([*x]).collect())
+        .collect();
+    for i in 0..6 {
+        for j in i + 1..6 {
+            let f = a[j][i] / a[i][i];
+            let pivot = a[i].clone();
+            for (x, p) in a[j].iter_mut().zip(&pivot).skip(i) {
+                *x -= f * p;
+            }
+        }
+    }
+    let mut x = [0.0; 6];
+    for i in (0..6).rev() {
+        x[i] = (a[i][6] - (i + 1..6).map(|k| a[i][k] * x[k]).sum::<f64>()) / a[i][i];
+    }
+    let want: f64 = r.iter().zip(&x).map(|(a, b)| a * b).sum();
+    assert!((l.chi2_data(&c_p) / want - 1.0).abs() < 1e-9);
+}

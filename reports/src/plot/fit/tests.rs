@@ -142,6 +142,7 @@ fn synthetic_fit(d: usize, chains: usize) -> Fit {
         seconds: 2.0,
         chi2: 12.0,
         ndf: 9,
+        posterior_predictive_p: 0.5,
         parameters,
         modes: Vec::new(),
         local_modes: Vec::new(),
@@ -185,6 +186,7 @@ fn synthetic_fit(d: usize, chains: usize) -> Fit {
         c_m_pf,
         sigma_pf,
         draws: 1000,
+        ppp: 0.5,
     };
     Fit {
         samples,
