@@ -51,7 +51,10 @@ pub fn synthesize_folder(o: &SynthOptions, observer: impl Fn(usize, usize)) -> R
             message: e.to_string(),
         },
     })?;
-    let (volts, c12) = read_model_curve(&o.curve)?;
+    let (volts, c12) = read_model_curve(&o.curve).map_err(|e| Error::Argument {
+        name: format!("--curve {}", o.curve.display()),
+        message: e.to_string(),
+    })?;
     let draws = StandInDraws::draw(o, &c12).map_err(|e| Error::Argument {
         name: format!("--curve {}", o.curve.display()),
         message: format!("the stand-in's draws: {e}"),
