@@ -395,6 +395,21 @@ mod signals {
     }
 }
 
+/// The folder `path` is in (`.` for a bare name): where [`remove_stale_temporaries`] looks for
+/// what a killed run left beside an output.
+///
+/// ```
+/// use std::path::Path;
+/// assert_eq!(hpge_files::parent_or_here(Path::new("cv.csv")), Path::new("."));
+/// assert_eq!(hpge_files::parent_or_here(Path::new("out/cv.csv")), Path::new("out"));
+/// ```
+pub fn parent_or_here(path: &Path) -> &Path {
+    match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    }
+}
+
 /// Removes the temporaries ([`temp_beside`]: `.NAME.PID-N.tmp`, files or folders) in `dir` that
 /// a process no longer running left behind (a run killed before it could put them in place or
 /// remove them). Only where the running processes can be listed (`/proc`); errors are ignored.

@@ -1,6 +1,6 @@
 //! The one error type of the measurement crate.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Errors of the measurement crate. Every variant names the file (and key) or the step at fault,
 /// so the command line can print a message a user can act on.
@@ -90,6 +90,17 @@ pub enum Error {
 pub type Result<T, E = Error> = std::result::Result<T, E>;
 
 impl Error {
+    /// [`Error::Io`] of `file` and `action` as a `map_err` argument:
+    /// `std::fs::write(f, b).map_err(Error::io(f, "cannot write the file"))`.
+    pub fn io(file: &Path, action: &'static str) -> impl FnOnce(std::io::Error) -> Self {
+        let file = file.to_path_buf();
+        move |source| Error::Io {
+            file,
+            action,
+            source,
+        }
+    }
+
     /// Shorthand for [`Error::Format`].
     pub fn format(file: impl Into<PathBuf>, message: impl Into<String>) -> Self {
         Error::Format {

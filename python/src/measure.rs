@@ -34,12 +34,10 @@ pub(crate) fn measure<'py>(
         out: out.clone().unwrap_or_default(),
         settings,
     };
-    let command = vec![
-        "hpge_cv.measure".to_string(),
-        raw.display().to_string(),
-        out.as_ref()
-            .map_or(String::new(), |p| p.display().to_string()),
-    ];
+    let command: Vec<String> = ["hpge_cv.measure".to_string(), raw.display().to_string()]
+        .into_iter()
+        .chain(out.as_ref().map(|p| p.display().to_string()))
+        .collect();
     let (run, report) = py.detach(|| -> PyResult<_> {
         let run = jobs::measure_raw(&o).map_err(err)?;
         let report = match &out {

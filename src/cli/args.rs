@@ -127,25 +127,12 @@ pub fn load_detector(input: &DetectorInput) -> Result<Detector> {
 /// parameters and the program version) to the object `v`. serde_json's maps are sorted, so the
 /// record prints the same wherever the keys were inserted.
 pub fn with_detector_provenance(mut v: serde_json::Value, det: &Detector) -> serde_json::Value {
-    if let Some(o) = v.as_object_mut() {
-        o.insert("detector".into(), det.file.display().to_string().into());
-        o.insert(
-            "impurity_file".into(),
-            det.semiconductor
-                .impurity_file()
-                .display()
-                .to_string()
-                .into(),
-        );
-        o.insert(
-            "parameters".into(),
-            serde_json::json!(
-                det.parameters
-                    .iter()
-                    .collect::<std::collections::BTreeMap<_, _>>()
-            ),
-        );
-        o.insert("version".into(), env!("CARGO_PKG_VERSION").into());
+    // The jobs' records carry the same fields (`hpge_solver::jobs::DetectorProvenance`).
+    if let (Some(o), Ok(serde_json::Value::Object(p))) = (
+        v.as_object_mut(),
+        serde_json::to_value(hpge_solver::jobs::DetectorProvenance::of(det)),
+    ) {
+        o.extend(p);
     }
     v
 }
@@ -231,13 +218,7 @@ pub fn commit(outputs: hpge_files::Staged) -> Result<()> {
         .map_err(|(file, e)| anyhow::anyhow!("{}: cannot write the file: {e}", file.display()))
 }
 
-/// The folder `path` is in (`.` for a bare name).
-pub fn parent_or_here(path: &std::path::Path) -> &std::path::Path {
-    match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => std::path::Path::new("."),
-    }
-}
+pub use hpge_files::parent_or_here;
 
 /// `x` as `{}` writes it, or in exponent form where that would be long (`1e300`, not 301
 /// digits; issue 66).

@@ -34,6 +34,14 @@ pub enum Error {
 pub type Result<T, E = Error> = std::result::Result<T, E>;
 
 impl Error {
+    /// [`Error::File`]: `path` could not be written, for `reason`.
+    pub(crate) fn cannot_write(path: &std::path::Path, reason: &dyn std::fmt::Display) -> Self {
+        Error::File {
+            path: path.to_path_buf(),
+            message: format!("cannot write the file: {reason}"),
+        }
+    }
+
     /// Whether a sampler may treat this error as a rejected proposal (zero posterior density):
     /// a closed form asked outside its domain, or a recoverable error of the crate below.
     pub fn is_recoverable(&self) -> bool {

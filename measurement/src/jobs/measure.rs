@@ -196,23 +196,15 @@ impl MeasureRun {
         command: &[String],
         staged: &mut hpge_files::Staged,
     ) -> Result<(serde_json::Value, Option<PathBuf>)> {
-        let io = |file: &Path, action: &'static str| {
-            let file = file.to_path_buf();
-            move |source| Error::Io {
-                file,
-                action,
-                source,
-            }
-        };
         let (table, covariance) = curve_texts(out, &self.measurement.curve, &[])?;
         staged
             .write(out, table.as_bytes())
-            .map_err(io(out, "cannot write the file"))?;
+            .map_err(Error::io(out, "cannot write the file"))?;
         let covariance_file = covariance_path(out);
         if let Some(text) = &covariance {
             staged
                 .write(&covariance_file, text.as_bytes())
-                .map_err(io(&covariance_file, "cannot write the file"))?;
+                .map_err(Error::io(&covariance_file, "cannot write the file"))?;
         }
         let mut report = serde_json::to_value(self.report(out)).map_err(|e| Error::Numerical {
             what: "the measurement's report".into(),
@@ -224,7 +216,7 @@ impl MeasureRun {
         let report_path = out.with_extension("measure.json");
         staged
             .write(&report_path, format!("{report:#}\n").as_bytes())
-            .map_err(io(&report_path, "cannot write the report"))?;
+            .map_err(Error::io(&report_path, "cannot write the report"))?;
         Ok((report, covariance.is_none().then_some(covariance_file)))
     }
 }

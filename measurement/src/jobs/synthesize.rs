@@ -72,23 +72,11 @@ pub fn synthesize_folder(o: &SynthOptions, observer: impl Fn(usize, usize)) -> R
             message: "-dc12/dU_B never falls to 1e-3 pF/V, so the full-depletion voltage is unknown; give --depletion-voltage".into(),
         })?,
     };
-    let parent = match o.out.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    };
-    hpge_files::remove_stale_temporaries(parent);
-    let io = |file: &Path, action: &'static str| {
-        let file = file.to_path_buf();
-        move |source| Error::Io {
-            file,
-            action,
-            source,
-        }
-    };
+    hpge_files::remove_stale_temporaries(hpge_files::parent_or_here(&o.out));
     let mut staged = hpge_files::Staged::new();
     let tmp = staged
         .replacing_folder(&o.out)
-        .map_err(io(&o.out, "cannot create the folder"))?;
+        .map_err(Error::io(&o.out, "cannot create the folder"))?;
     write_synthetic(o, &tmp, &settings, &volts, &c12, ufd, &draws, &observer)?;
     staged.commit().map_err(|(file, source)| Error::Io {
         file,
@@ -169,11 +157,7 @@ fn write_synthetic(
         observer(k + 1, volts.len());
     }
     let write = |path: PathBuf, text: String| {
-        hpge_files::write(&path, text).map_err(|source| Error::Io {
-            file: path,
-            action: "cannot write",
-            source,
-        })
+        hpge_files::write(&path, text).map_err(Error::io(&path, "cannot write"))
     };
     let list = volts
         .iter()

@@ -113,11 +113,7 @@ pub fn convergence(
             })
             .collect(),
         grid: options.settings.grid.clone(),
-        parameters: det
-            .parameters
-            .iter()
-            .map(|(k, v)| (k.to_string(), v))
-            .collect(),
+        parameters: super::parameters_of(det),
         version: VERSION,
     };
     Ok((rows, record))

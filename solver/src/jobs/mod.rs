@@ -88,14 +88,18 @@ impl DetectorProvenance {
         Self {
             detector: det.file.display().to_string(),
             impurity_file: det.semiconductor.impurity_file().display().to_string(),
-            parameters: det
-                .parameters
-                .iter()
-                .map(|(k, v)| (k.to_string(), v))
-                .collect(),
+            parameters: parameters_of(det),
             version: VERSION,
         }
     }
+}
+
+/// Every named parameter of `det` by name, as records carry them.
+fn parameters_of(det: &Detector) -> BTreeMap<String, f64> {
+    det.parameters
+        .iter()
+        .map(|(k, v)| (k.to_string(), v))
+        .collect()
 }
 
 /// Where the fields of a job were solved: the wgpu adapter and the precision it ran in (the

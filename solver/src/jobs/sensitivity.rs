@@ -122,11 +122,7 @@ pub fn sensitivity(
         options: options.clone(),
         detector: det.file.display().to_string(),
         detector_name: det.name.clone(),
-        parameters: det
-            .parameters
-            .iter()
-            .map(|(k, v)| (k.to_string(), v))
-            .collect(),
+        parameters: super::parameters_of(det),
     })
 }
 

@@ -91,15 +91,12 @@ impl HiddenStudy {
     ///
     /// Errors: a file that cannot be written ([`Error::File`], naming it).
     pub fn write(&self, out: &Path) -> Result<()> {
-        let failed = |path: &Path, e: &dyn std::fmt::Display| Error::File {
-            path: path.to_path_buf(),
-            message: format!("cannot write the file: {e}"),
-        };
         let path = out.join("summary.json");
-        let text = serde_json::to_string_pretty(self).map_err(|e| failed(&path, &e))? + "\n";
-        hpge_files::write(&path, text).map_err(|e| failed(&path, &e))?;
+        let text =
+            serde_json::to_string_pretty(self).map_err(|e| Error::cannot_write(&path, &e))? + "\n";
+        hpge_files::write(&path, text).map_err(|e| Error::cannot_write(&path, &e))?;
         let path = out.join("summary.md");
-        hpge_files::write(&path, self.markdown(out)).map_err(|e| failed(&path, &e))
+        hpge_files::write(&path, self.markdown(out)).map_err(|e| Error::cannot_write(&path, &e))
     }
 }
 

@@ -40,23 +40,19 @@ pub fn write_outputs(
     report: &CoverageReport,
     p: &CoverageProvenance<'_>,
 ) -> Result<serde_json::Value> {
-    let failed = |path: &Path, e: &dyn std::fmt::Display| Error::File {
-        path: path.to_path_buf(),
-        message: format!("cannot write the file: {e}"),
-    };
     let path = out.join("coverage.json");
-    let mut json = serde_json::to_value(report).map_err(|e| failed(&path, &e))?;
+    let mut json = serde_json::to_value(report).map_err(|e| Error::cannot_write(&path, &e))?;
     if let Some(obj) = json.as_object_mut() {
         obj.insert("program_version".into(), env!("CARGO_PKG_VERSION").into());
         obj.insert(
             "inputs".into(),
-            serde_json::to_value(p.inputs).map_err(|e| failed(&path, &e))?,
+            serde_json::to_value(p.inputs).map_err(|e| Error::cannot_write(&path, &e))?,
         );
         obj.insert("data_from".into(), p.data_from.into());
         obj.insert("shard".into(), p.shard.into());
         obj.insert(
             "settings".into(),
-            serde_json::to_value(p.settings).map_err(|e| failed(&path, &e))?,
+            serde_json::to_value(p.settings).map_err(|e| Error::cannot_write(&path, &e))?,
         );
         // ranks.csv's provenance (it is a plain table: one header row, no comment lines).
         obj.insert(
@@ -71,8 +67,9 @@ pub fn write_outputs(
             }),
         );
     }
-    let text = serde_json::to_string_pretty(&json).map_err(|e| failed(&path, &e))? + "\n";
-    hpge_files::write(&path, text).map_err(|e| failed(&path, &e))?;
+    let text =
+        serde_json::to_string_pretty(&json).map_err(|e| Error::cannot_write(&path, &e))? + "\n";
+    hpge_files::write(&path, text).map_err(|e| Error::cannot_write(&path, &e))?;
     let path = out.join("ranks.csv");
     let names: Vec<&str> = report.parameters.iter().map(|p| p.name.as_str()).collect();
     hpge_files::write_with(&path, |w| -> std::io::Result<()> {
@@ -87,6 +84,6 @@ pub fn write_outputs(
         }
         Ok(())
     })
-    .map_err(|e| failed(&path, &e))?;
+    .map_err(|e| Error::cannot_write(&path, &e))?;
     Ok(json)
 }
