@@ -3,7 +3,7 @@
 //! of a sample (priors, diagnostics, held-out
 //! figures), a stable hash that names inputs in fingerprints and model files, strided shards of
 //! an index range (Slurm array tasks of `generate`, the coverage studies, `depletion`), and the
-//! one-writer lock of an output folder.
+//! one-writer lock of an output folder, and the record of what made a results file ([`Made`]).
 //!
 //! ```
 //! use hpge_foundation::{Shard, fnv1a, normal_cdf, normal_quantile, quantile};
@@ -21,6 +21,7 @@ mod chi_squared;
 mod error;
 pub mod hash;
 mod lock;
+mod made;
 mod normal;
 mod quantile;
 mod shard;
@@ -29,6 +30,7 @@ pub use chi_squared::chi_squared_sf;
 pub use error::{Error, Result};
 pub use hash::fnv1a;
 pub use lock::{FolderLock, LOCK_FILE};
+pub use made::{MADE_KEY, Made, civil_from_days, today_utc};
 pub use normal::{normal_cdf, normal_quantile};
 pub use quantile::quantile;
 pub use shard::Shard;

@@ -48,6 +48,7 @@ mod error;
 pub mod discover;
 pub mod fit;
 mod json_file;
+pub mod numbers;
 pub mod paper;
 pub mod plot;
 mod provenance;

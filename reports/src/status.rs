@@ -589,7 +589,33 @@ pub fn status_rows(root: &Path, model: &str) -> Result<Vec<StatusRow>> {
         verdict: Verdict::Note,
         source: "reports/gpu-backend.md".into(),
     });
+    rows.push(older_reports_row(root)?);
     Ok(rows)
+}
+
+/// The reports that quote results files older than the solver's physics revision (issue 63:
+/// each says so at its top; [`crate::numbers`]).
+fn older_reports_row(root: &Path) -> Result<StatusRow> {
+    let filled = crate::numbers::fill_repository(root, hpge_solver::field::PHYSICS_REVISION)?;
+    let older: Vec<String> = filled
+        .iter()
+        .filter(|f| !f.older().is_empty())
+        .map(|f| f.file.display().to_string())
+        .collect();
+    Ok(StatusRow {
+        what: "reports made from older results".into(),
+        result: if older.is_empty() {
+            format!(
+                "none of {} reports with numbers from results files",
+                filled.len()
+            )
+        } else {
+            format!("{} of {}: {}", older.len(), filled.len(), older.join(", "))
+        },
+        target: "-".into(),
+        verdict: Verdict::Note,
+        source: older.first().cloned().unwrap_or_else(|| "README.md".into()),
+    })
 }
 
 /// The longest cell of the README's table, in characters of its Markdown (issue 61: the table

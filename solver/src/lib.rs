@@ -90,3 +90,15 @@ pub use field::{
 pub use gpu::Precision;
 pub use grid::{GridOverrides, GridSettings};
 pub use impurity::ImpuritySpec;
+
+/// What made a results file whose numbers come from this solver: the program, its version,
+/// today's UTC date and [`field::PHYSICS_REVISION`] (issue 63), written under
+/// [`hpge_foundation::MADE_KEY`].
+///
+/// ```
+/// let made = hpge_solver::made();
+/// assert_eq!(made.solver_revision.as_deref(), Some(hpge_solver::field::PHYSICS_REVISION));
+/// ```
+pub fn made() -> hpge_foundation::Made {
+    hpge_foundation::Made::now(Some(field::PHYSICS_REVISION))
+}

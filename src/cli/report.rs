@@ -22,6 +22,25 @@ enum ReportKind {
     Status(StatusArgs),
     /// Draws a coverage study's figures again from its coverage.json (the study is not run).
     Coverage(CoverageArgs),
+    /// Checks every number that the repository's reports quote against its results file
+    /// (README.md and the markdown under docs/, reports/, models/, data/; the markers of
+    /// `hpge_reports::numbers`) and the banner of each report made from results older than the
+    /// solver's physics revision; with --write, fills them. Exit 1 where a report differs and
+    /// --write is not given.
+    Numbers(NumbersArgs),
+}
+
+/// `report numbers`.
+#[derive(Debug, clap::Args)]
+struct NumbersArgs {
+    /// The repository whose reports and results files are read.
+    #[arg(long, default_value = ".")]
+    root: std::path::PathBuf,
+    /// Write the numbers and banners into the reports (only the reports that differ change).
+    #[arg(long)]
+    write: bool,
+    /// Only these reports (paths relative to --root); all of them when none is given.
+    files: Vec<String>,
 }
 
 /// `report coverage`.
@@ -47,6 +66,7 @@ pub fn run(a: &ReportArgs) -> Result<()> {
     match &a.what {
         ReportKind::Paper(p) => paper(p),
         ReportKind::Status(s) => status(s),
+        ReportKind::Numbers(n) => numbers(n),
         ReportKind::Coverage(c) => {
             let files = hpge_reports::plot::redraw_coverage(&c.dir)?;
             for f in files {
@@ -55,6 +75,69 @@ pub fn run(a: &ReportArgs) -> Result<()> {
             Ok(())
         }
     }
+}
+
+/// Runs `report numbers`: a line per report, one per difference; with `--write` the reports
+/// that differ are written.
+fn numbers(a: &NumbersArgs) -> Result<()> {
+    let current = hpge_solver::field::PHYSICS_REVISION;
+    let filled: Vec<_> = hpge_reports::numbers::fill_repository(&a.root, current)?
+        .into_iter()
+        .filter(|f| a.files.is_empty() || a.files.iter().any(|x| f.file == std::path::Path::new(x)))
+        .collect();
+    let (mut differing, mut quoted, mut older) = (0, 0, 0);
+    for f in &filled {
+        quoted += f.numbers;
+        let old = f.older().len();
+        if old > 0 {
+            older += 1;
+        }
+        outln!(
+            "{}: {} number(s) from {} results file(s){}{}",
+            f.file.display(),
+            f.numbers,
+            f.sources.len(),
+            if old > 0 {
+                format!(", {old} older than the solver's revision")
+            } else {
+                String::new()
+            },
+            if f.differences.is_empty() {
+                ""
+            } else {
+                ", differs:"
+            }
+        );
+        for d in &f.differences {
+            outln!(
+                "  line {}: {}: \"{}\" -> \"{}\"",
+                d.line,
+                d.what,
+                d.found,
+                d.expected
+            );
+        }
+        if !f.differences.is_empty() {
+            differing += 1;
+            if a.write {
+                let path = a.root.join(&f.file);
+                hpge_files::write(&path, &f.text)
+                    .map_err(|e| anyhow::anyhow!("{}: cannot write: {e}", path.display()))?;
+            }
+        }
+    }
+    outln!(
+        "{} report(s), {quoted} number(s); {older} made from older results; {differing} {}",
+        filled.len(),
+        if a.write { "written" } else { "differ" }
+    );
+    if differing > 0 && !a.write {
+        return Err(super::StudyFailed(format!(
+            "report numbers: {differing} report(s) differ from their results files (`hpge-cv report numbers --write` fills them)"
+        ))
+        .into());
+    }
+    Ok(())
 }
 
 /// Runs `report status`: prints the table and, with `--write`, puts it into the file.

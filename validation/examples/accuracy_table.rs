@@ -50,6 +50,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 "settings": settings,
                 "rows": rows,
                 "version": env!("CARGO_PKG_VERSION"),
+                "made": hpge_solver::made(),
             }))?,
         )?;
     }

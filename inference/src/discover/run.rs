@@ -281,6 +281,7 @@ pub fn discover(
         surrogate_start: surrogate_gap,
         not_applicable,
         verdict,
+        made: Some(hpge_solver::made()),
         program_version: env!("CARGO_PKG_VERSION").into(),
         inputs: inp.inputs.clone(),
         settings: settings.clone(),

@@ -134,6 +134,10 @@ pub struct DiscoverySummary {
     pub not_applicable: Vec<NotApplicable>,
     /// The decision in words.
     pub verdict: String,
+    /// What made this file: program, version, date and the solver's physics revision (issue
+    /// 63); absent from files written before it was recorded.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub made: Option<hpge_foundation::Made>,
     /// Program version.
     pub program_version: String,
     /// Input files and hashes.

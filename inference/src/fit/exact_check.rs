@@ -212,6 +212,14 @@ pub struct ExactCheck {
     /// the exact curve at the mode against the data's own errors.
     #[serde(default = "nan", deserialize_with = "super::round::f64_or_nan")]
     pub p_data_at_mode: f64,
+    /// The exact solver's curve at the global mode, pF (empty where its solve failed, and in
+    /// files made before it was recorded).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub c_exact_at_mode_pf: Vec<f64>,
+    /// That curve against the data's own errors (issue 63: the pulls panel of the predictive
+    /// figure, and the run's calibration factor given the exact curve at the mode).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub own_errors_at_mode: Option<crate::posterior::OwnErrors>,
     /// The largest |shift_sd|.
     #[serde(deserialize_with = "super::round::f64_or_nan")]
     pub max_abs_shift_sd: f64,
@@ -444,6 +452,8 @@ pub fn exact_check(
         chi2_exact_at_mode: chi2_exact,
         chi2_data_at_mode: chi2_data,
         p_data_at_mode: hpge_foundation::chi_squared_sf(ndf, chi2_data),
+        c_exact_at_mode_pf: at_mode.1.clone().unwrap_or_default(),
+        own_errors_at_mode: at_mode.1.as_ref().map(|ce| exact_like.own_errors(ce)),
         max_abs_shift_sd,
         seconds: start.elapsed().as_secs_f64(),
         grids,

@@ -35,6 +35,11 @@ pub struct Predictive {
     /// Near 0: the data lie further from every posterior curve than the likelihood's errors
     /// allow; near 1: closer (errors too large, or a stand-in made by the fitted model).
     pub ppp: f64,
+    /// The posterior of the run's calibration factor kappa (c_m = kappa c_p) that a measured
+    /// covariance u u^T + diag(d) lets float: per draw the normal posterior of the shared scale
+    /// under the likelihood the fit samples, mixed over the draws
+    /// ([`crate::posterior::calibration_mixture`]); None without such a covariance.
+    pub calibration: Option<crate::posterior::CalibrationScale>,
 }
 
 /// Quantile q of sorted values (linear interpolation).
@@ -82,6 +87,12 @@ pub fn predictive(
         })
         .sum::<f64>()
         / evaluations.len() as f64;
+    let scales: Vec<crate::posterior::CalibrationScale> = evaluations
+        .iter()
+        .filter_map(|e| posterior.likelihood.calibration_var(&e.c_p, &e.var_rel))
+        .map(|f| f.scale)
+        .collect();
+    let calibration = crate::posterior::calibration_mixture(&scales);
     let curves: Vec<Vec<f64>> = evaluations.into_iter().map(|e| e.c_p).collect();
     let mut median = vec![0.0; nv];
     let mut bands = vec![Vec::new(); nv];
@@ -106,5 +117,6 @@ pub fn predictive(
         bands_pf: bands,
         draws: curves.len(),
         ppp,
+        calibration,
     })
 }

@@ -74,6 +74,11 @@ pub struct FitSummary {
     /// The posterior-predictive p-value of the likelihood's chi^2
     /// ([`super::Predictive::ppp`]).
     pub posterior_predictive_p: f64,
+    /// The posterior of the run's calibration factor kappa (c_m = kappa c_p) that the measured
+    /// covariance lets float ([`super::Predictive::calibration`]); absent without a measured
+    /// covariance of one shared scale.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub calibration_factor: Option<crate::posterior::CalibrationScale>,
     /// Per parameter.
     pub parameters: Vec<ParameterSummary>,
     /// The modes found (one for a unimodal posterior).
@@ -96,6 +101,10 @@ pub struct FitSummary {
     /// (outside its support, issue 24: there it extrapolates); absent where not computed.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub posterior_outside_support: Option<f64>,
+    /// What made this file: program, version, date and the solver's physics revision (issue
+    /// 63); absent from files written before it was recorded.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub made: Option<hpge_foundation::Made>,
     /// hpge-cv version.
     pub program_version: String,
     /// Inputs: the data, model and prior files (with hashes where known).

@@ -30,6 +30,9 @@ use serde::{Deserialize, Serialize};
 use crate::numerics::Cholesky;
 use crate::{CvData, Error, Result};
 
+mod calibration;
+pub use calibration::{CalibrationScale, OwnErrors, ScaleFit, mixture as calibration_mixture};
+
 const LN_SQRT_2PI: f64 = 0.918_938_533_204_672_8;
 
 /// Which noise model (a closed set).

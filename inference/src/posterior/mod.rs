@@ -9,7 +9,10 @@ pub use density::{Posterior, PosteriorEvaluation};
 pub use laplace::{
     LaplaceFit, LaplaceSettings, VisitedCurve, fd_steps, laplace_fit, laplace_fit_guided,
 };
-pub use likelihood::{Likelihood, NoiseKind, NoiseSettings};
+pub use likelihood::{
+    CalibrationScale, Likelihood, NoiseKind, NoiseSettings, OwnErrors, ScaleFit,
+    calibration_mixture,
+};
 
 #[cfg(test)]
 mod tests;

@@ -122,6 +122,8 @@ pub struct MeasureReport {
     pub program: &'static str,
     /// The program version.
     pub version: &'static str,
+    /// What made this file: program, version and date (a measurement has no solver revision).
+    pub made: hpge_foundation::Made,
     /// The uncertainty model.
     pub uncertainties: Uncertainties,
     /// The covariance file's name beside the curve (null without a covariance).
@@ -176,6 +178,7 @@ impl MeasureRun {
                 .collect(),
             program: "hpge-cv",
             version: env!("CARGO_PKG_VERSION"),
+            made: hpge_foundation::Made::now(None),
             uncertainties: self.settings.uncertainties.clone(),
             covariance_file: m
                 .curve

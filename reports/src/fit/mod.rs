@@ -391,6 +391,15 @@ pub fn summary_text(fit: &Fit, out: &Path) -> String {
             );
         }
     }
+    if let Some(k) = s.calibration_factor {
+        let _ = writeln!(
+            t,
+            "calibration factor kappa (c_m = kappa c_p, prior sd {:.1}%): {:.4} +- {:.4}",
+            100.0 * k.prior_sd,
+            k.factor,
+            k.factor_sd
+        );
+    }
     if let Some(why) = &s.exact_check_skipped {
         let _ = writeln!(t, "exact check not run: {why}");
     }

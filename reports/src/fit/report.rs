@@ -220,6 +220,26 @@ pub fn write_report(
             "The data's own chi^2 at the exact-checked mode: {:.1} for {} degrees of freedom, P(chi^2({}) >= it) = {:.3}: the exact solver's curve at the global mode against the measurement's errors alone (the measured covariance where the curve has one, else the 3% term), without the solver's and the surrogate's terms.\n",
             c.chi2_data_at_mode, sm.ndf, sm.ndf, c.p_data_at_mode
         );
+        if let Some(k) = c.own_errors_at_mode.as_ref().and_then(|o| o.calibration) {
+            let _ = writeln!(
+                r,
+                "Given that curve, the run's calibration factor kappa (c_m = kappa c_p: the scale the measured covariance lets float, prior sd {:.1}%) is {:.5} +- {:.1e}; the pulls of `figures/predictive.png` are what is left once it is taken out.\n",
+                100.0 * k.prior_sd,
+                k.factor,
+                k.factor_sd
+            );
+        }
+    }
+    if let Some(k) = sm.calibration_factor {
+        let _ = writeln!(
+            r,
+            "The calibration factor's posterior over the fit's draws (the likelihood the fit samples: data, solver and surrogate terms): kappa = {:.4} +- {:.4} (prior sd {:.1}%): the data are {:.2}% {} the model.\n",
+            k.factor,
+            k.factor_sd,
+            100.0 * k.prior_sd,
+            100.0 * (k.factor - 1.0).abs(),
+            if k.factor >= 1.0 { "above" } else { "below" }
+        );
     }
     if let Some(f) = sm.posterior_outside_support {
         let _ = writeln!(

@@ -133,6 +133,7 @@ pub fn write(ctx: &Ctx, total_s: f64, staged: &mut hpge_files::Staged) -> Result
     let j = json!({
         "program": crate::provenance::PROGRAM,
         "version": crate::provenance::VERSION,
+        "made": hpge_solver::made(),
         "quick": ctx.quick,
         "exact_check": ctx.exact_check,
         "inputs": ctx.inputs.all().iter().map(|p| json!({"file": p.display().to_string(), "hash": hash(p)})).collect::<Vec<_>>(),

@@ -1,11 +1,14 @@
 //! Figures of a simulation-based-calibration study (Talts et al. 2018): the histograms of the
-//! normalised ranks of the truths among the posterior draws, with the 99% band of a uniform rank,
-//! and the coverage of the smallest intervals against their nominal level, with the 99% band of a
-//! calibrated fit around the diagonal. Each as SVG and PNG.
+//! normalised ranks of the truths among the posterior draws, with the 99% band of a uniform rank;
+//! the ECDF of the ranks against the uniform one with simultaneous 95% and 99% bands (Säilynoja,
+//! Bürkner and Vehtari 2022: a panel tests its parameter, where the per-bin band of a histogram
+//! does not); and the coverage of the smallest intervals against their nominal level, with the
+//! 99% binomial band of a calibrated fit around the diagonal. Each as SVG and PNG.
 
 use std::path::{Path, PathBuf};
 
 use hpge_validation::CoverageReport;
+use hpge_validation::studies::coverage::ecdf::{EcdfBand, ecdf_band, ecdf_difference, inside_band};
 use hpge_validation::studies::coverage::{ParameterCoverage, binomial_interval};
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -18,12 +21,12 @@ use crate::error::{Error, Result};
 const RANK_BINS: usize = 20;
 /// Probability mass of the bands.
 const BAND_MASS: f64 = 0.99;
-/// The 0.995 quantile of the standard normal (the half-width of a central 99% band in sigma).
-const Z_99: f64 = 2.575_829_303_548_901;
 /// Panels per row of the rank figure.
 const COLUMNS: usize = 3;
 /// The 99% bands.
 const BAND: RGBColor = RGBColor(215, 215, 215);
+/// The 95% band of the ECDF figure (inside the 99% one).
+const BAND_95: RGBColor = RGBColor(175, 175, 175);
 /// Histogram bars.
 const BARS: RGBColor = RGBColor(87, 153, 199);
 /// The edges of a band drawn over the bars.
@@ -38,7 +41,10 @@ const FAIL: RGBColor = RGBColor(214, 39, 40);
 /// rank/(L+1) in 20 bins, the expected count and its 99% binomial band, the KS p-value in the
 /// panel title (red below the pass threshold 0.01/d); and `coverage`, the empirical coverage of
 /// the smallest intervals against the nominal level per parameter, the diagonal and its 99%
-/// binomial band for n = `report.n_truths`. Every title starts with `title`.
+/// binomial band for n = `report.n_truths`; and `ecdf`, one panel per parameter with the ECDF
+/// difference F(z) - z of its ranks and the simultaneous 95% and 99% bands
+/// ([`hpge_validation::studies::coverage::ecdf`]), the panel's title saying which band it
+/// leaves. Every title starts with `title`.
 pub fn coverage_figures(dir: &Path, report: &CoverageReport, title: &str) -> Result<Vec<PathBuf>> {
     let params = &report.parameters;
     if params.is_empty() {
@@ -67,6 +73,21 @@ pub fn coverage_figures(dir: &Path, report: &CoverageReport, title: &str) -> Res
         let done: Result<()> = render!(&p, size, |root, _svg| ranks(&root, report, title, cols));
         done?;
         out.push(p);
+    }
+    let n = params.iter().map(|p| p.ranks.len()).max().unwrap_or(0);
+    if n > 0 && report.ranks > 0 {
+        let bands = [
+            ecdf_band(n, report.ranks, 0.99),
+            ecdf_band(n, report.ranks, 0.95),
+        ];
+        for ext in ["svg", "png"] {
+            let p = dir.join(format!("ecdf.{ext}"));
+            let done: Result<()> = render!(&p, size, |root, _svg| ecdf(
+                &root, report, title, cols, &bands
+            ));
+            done?;
+            out.push(p);
+        }
     }
     for ext in ["svg", "png"] {
         let p = dir.join(format!("coverage.{ext}"));
@@ -118,6 +139,8 @@ enum Key {
     Fill(RGBColor),
     /// A dashed line.
     Dashed(RGBColor),
+    /// A solid line.
+    Line(RGBColor),
 }
 
 /// Splits a one-row legend strip off the top of `area`, draws `keys` into it and returns the
@@ -133,6 +156,10 @@ fn key_strip<DB: DrawingBackend>(
     for (key, text) in keys {
         match *key {
             Key::Fill(c) => strip.draw(&Rectangle::new([(x, y - 8), (x + 24, y + 8)], c.filled())),
+            Key::Line(c) => strip.draw(&PathElement::new(
+                vec![(x, y), (x + 24, y)],
+                c.stroke_width(3),
+            )),
             Key::Dashed(c) => strip
                 .draw(&PathElement::new(
                     vec![(x, y), (x + 9, y)],
@@ -194,6 +221,126 @@ fn ranks<DB: DrawingBackend>(
     for (p, area) in params.iter().zip(&panels) {
         rank_panel(area, p, report.ranks, threshold)?;
     }
+    Ok(())
+}
+
+/// The grid of ECDF-difference panels.
+fn ecdf<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    report: &CoverageReport,
+    title: &str,
+    cols: usize,
+    bands: &[EcdfBand; 2],
+) -> Result<()> {
+    root.fill(&WHITE).map_err(err)?;
+    let params = &report.parameters;
+    let root = root
+        .titled(
+            &format!(
+                "{title}: ECDF of the ranks minus the uniform one (L = {}, {} truths)",
+                report.ranks, report.n_truths
+            ),
+            ("sans-serif", 24),
+        )
+        .map_err(err)?;
+    let keys = [
+        (Key::Fill(BAND), "simultaneous 99% band".to_string()),
+        (Key::Fill(BAND_95), "simultaneous 95% band".to_string()),
+        (Key::Line(BARS), "F(z) - z of the truths' ranks".to_string()),
+        (
+            Key::Fill(FAIL),
+            "title in red: leaves the 99% band".to_string(),
+        ),
+    ];
+    let body = key_strip(&root, &keys)?;
+    let rows = params.len().div_ceil(cols);
+    let panels = body.split_evenly((rows, cols));
+    let limit = params
+        .iter()
+        .flat_map(|p| ecdf_difference(&p.ranks, report.ranks))
+        .chain(bands[0].upper.iter().copied())
+        .chain(bands[0].lower.iter().map(|x| -x))
+        .fold(0.01_f64, |a, x| a.max(x.abs()))
+        * 1.1;
+    for (p, area) in params.iter().zip(&panels) {
+        ecdf_panel(area, p, report.ranks, bands, limit)?;
+    }
+    Ok(())
+}
+
+/// One parameter's ECDF difference over the two bands.
+fn ecdf_panel<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    p: &ParameterCoverage,
+    l: usize,
+    bands: &[EcdfBand; 2],
+    limit: f64,
+) -> Result<()> {
+    let (in99, in95) = (
+        inside_band(&p.ranks, l, &bands[0]),
+        inside_band(&p.ranks, l, &bands[1]),
+    );
+    let (word, color) = match (in99, in95) {
+        (true, true) => ("inside both bands", BLACK),
+        (true, false) => ("leaves the 95% band", BLACK),
+        _ => ("leaves the 99% band", FAIL),
+    };
+    let mut chart = ChartBuilder::on(area)
+        .margin(12)
+        .margin_right(22)
+        .caption(
+            format!("{}: {word}", p.name),
+            ("sans-serif", 19).into_font().color(&color),
+        )
+        .x_label_area_size(46)
+        .y_label_area_size(70)
+        .build_cartesian_2d(0.0..1.0, -limit..limit)
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc("z = rank / (L + 1)")
+        .y_desc("F(z) - z")
+        .x_labels(6)
+        .y_labels(7)
+        .x_label_formatter(&|v| format!("{v:.1}"))
+        // A label within rounding of 0 is "0.00", not "-0.00".
+        .y_label_formatter(&|v| format!("{:.2}", if v.abs() < 5e-3 { 0.0 } else { *v }))
+        .label_style(("sans-serif", 15))
+        .axis_desc_style(("sans-serif", 17))
+        .light_line_style(WHITE)
+        .draw()
+        .map_err(err)?;
+    for (band, c) in bands.iter().zip([BAND, BAND_95]) {
+        // The band at z = 0 and 1 is a point (F - z = 0 there).
+        let upper = std::iter::once((0.0, 0.0))
+            .chain(band.z.iter().copied().zip(band.upper.iter().copied()))
+            .chain(std::iter::once((1.0, 0.0)));
+        let lower: Vec<(f64, f64)> = band
+            .z
+            .iter()
+            .copied()
+            .zip(band.lower.iter().copied())
+            .rev()
+            .collect();
+        let outline: Vec<(f64, f64)> = upper.chain(lower).collect();
+        chart
+            .draw_series(std::iter::once(Polygon::new(outline, c.filled())))
+            .map_err(err)?;
+    }
+    chart
+        .draw_series(LineSeries::new(
+            [(0.0, 0.0), (1.0, 0.0)],
+            BLACK.stroke_width(1),
+        ))
+        .map_err(err)?;
+    let d = ecdf_difference(&p.ranks, l);
+    let pts: Vec<(f64, f64)> = std::iter::once((0.0, 0.0))
+        .chain(bands[0].z.iter().copied().zip(d))
+        .chain(std::iter::once((1.0, 0.0)))
+        .collect();
+    chart
+        .draw_series(LineSeries::new(pts, BARS.stroke_width(2)))
+        .map_err(err)?;
     Ok(())
 }
 
@@ -378,15 +525,24 @@ fn coverage<DB: DrawingBackend>(
         .light_line_style(WHITE)
         .draw()
         .map_err(err)?;
-    // The band in the normal approximation: the exact binomial quantiles step with k/n and
-    // would draw a saw-tooth.
-    let n = report.n_truths.max(1) as f64;
-    let bands: Vec<(f64, [f64; 2])> = (0..=400)
-        .map(|i| i as f64 / 400.0)
-        .map(|l| {
-            let h = Z_99 * (l * (1.0 - l) / n).sqrt();
-            (l, [(l - h).max(0.0), (l + h).min(1.0)])
-        })
+    // The exact binomial band of the converged truths at each of the study's levels, joined
+    // between them (the band is the fraction of n truths inside a calibrated interval).
+    let n = report
+        .parameters
+        .iter()
+        .map(|p| p.ranks.len())
+        .max()
+        .unwrap_or(0)
+        .max(1);
+    let bands: Vec<(f64, [f64; 2])> = std::iter::once((0.0, [0.0, 0.0]))
+        .chain(
+            report
+                .levels
+                .iter()
+                .filter(|l| l.is_finite() && **l > 0.0 && **l < 1.0)
+                .map(|&l| (l, band(n, l))),
+        )
+        .chain(std::iter::once((1.0, [1.0, 1.0])))
         .collect();
     let outline: Vec<(f64, f64)> = bands
         .iter()
@@ -396,7 +552,7 @@ fn coverage<DB: DrawingBackend>(
     chart
         .draw_series(std::iter::once(Polygon::new(outline, BAND.filled())))
         .map_err(err)?
-        .label("99% band of a calibrated fit (normal approx.)")
+        .label(format!("99% binomial band of a calibrated fit, n = {n}"))
         .legend(|(x, y)| Rectangle::new([(x, y - 6), (x + 20, y + 6)], BAND.filled()));
     chart
         .draw_series(DashedLineSeries::new(
@@ -532,8 +688,8 @@ mod tests {
         let dir =
             std::env::temp_dir().join(format!("hpge-cv-coverage-{tag}-{}", std::process::id()));
         let paths = coverage_figures(&dir, report, &format!("{tag}, synthetic")).unwrap();
-        assert_eq!(paths.len(), 4, "{paths:?}");
-        for stem in ["ranks", "coverage"] {
+        assert_eq!(paths.len(), 6, "{paths:?}");
+        for stem in ["ranks", "ecdf", "coverage"] {
             for ext in ["svg", "png"] {
                 let p = dir.join(format!("{stem}.{ext}"));
                 assert!(paths.contains(&p), "{} not listed", p.display());

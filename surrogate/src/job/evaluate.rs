@@ -191,6 +191,9 @@ pub struct EvaluationJson<'a> {
     pub sigma_p: f64,
     /// The worst samples, worst first.
     pub worst: &'a [Worst],
+    /// What made this file: program, version, date and the solver's physics revision (the
+    /// rows' labels come from the solver).
+    pub made: hpge_foundation::Made,
     /// This program's version.
     pub program_version: &'static str,
     /// The accuracy at the edges of every input (issue 24): rows in the lowest and highest 5%
@@ -286,6 +289,7 @@ impl Evaluation {
             recipe: &self.recipe,
             sigma_p: self.sigma_p,
             worst: &self.worst,
+            made: hpge_solver::made(),
             program_version: env!("CARGO_PKG_VERSION"),
             edges: &self.edges,
             bias_bands: &self.bias_bands,

@@ -20,6 +20,9 @@ pub struct HiddenStudy {
     /// What makes two studies the same run: the effects, the start model, the inputs with
     /// their hashes and the workflow's settings (compared before a study replaces this one).
     pub run: serde_json::Value,
+    /// What made this file: program, version, date and the solver's physics revision.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub made: Option<hpge_foundation::Made>,
     /// The program version.
     pub program_version: String,
     /// One outcome per data set.
@@ -40,6 +43,7 @@ impl HiddenStudy {
             pass: outcomes.iter().all(|o| o.correct && o.consistent),
             seed,
             run,
+            made: Some(hpge_solver::made()),
             program_version: env!("CARGO_PKG_VERSION").into(),
             outcomes,
             seconds,

@@ -184,6 +184,7 @@ fn synthetic(extended: bool) -> Discovery {
         surrogate_start: gap("b-z", 3.41),
         not_applicable: Vec::new(),
         verdict: "synthetic".into(),
+        made: None,
         program_version: "0".into(),
         inputs,
         settings: DiscoverSettings::default(),

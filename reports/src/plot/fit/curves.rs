@@ -1,122 +1,18 @@
-//! Figures against a coordinate: the posterior predictive against the bias and zeta at the
-//! global mode along z and r.
+//! Figures against a coordinate: zeta at the global mode along z and r (the posterior
+//! predictive against the bias is `predictive.rs`).
 
-use hpge_inference::fit::{LEVELS, Predictive};
 use plotters::coord::Shift;
 use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 
-use super::layout::{Axes, Key, LEVEL_COLORS, draw_axes, key_strip, padded};
+use super::layout::{Axes, Key, draw_axes, key_strip, padded};
 use crate::error::Result;
 use crate::plot::style::PALETTE;
 use crate::plot::style::err;
-use hpge_inference::fit::ZetaProfile;
 
-/// sigma_c (dashed) and the zero line.
+/// The zero line.
 const SIGMA: RGBColor = RGBColor(90, 90, 90);
-/// c_p - c_m at the global mode.
-const MODE: RGBColor = RGBColor(31, 119, 180);
-
-/// The posterior predictive of c_p - c_m against U_B: nested central bands, the median, the
-/// difference at the global mode and +-sigma_c around zero.
-pub(super) fn predictive<DB: DrawingBackend>(
-    root: &DrawingArea<DB, Shift>,
-    pred: &Predictive,
-    title: &str,
-) -> Result<()> {
-    root.fill(&WHITE).map_err(err)?;
-    let root = root
-        .titled(
-            &format!(
-                "{title}: posterior predictive of c_p - c_m ({} draws)",
-                pred.draws
-            ),
-            ("sans-serif", 24),
-        )
-        .map_err(err)?;
-    let mut keys: Vec<(Key, String)> = LEVELS
-        .iter()
-        .zip(LEVEL_COLORS)
-        .map(|(l, c)| (Key::Fill(c), format!("{:.1}% central interval", 100.0 * l)))
-        .collect();
-    keys.push((Key::Line(BLACK), "median".into()));
-    keys.push((Key::Dot(MODE), "global mode".into()));
-    keys.push((Key::Dashed(SIGMA), "\u{b1} sigma_c at the mode".into()));
-    let body = key_strip(&root, &keys)?;
-    // Points in order of the bias.
-    let mut order: Vec<usize> = (0..pred.voltage_v.len()).collect();
-    order.sort_by(|&i, &k| pred.voltage_v[i].total_cmp(&pred.voltage_v[k]));
-    let v = |i: usize| pred.voltage_v[i];
-    let diff = |i: usize| {
-        pred.c_mode_pf
-            .get(i)
-            .zip(pred.c_m_pf.get(i))
-            .map(|(p, m)| p - m)
-    };
-    let band = |i: usize, l: usize| pred.bands_pf.get(i).and_then(|b| b.get(l)).copied();
-    let sigma = |i: usize| pred.sigma_pf.get(i).copied();
-    let ys = order.iter().flat_map(|&i| {
-        let b = (0..LEVELS.len()).filter_map(move |l| band(i, l)).flatten();
-        let s = sigma(i).into_iter().flat_map(|s| [s, -s]);
-        b.chain(s)
-            .chain(diff(i))
-            .chain(pred.median_pf.get(i).copied())
-    });
-    let (y0, y1) = padded(ys.chain([0.0]), 0.08);
-    let (x0, x1) = padded(pred.voltage_v.iter().copied(), 0.03);
-    let mut chart = curve_chart(&body, (x0, x1), (y0, y1), ("U_B [V]", "c_p - c_m [pF]"))?;
-    // Widest band first, so that the narrower ones lie on top.
-    for l in (0..LEVELS.len()).rev() {
-        let have: Vec<(f64, [f64; 2])> = order
-            .iter()
-            .filter_map(|&i| band(i, l).map(|b| (v(i), b)))
-            .collect();
-        if have.len() < 2 {
-            continue;
-        }
-        let outline: Vec<(f64, f64)> = have
-            .iter()
-            .map(|(x, b)| (*x, b[1]))
-            .chain(have.iter().rev().map(|(x, b)| (*x, b[0])))
-            .collect();
-        chart
-            .draw_series(std::iter::once(Polygon::new(
-                outline,
-                LEVEL_COLORS[l].filled(),
-            )))
-            .map_err(err)?;
-    }
-    chart
-        .draw_series(LineSeries::new(
-            [(x0, 0.0), (x1, 0.0)],
-            SIGMA.stroke_width(1),
-        ))
-        .map_err(err)?;
-    for sign in [1.0, -1.0] {
-        let pts: Vec<(f64, f64)> = order
-            .iter()
-            .filter_map(|&i| sigma(i).map(|s| (v(i), sign * s)))
-            .collect();
-        chart
-            .draw_series(DashedLineSeries::new(pts, 8, 5, SIGMA.stroke_width(2)))
-            .map_err(err)?;
-    }
-    let median: Vec<(f64, f64)> = order
-        .iter()
-        .filter_map(|&i| pred.median_pf.get(i).map(|m| (v(i), *m)))
-        .collect();
-    chart
-        .draw_series(LineSeries::new(median, BLACK.stroke_width(2)))
-        .map_err(err)?;
-    chart
-        .draw_series(
-            order
-                .iter()
-                .filter_map(|&i| diff(i).map(|d| Circle::new((v(i), d), 4, MODE.filled()))),
-        )
-        .map_err(err)?;
-    Ok(())
-}
+use hpge_inference::fit::ZetaProfile;
 
 /// zeta in 1e10 cm^-3 along `axis` ("z" or "r"), one colour per profile: the global mode (solid),
 /// the posterior's 68.3% and 95.5% central bands over the draws (shaded, where computed) and the

@@ -14,6 +14,7 @@ use crate::error::{Error, Result};
 mod curves;
 mod layout;
 mod posterior;
+mod predictive;
 
 pub use hpge_inference::fit::{ZetaAtMode, ZetaProfile};
 use layout::grid;
@@ -97,8 +98,8 @@ pub fn fit_figures(
         ));
     }
     if !fit.predictive.voltage_v.is_empty() {
-        both!(out, dir, "predictive", (1200, 760), |root| {
-            curves::predictive(&root, &fit.predictive, title)
+        both!(out, dir, "predictive", (1200, 1250), |root| {
+            predictive::predictive(&root, fit, title)
         });
     }
     for (stem, profiles, axis) in [

@@ -143,6 +143,7 @@ fn synthetic_fit(d: usize, chains: usize) -> Fit {
         chi2: 12.0,
         ndf: 9,
         posterior_predictive_p: 0.5,
+        calibration_factor: None,
         parameters,
         modes: Vec::new(),
         local_modes: Vec::new(),
@@ -150,6 +151,7 @@ fn synthetic_fit(d: usize, chains: usize) -> Fit {
         exact_check_skipped: None,
         refinement: None,
         posterior_outside_support: None,
+        made: None,
         program_version: "test".into(),
         inputs: BTreeMap::new(),
         likelihood: NoiseSettings::default(),
@@ -187,6 +189,7 @@ fn synthetic_fit(d: usize, chains: usize) -> Fit {
         sigma_pf,
         draws: 1000,
         ppp: 0.5,
+        calibration: None,
     };
     Fit {
         samples,
@@ -285,9 +288,35 @@ fn b_z_figures() {
     assert!(!dir.exists());
 }
 
+/// `fit` with an exact check at the mode: the exact curve 3% below the data, pulls of a few
+/// sigma with a structure, the calibration factor 1.03.
+fn with_exact_check(mut fit: Fit) -> Fit {
+    let c_m = &fit.predictive.c_m_pf;
+    let exact: Vec<f64> = c_m.iter().map(|c| c / 1.03).collect();
+    let pulls: Vec<f64> = (0..c_m.len())
+        .map(|k| 4.0 * (k as f64 * 0.7).sin())
+        .collect();
+    let check = serde_json::json!({
+        "draws": 100, "failed": 0, "pareto_k": 0.3, "ess": 80.0, "log_ratio_sd": 0.1,
+        "log_ratio_range": 0.5, "parameters": [], "max_rel_diff_at_mode": 0.01,
+        "chi2_exact_at_mode": 60.0, "chi2_data_at_mode": 39313.5, "p_data_at_mode": 0.0,
+        "max_abs_shift_sd": 0.1, "pass": true, "seconds": 1.0, "grids": "mode",
+        "c_exact_at_mode_pf": exact,
+        "own_errors_at_mode": {
+            "sigma_pf": vec![0.004; c_m.len()],
+            "sigma_total_pf": c_m.iter().map(|c| 0.03 * c).collect::<Vec<f64>>(),
+            "pulls": pulls,
+            "calibration": {"factor": 1.03, "factor_sd": 1e-4, "prior_sd": 0.03},
+            "scale_chi2": 1.0
+        }
+    });
+    fit.summary.exact_check = Some(serde_json::from_value(check).unwrap());
+    fit
+}
+
 #[test]
 fn b_rz_figures() {
-    let fit = synthetic_fit(9, 4);
+    let fit = with_exact_check(synthetic_fit(9, 4));
     let stems = [
         "marginals",
         "marginals-zeta",

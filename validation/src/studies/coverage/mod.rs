@@ -15,6 +15,7 @@ use hpge_inference::{Likelihood, Prior};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+pub mod ecdf;
 mod outputs;
 mod settings;
 pub mod store;

@@ -45,6 +45,10 @@ pub fn write_outputs(
     if let Some(obj) = json.as_object_mut() {
         obj.insert("program_version".into(), env!("CARGO_PKG_VERSION").into());
         obj.insert(
+            hpge_foundation::MADE_KEY.into(),
+            hpge_solver::made().to_json(),
+        );
+        obj.insert(
             "inputs".into(),
             serde_json::to_value(p.inputs).map_err(|e| Error::cannot_write(&path, &e))?,
         );
