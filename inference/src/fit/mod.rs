@@ -43,6 +43,6 @@ pub use refine::{
 };
 pub use round::{RefineRound, f64_or_nan};
 pub use run::{Fit, FitSettings, draw_range, fit};
-pub use summary::{FitSummary, LEVELS, ModeSummary, ParameterSummary};
+pub use summary::{FitSummary, LEVELS, ModeSummary, ParameterSummary, mode_physics};
 pub use truth::{TruthRecord, read_truth, truth_records};
 pub use zeta::{ZETA_BAND_DRAWS, ZetaAtMode, ZetaProfile, zeta_profiles};

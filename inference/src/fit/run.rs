@@ -184,6 +184,7 @@ pub fn fit(
             weight: c.weight,
             location: c.mean.clone(),
             std: (0..d).map(|j| c.cov[j * d + j].max(0.0).sqrt()).collect(),
+            physics: super::summary::mode_physics(&prior.names(), &c.mean),
         })
         .collect();
     let predictive = predictive(

@@ -56,6 +56,45 @@ pub struct ModeSummary {
     pub location: Vec<f64>,
     /// The component's standard deviations.
     pub std: Vec<f64>,
+    /// What the mode is, by physics rather than rank (issue 63): for each pair of parameters
+    /// `X_bot` / `X_top`, whether the bottom or the top level is the higher at its location
+    /// (`y: bottom > top`), joined by "; " ([`mode_physics`]); empty where no pair exists.
+    #[serde(default)]
+    pub physics: String,
+}
+
+/// The physics label of a mode at `location` of parameters `names` ([`ModeSummary::physics`]):
+/// B_Z's two modes, the bottom and top levels swapped, are "y: bottom > top" and
+/// "y: top > bottom" whatever their weights.
+///
+/// ```
+/// use hpge_inference::fit::mode_physics;
+/// let names = ["d_li_mm", "y_bot", "y_top"].map(String::from);
+/// assert_eq!(mode_physics(&names, &[1.0, 0.68, 0.50]), "y: bottom > top");
+/// assert_eq!(mode_physics(&names, &[1.0, 0.50, 0.68]), "y: top > bottom");
+/// assert_eq!(mode_physics(&names[..1], &[1.0]), "");
+/// ```
+pub fn mode_physics(names: &[String], location: &[f64]) -> String {
+    let mut out = Vec::new();
+    for (j, name) in names.iter().enumerate() {
+        let Some(stem) = name.strip_suffix("_bot") else {
+            continue;
+        };
+        let top = format!("{stem}_top");
+        let Some(k) = names.iter().position(|n| *n == top) else {
+            continue;
+        };
+        let (b, t) = (location[j], location[k]);
+        let word = if b > t {
+            "bottom > top"
+        } else if t > b {
+            "top > bottom"
+        } else {
+            "bottom = top"
+        };
+        out.push(format!("{stem}: {word}"));
+    }
+    out.join("; ")
 }
 
 /// The summary of a fit.

@@ -385,7 +385,12 @@ pub fn summary_text(fit: &Fit, out: &Path) -> String {
             let loc: Vec<String> = m.location.iter().map(|v| format!("{v:.4}")).collect();
             let _ = writeln!(
                 t,
-                "mode {i}: weight {:.3} at ({})",
+                "mode {i}{}: weight {:.3} at ({})",
+                if m.physics.is_empty() {
+                    String::new()
+                } else {
+                    format!(" ({})", m.physics)
+                },
                 m.weight,
                 loc.join(", ")
             );

@@ -170,7 +170,17 @@ pub fn write_report(
                 .zip(&m.std)
                 .map(|((p, v), sd)| format!("{} = {v:.4} +- {sd:.4}", p.name))
                 .collect();
-            let _ = writeln!(r, "- mode {i}, weight {:.3}: {}", m.weight, loc.join(", "));
+            let physics = if m.physics.is_empty() {
+                String::new()
+            } else {
+                format!(" ({})", m.physics)
+            };
+            let _ = writeln!(
+                r,
+                "- mode {i}{physics}, weight {:.3}: {}",
+                m.weight,
+                loc.join(", ")
+            );
         }
         let _ = writeln!(r);
     } else {
