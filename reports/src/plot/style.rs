@@ -61,3 +61,26 @@ pub(crate) fn log_key_points(lo: f64, hi: f64) -> Vec<f64> {
     }
     out
 }
+
+/// The horizontal line y = 0 across [x0, x1] of a residual or pull panel, one pixel wide.
+pub(crate) fn zero_line<DB: plotters::prelude::DrawingBackend>(
+    chart: &mut plotters::prelude::ChartContext<
+        '_,
+        DB,
+        plotters::prelude::Cartesian2d<
+            plotters::coord::types::RangedCoordf64,
+            plotters::coord::types::RangedCoordf64,
+        >,
+    >,
+    (x0, x1): (f64, f64),
+    color: RGBColor,
+) -> crate::error::Result<()> {
+    use plotters::prelude::{LineSeries, ShapeStyle};
+    chart
+        .draw_series(LineSeries::new(
+            [(x0, 0.0), (x1, 0.0)],
+            ShapeStyle::from(color).stroke_width(1),
+        ))
+        .map_err(err)?;
+    Ok(())
+}

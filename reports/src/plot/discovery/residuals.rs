@@ -6,7 +6,7 @@ use plotters::prelude::*;
 
 use super::layout::*;
 use crate::error::Result;
-use crate::plot::style::err;
+use crate::plot::style::{err, zero_line};
 
 /// The residuals against U_B.
 pub(super) fn residual_panel<DB: DrawingBackend>(
@@ -79,12 +79,7 @@ pub(super) fn residual_panel<DB: DrawingBackend>(
             )))
             .map_err(err)?;
     }
-    chart
-        .draw_series(LineSeries::new(
-            [(x0, 0.0), (x1, 0.0)],
-            GUIDE.stroke_width(1),
-        ))
-        .map_err(err)?;
+    zero_line(&mut chart, (x0, x1), GUIDE)?;
     for y in [2.0, -2.0] {
         chart
             .draw_series(DashedLineSeries::new(

@@ -20,7 +20,7 @@ use plotters::prelude::*;
 
 use super::layout::{Axes, Key, LEVEL_COLORS, draw_axes, key_strip, padded};
 use crate::error::Result;
-use crate::plot::style::{err, log_key_points};
+use crate::plot::style::{err, log_key_points, zero_line};
 
 /// The data.
 const DATA: RGBColor = RGBColor(0, 0, 0);
@@ -293,12 +293,7 @@ pub(super) fn predictive<DB: DrawingBackend>(
             )))
             .map_err(err)?;
     }
-    chart
-        .draw_series(LineSeries::new(
-            [(x0, 0.0), (x1, 0.0)],
-            GUIDE.stroke_width(1),
-        ))
-        .map_err(err)?;
+    zero_line(&mut chart, (x0, x1), GUIDE)?;
     for sign in [1.0, -1.0] {
         let pts: Vec<(f64, f64)> = order
             .iter()
@@ -367,12 +362,7 @@ pub(super) fn predictive<DB: DrawingBackend>(
             ))
             .map_err(err)?;
     }
-    chart
-        .draw_series(LineSeries::new(
-            [(x0, 0.0), (x1, 0.0)],
-            GUIDE.stroke_width(1),
-        ))
-        .map_err(err)?;
+    zero_line(&mut chart, (x0, x1), GUIDE)?;
     chart
         .draw_series(
             p.points
