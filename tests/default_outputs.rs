@@ -346,6 +346,8 @@ fn every_command_with_its_default_outputs_leaves_the_tracked_files_alone() {
         ),
         ("report paper", vec!["--quick"], &[0]),
         ("report status", vec![], &[0]),
+        // Without --write it only reads the reports (exit 1 where one differs).
+        ("report numbers", vec![], &[0, 1]),
         // The study `validate coverage` wrote into its default folder above.
         ("report coverage", vec!["coverage/narrow"], &[0]),
         // Hidden: the section 9 step of `report paper` on its own.

@@ -382,19 +382,33 @@ fn cv<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, m: &Measurement) -> Res
     Ok(())
 }
 
+/// -dc12/dU_B between neighbouring points on a log axis, every point shown (issue 63 item 6):
+/// a point where c12 rises with the bias (-dc12/dU_B <= 0, where the log axis has no place) is
+/// drawn as a cross on the axis floor with its value in the legend, so that a negative point
+/// near U_fd, where the depletion voltage is read, is not lost.
 fn slope<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, m: &Measurement) -> Result<()> {
     root.fill(&WHITE).map_err(err)?;
     let s = negative_slopes(&m.curve.voltage_v, &m.curve.c12_pf);
     let th = m.settings.depletion_slope_pf_per_v;
     let pos: Vec<(f64, f64)> = s.iter().copied().filter(|p| p.1 > 0.0).collect();
+    let rising: Vec<(f64, f64)> = s
+        .iter()
+        .copied()
+        .filter(|p| p.1 <= 0.0 || p.1.is_nan())
+        .collect();
     let lo = pos.iter().map(|p| p.1).fold(th, f64::min) / 3.0;
     let hi = pos.iter().map(|p| p.1).fold(th, f64::max) * 3.0;
     let vmax = m.curve.voltage_v.last().copied().unwrap_or(1.0) * 1.05;
-    let mut chart = ChartBuilder::on(root)
-        .caption(
-            "-dc12/dU_B between neighbouring points (values <= 0 not shown)",
-            ("sans-serif", 18),
+    let caption = if rising.is_empty() {
+        "-dc12/dU_B between neighbouring points (every one positive)".to_string()
+    } else {
+        format!(
+            "-dc12/dU_B between neighbouring points; {} where c12 rises (<= 0): crosses on the floor",
+            rising.len()
         )
+    };
+    let mut chart = ChartBuilder::on(root)
+        .caption(caption, ("sans-serif", 18))
         .margin(15)
         .x_label_area_size(45)
         .y_label_area_size(70)
@@ -407,6 +421,7 @@ fn slope<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, m: &Measurement) -> 
         .configure_mesh()
         .x_desc("bias U_B (V)")
         .y_desc("-dc12/dU_B (pF/V)")
+        .x_label_formatter(&|v| format!("{v:.0}"))
         .y_label_formatter(&|v| format!("{v:.0e}"))
         .draw()
         .map_err(err)?;
@@ -416,6 +431,24 @@ fn slope<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, m: &Measurement) -> 
                 .map(|&(u, d)| Circle::new((u, d), 4, BLUE.filled())),
         )
         .map_err(err)?;
+    if !rising.is_empty() {
+        let floor = lo * 1.15;
+        let values: Vec<String> = rising
+            .iter()
+            .take(4)
+            .map(|(u, d)| format!("{d:.1e} at {u:.0} V"))
+            .collect();
+        let more = if rising.len() > 4 { ", ..." } else { "" };
+        chart
+            .draw_series(
+                rising
+                    .iter()
+                    .map(|&(u, _)| Cross::new((u, floor), 7, RED.stroke_width(3))),
+            )
+            .map_err(err)?
+            .label(format!("<= 0 pF/V: {}{more}", values.join(", ")))
+            .legend(|(x, y)| Cross::new((x + 10, y), 6, RED.stroke_width(3)));
+    }
     chart
         .draw_series(LineSeries::new([(0.0, th), (vmax, th)], RED))
         .map_err(err)?
