@@ -217,6 +217,42 @@ fn bad_input_is_a_clear_error() {
             "--gate",
         ),
         (
+            vec![
+                "depletion",
+                "--detector",
+                "detectors/coax-closed-end.toml",
+                "--measured",
+                "3000+-50",
+                "--tilt-range",
+                "2:1",
+            ],
+            "--tilt-range",
+        ),
+        (
+            vec![
+                "depletion",
+                "--detector",
+                "detectors/coax-closed-end.toml",
+                "--tilt-range",
+                "0:2",
+            ],
+            "--tilt-range needs a measured voltage",
+        ),
+        (
+            // A density constant in z: a tilt changes nothing.
+            vec![
+                "depletion",
+                "--detector",
+                "detectors/coax-analytic.toml",
+                "--measured",
+                "3000+-50",
+                "--tilt-range",
+                "0:2",
+                "--no-pinch-off",
+            ],
+            "does not vary along z",
+        ),
+        (
             vec!["depletion", "--records", "no/such/folder"],
             "no/such/folder",
         ),
@@ -241,4 +277,62 @@ fn bad_input_is_a_clear_error() {
     ] {
         bad(&hpge_cv(&args), &[needle]);
     }
+}
+
+#[test]
+fn records_with_a_tilt_range_fit_the_gradient_where_the_profile_has_one() {
+    // B00002A's profile falls from 1.1e9 to 0.7e9 cm^-3 along the crystal; given a measured
+    // voltage it gets a tilt. V00002A (also a gradient) without a measurement gets none.
+    let dir = temp_dir("records-tilt");
+    let records = dir.join("in");
+    std::fs::create_dir_all(&records).unwrap();
+    let mut b: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/detectors/legend/B00002A.json"
+        ))
+        .unwrap(),
+    )
+    .unwrap();
+    b["characterization"]["manufacturer"]["depletion_voltage_in_V"] = serde_json::json!(150.0);
+    std::fs::write(records.join("B00002A.json"), b.to_string()).unwrap();
+    std::fs::copy(
+        concat!(env!("CARGO_MANIFEST_DIR"), "/detectors/legend/V00002A.json"),
+        records.join("V00002A.json"),
+    )
+    .unwrap();
+    let out = dir.join("out");
+    let got = json(&hpge_cv(&[
+        "depletion",
+        "--records",
+        records.to_str().unwrap(),
+        "--tilt-range",
+        "0.5:1.5",
+        "--no-pinch-off",
+        "--tolerance",
+        "0.01",
+        "--out",
+        out.to_str().unwrap(),
+        "--json",
+    ]));
+    let rows = got["records"].as_array().unwrap();
+    let (b, v) = (&rows[0], &rows[1]);
+    let t = b["tilt"].as_f64().unwrap();
+    let (lo, hi) = (
+        b["tilt_68"][0].as_f64().unwrap(),
+        b["tilt_68"][1].as_f64().unwrap(),
+    );
+    assert!(0.5 < lo && lo < t && t < hi && hi < 1.5, "{b}");
+    assert!(b["factor"].as_f64().unwrap() > 0.0, "{b}");
+    assert!(v["tilt"].is_null(), "{v}");
+    let csv = std::fs::read_to_string(out.join("table.csv")).unwrap();
+    assert!(
+        csv.lines()
+            .next()
+            .unwrap()
+            .ends_with(",tilt,tilt_lo_68,tilt_hi_68"),
+        "{csv}"
+    );
+    let md = std::fs::read_to_string(out.join("table.md")).unwrap();
+    assert!(md.contains("(tilt "), "{md}");
 }

@@ -10,6 +10,7 @@ import hpge_cv
 from conftest import ROOT
 
 COAX = ROOT / "detectors" / "coax-analytic.toml"
+CLOSED_END = ROOT / "detectors" / "coax-closed-end.toml"
 MODEL = ROOT / "models" / "super-siegfried-rz-split.safetensors"
 PARAMS = {
     "d_li_mm": 1.0,
@@ -242,3 +243,19 @@ def test_depletion_equals_the_command_line(cli_json):
     assert len(table["f"]) == len(table["density"]) > 1000
     with pytest.raises(Exception, match="measured"):
         hpge_cv.depletion(det, measured=(-1.0, 10.0))
+
+
+def test_depletion_with_a_tilt_equals_the_command_line(cli_json):
+    # Issue 64: the factor and the tilt of the density's gradient, as `--tilt-range`, on a
+    # detector whose density is linear in z.
+    det = hpge_cv.Detector(CLOSED_END)
+    got = hpge_cv.depletion(det, measured=(3000.0, 50.0), tilt_range=(0.0, 2.0), pinch_off=False, curve=False)
+    ref = cli_json(
+        "depletion", "--detector", CLOSED_END, "--measured", "3000+-50", "--tilt-range", "0:2",
+        "--no-pinch-off", "--json",
+    )
+    assert got["factor"]["median"] == pytest.approx(ref["factor"]["median"], rel=1e-9)
+    assert got["tilt"]["median"] == pytest.approx(ref["tilt"]["median"], rel=1e-9)
+    assert [n["tilt"] for n in got["tilt"]["nodes"]] == pytest.approx([0.0, 0.2928932, 1.0, 1.7071068, 2.0], abs=1e-6)
+    with pytest.raises(Exception, match="tilt-range"):
+        hpge_cv.depletion(det, measured=(3000.0, 50.0), tilt_range=(2.0, 1.0))

@@ -10,7 +10,7 @@ use hpge_foundation::Shard;
 use hpge_inference::depletion::records::{csv_table, markdown_table};
 use hpge_inference::depletion::{
     DEFAULT_GATE_V, DepletionOptions, DepletionReport, Measured, RecordsOptions, ScalePrior,
-    depletion, run_records,
+    TiltPrior, depletion, run_records,
 };
 use hpge_reports::plot;
 use hpge_reports::plot::{Corner, Curve, LineFigure, line_figure};
@@ -48,6 +48,11 @@ pub struct DepletionArgs {
     /// The factor's log-uniform prior range LO:HI.
     #[arg(long, value_name = "LO:HI", default_value = "0.1:10")]
     factor_range: String,
+    /// Fit the tilt of the density's variation along z too, uniform on LO:HI (1: the
+    /// profile's gradient as given, 0: flat, 2: twice as steep), e.g. 0.5:1.5. The factor's
+    /// interval then carries the gradient's uncertainty. Costs 4 more U_fd searches.
+    #[arg(long, value_name = "LO:HI", allow_hyphen_values = true)]
+    tilt_range: Option<String>,
     /// Flag |simulated - measured| above this many volts (LEGEND's gate).
     #[arg(long, value_name = "V", default_value_t = DEFAULT_GATE_V, allow_hyphen_values = true)]
     gate: f64,
@@ -83,6 +88,7 @@ pub struct DepletionArgs {
 /// Runs `hpge-cv depletion`.
 pub fn run(a: &DepletionArgs) -> Result<()> {
     let prior = ScalePrior::parse(&a.factor_range)?;
+    let tilt = a.tilt_range.as_deref().map(TiltPrior::parse).transpose()?;
     if !(a.measured_sigma.is_finite() && a.measured_sigma >= 0.0) {
         bail!(
             "--measured-sigma {}: must be zero or a positive number of V",
@@ -110,7 +116,7 @@ pub fn run(a: &DepletionArgs) -> Result<()> {
         if a.plot.is_some() || a.curve_plot.is_some() {
             bail!("--plot and --curve-plot go with one detector, not --records");
         }
-        return records(a, dir, prior, legend, &base);
+        return records(a, dir, prior, tilt, legend, &base);
     }
     if a.shard != Shard::WHOLE {
         bail!("--shard goes with --records");
@@ -142,12 +148,16 @@ pub fn run(a: &DepletionArgs) -> Result<()> {
         }
         (None, None) => None,
     };
+    if measured.is_none() && tilt.is_some() {
+        bail!("--tilt-range needs a measured voltage (--measured U±S, or a record that gives one)");
+    }
     if measured.is_none() && (a.plot.is_some() || a.curve_plot.is_some() || a.out.is_some()) {
         bail!("--plot, --curve-plot and --out need a measured voltage (--measured U±S)");
     }
     let opts = DepletionOptions {
         measured,
         prior,
+        tilt,
         pinch_off: !a.no_pinch_off,
         // The curve (25 solves) only where it is shown.
         curve: a.out.is_some() || a.curve_plot.is_some() || a.json,
@@ -249,6 +259,28 @@ fn print_report(det: &Detector, r: &DepletionReport, pinch_searched: bool) -> Re
             outln!("AT A PRIOR BOUND: widen --factor-range");
         }
     }
+    if let Some(t) = &r.tilt {
+        let m = &t.marginal;
+        outln!(
+            "tilt of the gradient {:.3} (68.3%: [{:.3}, {:.3}], 95.4%: [{:.3}, {:.3}]; prior uniform [{}, {}]); correlation with ln f {:.2}",
+            m.median,
+            m.interval_68.0,
+            m.interval_68.1,
+            m.interval_95.0,
+            m.interval_95.1,
+            t.prior.lo,
+            t.prior.hi,
+            t.correlation_log_factor
+        );
+        for n in &t.nodes {
+            outln!(
+                "  U_fd at tilt {:.4}: {:.1} ± {:.1} V",
+                n.tilt,
+                n.u_fd_v,
+                n.err_v
+            );
+        }
+    }
     Ok(())
 }
 
@@ -293,16 +325,27 @@ fn draw(
             ],
             y_from_zero: true,
             legend: Corner::UpperLeft,
-            footnotes: vec![format!(
-                "hpge-cv {} depletion; U_fd(f) = f U_fd(1), U_fd(1) = {}; prior log-uniform [{}, {}]",
-                env!("CARGO_PKG_VERSION"),
-                r.voltages.full_depletion.map_or_else(
-                    || "-".into(),
-                    |u| format!("{:.1} ± {:.1} V", u.voltage_v, u.err_v)
+            footnotes: vec![match &r.tilt {
+                None => format!(
+                    "hpge-cv {} depletion; U_fd(f) = f U_fd(1), U_fd(1) = {}; prior log-uniform [{}, {}]",
+                    env!("CARGO_PKG_VERSION"),
+                    r.voltages.full_depletion.map_or_else(
+                        || "-".into(),
+                        |u| format!("{:.1} ± {:.1} V", u.voltage_v, u.err_v)
+                    ),
+                    p.prior.lo,
+                    p.prior.hi
                 ),
-                p.prior.lo,
-                p.prior.hi
-            )],
+                Some(t) => format!(
+                    "hpge-cv {} depletion; marginal over the tilt (uniform [{}, {}], median {:.3}); U_fd(f, t) = f U_fd(1, t); prior log-uniform [{}, {}]",
+                    env!("CARGO_PKG_VERSION"),
+                    t.prior.lo,
+                    t.prior.hi,
+                    t.marginal.median,
+                    p.prior.lo,
+                    p.prior.hi
+                ),
+            }],
         };
         line_figure(&fig, path)?;
         eprintln!("wrote {}", path.display());
@@ -342,6 +385,7 @@ fn records(
     a: &DepletionArgs,
     dir: &Path,
     prior: ScalePrior,
+    tilt: Option<TiltPrior>,
     legend: LegendOptions,
     base: &FieldSettings,
 ) -> Result<()> {
@@ -354,6 +398,7 @@ fn records(
         shard: a.shard,
         sigma_v: a.measured_sigma,
         prior,
+        tilt,
         gate_v: a.gate,
         pinch_off: !a.no_pinch_off,
         legend,

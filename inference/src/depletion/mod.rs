@@ -10,6 +10,7 @@
 
 pub mod records;
 pub mod scale;
+pub mod tilt;
 
 use serde::Serialize;
 
@@ -17,7 +18,8 @@ use hpge_solver::field::{DepletionVoltages, depletion_voltages};
 use hpge_solver::{Detector, FieldSettings, cv_curve};
 
 pub use records::{RecordRow, RecordsOptions, not_converged, run_records};
-pub use scale::{Measured, ScalePosterior, ScalePrior, scale_posterior};
+pub use scale::{Marginal, Measured, ScalePosterior, ScalePrior, scale_posterior};
+pub use tilt::{TiltNode, TiltPosterior, TiltPrior, tilt_posterior};
 
 use crate::error::{Error, Result};
 
@@ -35,6 +37,9 @@ pub struct DepletionOptions {
     pub measured: Option<Measured>,
     /// The factor's prior.
     pub prior: ScalePrior,
+    /// Fit the tilt of the density's variation along z too, with this uniform prior (none: the
+    /// profile's gradient as given, the factor alone; [`tilt`]).
+    pub tilt: Option<TiltPrior>,
     /// Search for the pinch-off voltage too.
     pub pinch_off: bool,
     /// Compute the C-V curve at the posterior median (with a measurement).
@@ -48,6 +53,7 @@ impl Default for DepletionOptions {
         DepletionOptions {
             measured: None,
             prior: ScalePrior::default(),
+            tilt: None,
             pinch_off: true,
             curve: true,
             gate_v: DEFAULT_GATE_V,
@@ -60,6 +66,8 @@ impl Default for DepletionOptions {
 pub struct ScaledCurve {
     /// The factor (the posterior median).
     pub factor: f64,
+    /// The tilt (its posterior median; 1 without a tilt fit).
+    pub tilt: f64,
     /// Biases, V: U_fd(factor) times 0.05, 0.10, ..., 1.25.
     pub voltage_v: Vec<f64>,
     /// c12, pF.
@@ -79,8 +87,10 @@ pub struct DepletionReport {
     pub gate_v: f64,
     /// |U_fd - U_measured| > gate (None without a measurement or a U_fd).
     pub exceeds_gate: Option<bool>,
-    /// The factor's posterior (with a measurement).
+    /// The factor's posterior (with a measurement; its marginal where a tilt was fitted).
     pub posterior: Option<ScalePosterior>,
+    /// The tilt's posterior (with a measurement and a tilt range).
+    pub tilt: Option<TiltPosterior>,
     /// The C-V curve at the posterior median.
     pub curve: Option<ScaledCurve>,
 }
@@ -92,7 +102,8 @@ impl DepletionReport {
     /// estimated), `depletion_voltage_halved_V` and `depletion_voltage_converged` (U_fd on the
     /// grid with halved spacings, and whether U_fd converges:
     /// `hpge_solver::field::CONVERGED_RATIO`), `grid`, `measured`, `gate_V`, `exceeds_gate`,
-    /// `factor` (the posterior's summaries) and `curve_at_median`.
+    /// `factor` (the posterior's summaries), `tilt` (with a tilt range: its prior, marginal,
+    /// correlation with ln f and the exact solves at its nodes) and `curve_at_median`.
     pub fn to_json(&self) -> serde_json::Value {
         let finite = |x: Option<f64>| x.filter(|v| v.is_finite());
         let (fd, po) = (self.voltages.full_depletion, self.voltages.pinch_off);
@@ -108,6 +119,7 @@ impl DepletionReport {
             "gate_V": self.gate_v,
             "exceeds_gate": self.exceeds_gate,
             "factor": self.posterior,
+            "tilt": self.tilt,
             "curve_at_median": self.curve,
             "solver_revision": hpge_solver::field::PHYSICS_REVISION,
         })
@@ -142,6 +154,7 @@ pub fn depletion(
         gate_v: o.gate_v,
         exceeds_gate: None,
         posterior: None,
+        tilt: None,
         curve: None,
     };
     let Some(m) = o.measured else {
@@ -168,16 +181,35 @@ pub fn depletion(
         });
     }
     report.exceeds_gate = Some((u1.voltage_v - m.voltage_v).abs() > o.gate_v);
-    let posterior = scale_posterior(m, o.prior, |f| Ok((f * u1.voltage_v, f * u1.err_v)))?;
+    let (posterior, tilt_median, u_at_tilt) = match o.tilt {
+        None => (
+            scale_posterior(m, o.prior, |f| Ok((f * u1.voltage_v, f * u1.err_v)))?,
+            1.0,
+            u1.voltage_v,
+        ),
+        Some(tp) => {
+            let nodes = tilt_nodes(det, settings, tp, u1, &mut progress)?;
+            let (fp, t) = tilt_posterior(m, o.prior, tp, &nodes)?;
+            let xs: Vec<f64> = nodes.iter().map(|n| n.tilt).collect();
+            let us: Vec<f64> = nodes.iter().map(|n| n.u_fd_v).collect();
+            let med = t.marginal.median;
+            report.tilt = Some(t);
+            (fp, med, tilt::interpolate(&xs, &us, med))
+        }
+    };
     if o.curve {
         progress("the C-V curve at the posterior median");
         let f = posterior.median;
-        let scaled = det.with_impurity_scale(f)?;
-        let top = f * u1.voltage_v;
+        let mut scaled = det.with_impurity_scale(f)?;
+        if o.tilt.is_some() {
+            scaled = scaled.with_impurity_tilt(tilt_median)?;
+        }
+        let top = f * u_at_tilt;
         let volts: Vec<f64> = (1..=CURVE_POINTS).map(|k| top * 0.05 * k as f64).collect();
         let c = cv_curve(&scaled, &volts, settings, |_, _| {})?;
         report.curve = Some(ScaledCurve {
             factor: f,
+            tilt: tilt_median,
             voltage_v: c.points.iter().map(|p| p.voltage_v).collect(),
             c12_pf: c.points.iter().map(|p| p.c12_pf).collect(),
             c12_err_pf: c.points.iter().map(|p| p.c12_err_pf).collect(),
@@ -186,4 +218,61 @@ pub fn depletion(
     }
     report.posterior = Some(posterior);
     Ok(report)
+}
+
+/// U_fd with its error bar at the tilt prior's nodes (f = 1); the detector's own U_fd `u1`
+/// where a node is the tilt 1.
+///
+/// # Errors
+/// A detector whose density does not vary along z ([`Error::NotApplicable`]: a tilt changes
+/// nothing), a node that does not deplete up to the ceiling, solver failures.
+fn tilt_nodes(
+    det: &Detector,
+    settings: &FieldSettings,
+    prior: TiltPrior,
+    u1: hpge_solver::field::VoltageEstimate,
+    progress: &mut impl FnMut(&str),
+) -> Result<Vec<TiltNode>> {
+    if !det.impurity_varies_along_z() {
+        return Err(Error::NotApplicable {
+            extension: "tilt".into(),
+            reason: format!(
+                "{}: the impurity density does not vary along z, so a tilt (--tilt-range) changes nothing",
+                det.name
+            ),
+        });
+    }
+    let nodes = prior.nodes();
+    let mut out = Vec::with_capacity(nodes.len());
+    for (k, &t) in nodes.iter().enumerate() {
+        if (t - 1.0).abs() < 1e-12 {
+            out.push(TiltNode {
+                tilt: t,
+                u_fd_v: u1.voltage_v,
+                err_v: u1.err_v,
+            });
+            continue;
+        }
+        progress(&format!(
+            "U_fd at tilt {t:.4} ({} of {})",
+            k + 1,
+            nodes.len()
+        ));
+        let tilted = det.with_impurity_tilt(t)?;
+        let v = depletion_voltages(&tilted, settings, false)?;
+        let u = v.full_depletion.ok_or_else(|| Error::NotApplicable {
+            extension: "tilt".into(),
+            reason: format!(
+                "{}: not fully depleted up to {} V at tilt {t}; narrow --tilt-range",
+                det.name,
+                hpge_solver::field::CEILING_V
+            ),
+        })?;
+        out.push(TiltNode {
+            tilt: t,
+            u_fd_v: u.voltage_v,
+            err_v: u.err_v,
+        });
+    }
+    Ok(out)
 }

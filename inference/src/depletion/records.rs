@@ -24,7 +24,7 @@ use hpge_foundation::Shard;
 use hpge_solver::detector::legend::{LegendOptions, read_file, to_toml};
 use hpge_solver::{Detector, FieldSettings, Parameters};
 
-use super::{DepletionOptions, Measured, ScalePrior, depletion};
+use super::{DepletionOptions, Measured, ScalePrior, TiltPrior, depletion};
 use crate::error::{Error, Result};
 
 /// What a records run is asked for.
@@ -40,6 +40,9 @@ pub struct RecordsOptions {
     pub sigma_v: f64,
     /// The factor's prior.
     pub prior: ScalePrior,
+    /// Fit the tilt of the density's gradient too, with this prior, for every record whose
+    /// density varies along z (the others get the factor alone and a note).
+    pub tilt: Option<TiltPrior>,
     /// The gate on |simulated - measured|, V.
     pub gate_v: f64,
     /// Search the pinch-off voltage too.
@@ -80,6 +83,12 @@ pub struct RecordRow {
     pub factor: Option<f64>,
     /// Its central 68.3% interval.
     pub factor_68: Option<(f64, f64)>,
+    /// Posterior median of the tilt (with `--tilt-range` and a density that varies along z).
+    #[serde(default)]
+    pub tilt: Option<f64>,
+    /// Its central 68.3% interval.
+    #[serde(default)]
+    pub tilt_68: Option<(f64, f64)>,
     /// |simulated - measured| > gate.
     pub exceeds_gate: Option<bool>,
     /// Why there are no numbers (not a diode record, a conversion or solver failure), or a
@@ -203,7 +212,7 @@ fn inputs(file: &Path, o: &RecordsOptions, settings: &FieldSettings) -> Result<s
         action: "cannot read the file",
         source,
     })?;
-    Ok(serde_json::json!({
+    let mut v = serde_json::json!({
         "record_text": text,
         "settings": settings,
         "sigma_V": o.sigma_v,
@@ -219,7 +228,12 @@ fn inputs(file: &Path, o: &RecordsOptions, settings: &FieldSettings) -> Result<s
         },
         "version": env!("CARGO_PKG_VERSION"),
         "solver_revision": hpge_solver::field::PHYSICS_REVISION,
-    }))
+    });
+    // Only with a tilt: rows made without one keep matching.
+    if let Some(t) = o.tilt {
+        v["tilt_prior"] = serde_json::json!(t);
+    }
+    Ok(v)
 }
 
 fn load_row(path: &Path, inputs: &serde_json::Value) -> Option<RecordRow> {
@@ -243,6 +257,8 @@ fn one_record(file: &Path, o: &RecordsOptions, settings: &FieldSettings) -> Reco
         measured_v: None,
         factor: None,
         factor_68: None,
+        tilt: None,
+        tilt_68: None,
         exceeds_gate: None,
         note: None,
     };
@@ -271,6 +287,7 @@ fn fill(
             sigma_v: o.sigma_v,
         }),
         prior: o.prior,
+        tilt: o.tilt.filter(|_| det.impurity_varies_along_z()),
         pinch_off: o.pinch_off,
         curve: false,
         gate_v: o.gate_v,
@@ -296,6 +313,12 @@ fn fill(
     }
     if r.voltages.full_depletion_converged == Some(false) {
         notes.push(not_converged(r.voltages.full_depletion_halved_v));
+    }
+    if let Some(t) = &r.tilt {
+        row.tilt = Some(t.marginal.median);
+        row.tilt_68 = Some(t.marginal.interval_68);
+    } else if o.tilt.is_some() && row.measured_v.is_some() && !det.impurity_varies_along_z() {
+        notes.push("the density does not vary along z: no tilt fitted".into());
     }
     if let Some(p) = &r.posterior {
         row.factor = Some(p.median);
@@ -350,6 +373,10 @@ pub fn markdown_table(rows: &[RecordRow], gate_v: f64) -> String {
             (Some(f), Some((a, b))) => format!("{f:.3} [{a:.3}, {b:.3}]"),
             _ => "-".into(),
         };
+        let factor = match (r.tilt, r.tilt_68) {
+            (Some(t), Some((a, b))) => format!("{factor} (tilt {t:.2} [{a:.2}, {b:.2}])"),
+            _ => factor,
+        };
         let flag = match r.exceeds_gate {
             Some(true) => "**yes**",
             Some(false) => "no",
@@ -378,13 +405,13 @@ pub fn markdown_table(rows: &[RecordRow], gate_v: f64) -> String {
 /// The rows as CSV (one header line; empty cells where a value is missing).
 pub fn csv_table(rows: &[RecordRow]) -> String {
     let mut s = String::from(
-        "record,detector,type,depletion_voltage_V,depletion_voltage_err_V,pinch_off_voltage_V,pinch_off_voltage_err_V,measured_V,factor,factor_lo_68,factor_hi_68,exceeds_gate,note,depletion_voltage_halved_V,depletion_voltage_converged\n",
+        "record,detector,type,depletion_voltage_V,depletion_voltage_err_V,pinch_off_voltage_V,pinch_off_voltage_err_V,measured_V,factor,factor_lo_68,factor_hi_68,exceeds_gate,note,depletion_voltage_halved_V,depletion_voltage_converged,tilt,tilt_lo_68,tilt_hi_68\n",
     );
     let c = |x: Option<f64>| x.map_or_else(String::new, |v| format!("{v}"));
     for r in rows {
         let q = |t: &str| format!("\"{}\"", t.replace('"', "\"\""));
         s.push_str(&format!(
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
             q(&r.record),
             q(r.name.as_deref().unwrap_or("")),
             q(r.kind.as_deref().unwrap_or("")),
@@ -401,6 +428,9 @@ pub fn csv_table(rows: &[RecordRow]) -> String {
             c(r.depletion_voltage_halved_v),
             r.depletion_voltage_converged
                 .map_or_else(String::new, |b| b.to_string()),
+            c(r.tilt),
+            c(r.tilt_68.map(|i| i.0)),
+            c(r.tilt_68.map(|i| i.1)),
         ));
     }
     s

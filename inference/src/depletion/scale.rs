@@ -200,59 +200,115 @@ pub fn scale_posterior(
     }
     let top = logp.iter().copied().fold(f64::NEG_INFINITY, f64::max);
     let w: Vec<f64> = logp.iter().map(|l| (l - top).exp()).collect();
-    // Cumulative trapezoid in t.
-    let mut cdf = vec![0.0; n];
-    for k in 1..n {
-        cdf[k] = cdf[k - 1] + 0.5 * (w[k] + w[k - 1]) * dt;
-    }
-    let z = cdf[n - 1];
-    if !(z.is_finite() && z > 0.0) {
-        return Err(Error::Numerical {
-            what: "the depletion-voltage posterior".into(),
-            message: "the likelihood vanishes over the whole factor range".into(),
-        });
-    }
-    for c in &mut cdf {
-        *c /= z;
-    }
-    let quantile = |q: f64| -> f64 {
-        let k = cdf.partition_point(|&c| c < q).clamp(1, n - 1);
-        let (c0, c1) = (cdf[k - 1], cdf[k]);
-        let a = if c1 > c0 { (q - c0) / (c1 - c0) } else { 0.5 };
-        (ts[k - 1] + a * dt).exp()
-    };
-    // Moments of f: integrate f p(t) dt.
-    let moment = |p: i32| -> f64 {
-        (1..n)
-            .map(|k| 0.5 * (w[k] * ts[k].exp().powi(p) + w[k - 1] * ts[k - 1].exp().powi(p)) * dt)
-            .sum::<f64>()
-            / z
-    };
-    let mean = moment(1);
-    let sd = (moment(2) - mean * mean).max(0.0).sqrt();
-    let edge = 0.01 * (t1 - t0);
-    let lo_mass = cdf[((edge / dt).round() as usize).min(n - 1)];
-    let hi_mass = 1.0 - cdf[n - 1 - ((edge / dt).round() as usize).min(n - 1)];
-    let table = ts
-        .iter()
-        .zip(&w)
-        .map(|(&t, &wk)| {
-            let f = t.exp();
-            // Density in f: p(t) / f.
-            (f, wk / z / f)
+    let m = Marginal::from_grid(t0, dt, &w, f64::exp).ok_or_else(|| Error::Numerical {
+        what: "the depletion-voltage posterior".into(),
+        message: "the likelihood vanishes over the whole factor range".into(),
+    })?;
+    Ok(ScalePosterior::new(prior, measured, &m, t0, dt, &w))
+}
+
+/// Summaries of a one-dimensional posterior tabulated on a uniform grid u_k = u0 + k du of a
+/// coordinate u (ln f for the factor, t itself for the tilt), with x = map(u) the quantity
+/// summarised: quantiles from the trapezoidal CDF in u (linear between grid points), moments
+/// of x by the trapezoidal rule in u.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Marginal {
+    /// Posterior median of x.
+    pub median: f64,
+    /// Posterior mean of x.
+    pub mean: f64,
+    /// Posterior standard deviation of x.
+    pub sd: f64,
+    /// The central 68.3% interval of x.
+    pub interval_68: (f64, f64),
+    /// The central 95.4% interval of x.
+    pub interval_95: (f64, f64),
+    /// More than 1% of the posterior lies within 1% of the grid's range of a bound: the prior
+    /// range cut the answer off.
+    pub at_prior_bound: bool,
+}
+
+impl Marginal {
+    /// The summaries of the unnormalised density `w` (in u) on the grid; `None` where `w`
+    /// does not integrate to a positive finite number or has fewer than two points.
+    pub fn from_grid(u0: f64, du: f64, w: &[f64], map: impl Fn(f64) -> f64) -> Option<Self> {
+        let n = w.len();
+        if n < 2 {
+            return None;
+        }
+        let u = |k: usize| u0 + k as f64 * du;
+        let mut cdf = vec![0.0; n];
+        for k in 1..n {
+            cdf[k] = cdf[k - 1] + 0.5 * (w[k] + w[k - 1]) * du;
+        }
+        let z = cdf[n - 1];
+        if !(z.is_finite() && z > 0.0) {
+            return None;
+        }
+        for c in &mut cdf {
+            *c /= z;
+        }
+        let quantile = |q: f64| -> f64 {
+            let k = cdf.partition_point(|&c| c < q).clamp(1, n - 1);
+            let (c0, c1) = (cdf[k - 1], cdf[k]);
+            let a = if c1 > c0 { (q - c0) / (c1 - c0) } else { 0.5 };
+            map(u(k - 1) + a * du)
+        };
+        let moment = |p: i32| -> f64 {
+            (1..n)
+                .map(|k| 0.5 * (w[k] * map(u(k)).powi(p) + w[k - 1] * map(u(k - 1)).powi(p)) * du)
+                .sum::<f64>()
+                / z
+        };
+        let mean = moment(1);
+        let sd = (moment(2) - mean * mean).max(0.0).sqrt();
+        let edge = ((0.01 * (n - 1) as f64).round() as usize).min(n - 1);
+        let lo_mass = cdf[edge];
+        let hi_mass = 1.0 - cdf[n - 1 - edge];
+        Some(Marginal {
+            median: quantile(0.5),
+            mean,
+            sd,
+            interval_68: (quantile(0.158_655), quantile(0.841_345)),
+            interval_95: (quantile(0.022_750), quantile(0.977_250)),
+            at_prior_bound: lo_mass > 0.01 || hi_mass > 0.01,
         })
-        .collect();
-    Ok(ScalePosterior {
-        prior,
-        measured,
-        median: quantile(0.5),
-        mean,
-        sd,
-        interval_68: (quantile(0.158_655), quantile(0.841_345)),
-        interval_95: (quantile(0.022_750), quantile(0.977_250)),
-        at_prior_bound: lo_mass > 0.01 || hi_mass > 0.01,
-        table,
-    })
+    }
+}
+
+impl ScalePosterior {
+    /// The factor's posterior from its marginal `m` and its unnormalised density `w` in
+    /// t = ln f on the grid t0 + k dt (the table is the density in f).
+    pub(crate) fn new(
+        prior: ScalePrior,
+        measured: Measured,
+        m: &Marginal,
+        t0: f64,
+        dt: f64,
+        w: &[f64],
+    ) -> Self {
+        let z: f64 = (1..w.len()).map(|k| 0.5 * (w[k] + w[k - 1]) * dt).sum();
+        let table = w
+            .iter()
+            .enumerate()
+            .map(|(k, &wk)| {
+                let f = (t0 + k as f64 * dt).exp();
+                // Density in f: p(t) / f.
+                (f, wk / z / f)
+            })
+            .collect();
+        ScalePosterior {
+            prior,
+            measured,
+            median: m.median,
+            mean: m.mean,
+            sd: m.sd,
+            interval_68: m.interval_68,
+            interval_95: m.interval_95,
+            at_prior_bound: m.at_prior_bound,
+            table,
+        }
+    }
 }
 
 #[cfg(test)]

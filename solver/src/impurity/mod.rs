@@ -16,7 +16,7 @@ mod spline;
 mod transform;
 
 pub use model::{
-    ConstantModel, ImpurityModel, LinearZModel, PointDensity, ScaledModel, ZTableModel,
+    ConstantModel, ImpurityModel, LinearZModel, PointDensity, ScaledModel, TiltedModel, ZTableModel,
 };
 pub use rz::RzModel;
 pub use spec::{ImpurityContext, ImpuritySpec, ModelKind};

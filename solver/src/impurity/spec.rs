@@ -2,7 +2,9 @@
 
 use std::path::Path;
 
-use super::model::{ConstantModel, ImpurityModel, LinearZModel, ScaledModel, ZTableModel};
+use super::model::{
+    ConstantModel, ImpurityModel, LinearZModel, ScaledModel, TiltedModel, ZTableModel,
+};
 use super::rz::RzModel;
 use super::transform::LogTransform;
 use crate::error::{Error, Result};
@@ -99,6 +101,12 @@ pub struct ImpuritySpec {
     /// depletion`, issue 64).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub scale: Option<f64>,
+    /// Any model: a factor on its variation along z about the crystal's mid-height (default 1;
+    /// [`TiltedModel`]): zeta(r, z) = zeta(r, z_mid) + tilt (zeta(r, z) - zeta(r, z_mid)),
+    /// applied before `scale`. The gradient's uncertainty in `hpge-cv depletion --tilt-range`
+    /// (issue 64).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tilt: Option<f64>,
 }
 
 /// What a model needs from the detector: the crystal's z range and default knots.
@@ -174,6 +182,18 @@ impl ImpuritySpec {
         };
         self.check_foreign_keys(keys)?;
         let model = self.build_unscaled(ctx, keys)?;
+        let model: Box<dyn ImpurityModel> = match self.tilt {
+            None => model,
+            Some(t) if t.is_finite() => {
+                check_context(ctx)?;
+                Box::new(TiltedModel {
+                    inner: model,
+                    tilt: t,
+                    z_mid_mm: 0.5 * (ctx.z_bottom_mm + ctx.z_top_mm),
+                })
+            }
+            Some(t) => return Err(keys.err("tilt", format!("must be a finite number, got {t}"))),
+        };
         match self.scale {
             None => Ok(model),
             Some(f) if f.is_finite() && f > 0.0 => Ok(Box::new(ScaledModel {

@@ -83,6 +83,20 @@ fn constant_and_linear_z() {
 }
 
 #[test]
+fn a_tilt_scales_the_gradient_before_the_scale() {
+    // 1.3e10 at z = 0 to 0.44e10 at z = 70: mid-height value 0.87e10.
+    let m = build(
+        "model = \"linear-z\"\nbottom_cm3 = 1.3e10\ntop_cm3 = 0.44e10\ntilt = 2.0\nscale = 0.5\n",
+    )
+    .unwrap();
+    assert!(rel(m.density_cm3(0.0, 35.0), 0.5 * 0.87e10) < 1e-12);
+    assert!(rel(m.density_cm3(0.0, 0.0), 0.5 * (0.87e10 + 2.0 * 0.43e10)) < 1e-12);
+    let (key, message) = invalid("model = \"constant\"\nzeta_cm3 = 1e10\ntilt = nan\n");
+    assert_eq!(key, "tilt");
+    assert!(message.contains("finite"), "{message}");
+}
+
+#[test]
 fn serialisation_round_trip() {
     let text = format!("{RZ_Y}y_bot = [0.5, 0.5, 0.1, -0.2]\ny_top = [0.4, 0.4, 0.1, -0.3]\n");
     let spec = ImpuritySpec::from_toml_str(&text, &file()).unwrap();
