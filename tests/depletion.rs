@@ -138,6 +138,16 @@ fn a_folder_of_records_makes_one_resumable_table_in_shards() {
     assert!(md.contains("| V99000A.yaml | V99000A | icpc |"), "{md}");
     let csv = std::fs::read_to_string(out.join("table.csv")).unwrap();
     assert_eq!(csv.lines().count(), 5, "{csv}");
+    // The CSV's sidecar: its provenance with the solver's physics revision.
+    let sidecar: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("table.json")).unwrap()).unwrap();
+    assert_eq!(
+        sidecar["made"]["solver_revision"],
+        hpge_solver::field::PHYSICS_REVISION,
+        "{sidecar}"
+    );
+    assert_eq!(sidecar["rows"], 4, "{sidecar}");
+    assert_eq!(sidecar["csv"], "table.csv", "{sidecar}");
     // Resumed: the rows are read back, not solved again (a row file's mtime is unchanged).
     let row = out.join("rows/B99000A.yaml.json");
     let before = std::fs::metadata(&row).unwrap().modified().unwrap();

@@ -33,6 +33,7 @@ def main():
         name = os.path.basename(r["detector"])
         fine.setdefault(name, {})[r["parts"]] = r
     rows, bounded, total = [], 0, 0
+    used_fine = []
     for d in lines("depletion-error.jsonl"):
         name = d["detector"]
         e = d.get("u_fd_estimate")
@@ -55,6 +56,8 @@ def main():
             p = pinch[0]["estimate"]
             ref = fine.get(name, {}).get(4) or fine.get(name, {}).get(2)
             cells.append(f"{p['voltage_v']:.2f} +- {p['err_v']:.2f} ({pinch[0]['seconds']:.0f} s)")
+            if ref:
+                used_fine.append((name, ref))
             if ref and ref["bracketed"]:
                 # The finer value lies in (lo_V, hi_V]; a bracket wider than the bisection's
                 # 1e-4 (a run given WIDTH_V) is shown as such and its far end is the diff.
@@ -92,6 +95,19 @@ def main():
     for r in rows:
         print(r)
     print(f"\nError bars that bound the finer grid's value: {bounded} of {total}.")
+    if used_fine:
+        print("\nThe pinch-off's finer-grid values (`pinch-off-fine.jsonl`, the last line of each detector):\n")
+        for name, ref in used_fine:
+            made = ref.get("made")
+            when = (
+                f"made {made['date']} under the solver revision \"{made['solver_revision']}\""
+                if made
+                else "no date or revision recorded (made before the runs recorded them)"
+            )
+            print(
+                f"- {name}: {ref['parts']}x, bracket ({ref['lo_V'] if 'lo_V' in ref else 'n/a'}, "
+                f"{ref['pinch_off_V']}] V, {ref['seconds']:.0f} s; {when}"
+            )
     bench_file = os.path.join(HERE, "depletion-bench.json")
     if os.path.exists(bench_file):
         b = json.load(open(bench_file))

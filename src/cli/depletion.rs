@@ -63,7 +63,7 @@ pub struct DepletionArgs {
     #[arg(long, value_name = "K/M", value_parser = Shard::parse, default_value = "0/1")]
     shard: Shard,
     /// With --records: a folder for the per-record rows (resumable) and the tables (table.md,
-    /// table.csv). Otherwise: the C-V curve at the posterior median as CSV.
+    /// table.csv, and table.json: the CSV's provenance). Otherwise: the C-V curve at the posterior median as CSV.
     #[arg(long, value_name = "PATH")]
     out: Option<PathBuf>,
     /// Draw the factor's posterior (.svg or .png).
@@ -436,9 +436,26 @@ fn records(
             prior.lo,
             prior.hi
         );
+        // table.csv's provenance (its JSON sidecar, as every CSV without a summary of its own).
+        let csv_path = out.join("table.csv");
+        let mut sidecar = super::sidecar::common(&csv_path);
+        sidecar.insert(
+            hpge_foundation::MADE_KEY.into(),
+            serde_json::to_value(hpge_solver::made())?,
+        );
+        sidecar.insert("records".into(), dir.display().to_string().into());
+        sidecar.insert("rows".into(), rows.len().into());
+        sidecar.insert("gate_V".into(), a.gate.into());
+        sidecar.insert("measured_sigma_V".into(), a.measured_sigma.into());
+        sidecar.insert(
+            "prior".into(),
+            serde_json::json!({"lo": prior.lo, "hi": prior.hi}),
+        );
+        let sidecar = serde_json::to_string_pretty(&serde_json::Value::Object(sidecar))? + "\n";
         for (name, text) in [
             ("table.md", format!("{header}{md}")),
             ("table.csv", csv_table(&rows)),
+            ("table.json", sidecar),
         ] {
             let p = out.join(name);
             hpge_files::write(&p, text)

@@ -106,7 +106,7 @@ fn main() -> AnyResult<()> {
                 }));
             }
         }
-        let out = serde_json::json!({
+        let mut out = serde_json::json!({
             "parts": parts, "u_fd_estimate": est, "pinch_off": pinch,
             "detector": f.file_name().map(|n| n.to_string_lossy().to_string()),
             "u_fd_curve_V": c.depletion_voltage_v,
@@ -115,6 +115,7 @@ fn main() -> AnyResult<()> {
             "u_fd_fine4_V": fine.0, "nodes_fine4": fine.1,
             "seconds": t0.elapsed().as_secs_f64(),
         });
+        out[hpge_foundation::MADE_KEY] = serde_json::to_value(hpge_solver::made())?;
         println!("{out}");
     }
     Ok(())

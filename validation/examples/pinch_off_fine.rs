@@ -62,12 +62,13 @@ fn main() -> AnyResult<()> {
             }
         }
     }
-    let out = serde_json::json!({
+    let mut out = serde_json::json!({
         "detector": a[0], "parts": parts, "nodes": nodes, "bracketed": bracketed,
         "pinch_off_V": bracketed.then_some(hi), "width_V": hi - lo,
         "lo_V": lo, "hi_V": hi,
         "seconds": t0.elapsed().as_secs_f64(),
     });
+    out[hpge_foundation::MADE_KEY] = serde_json::to_value(hpge_solver::made())?;
     println!("{out}");
     Ok(())
 }

@@ -7,9 +7,10 @@
 //! ```
 //!
 //! A marker's words, after `n`: the results file (relative to the repository root; left out, the
-//! last `n-from` file), a JSON pointer (RFC 6901, with two additions: a `*` segment selects every
-//! element or member, a `key=value` segment selects the elements of an array whose `key` is
-//! `value`), then in any order at most one reduction, one scale and one format
+//! last `n-from` file; a `.jsonl` file reads as the array of its lines, a `.csv` file as the
+//! array of its rows keyed by the header), a JSON pointer (RFC 6901, with three additions: a `*`
+//! segment selects every element or member, a `key=value` segment selects the elements of an
+//! array whose `key` is `value`, and `~s` stands for a space), then in any order at most one reduction, one scale and one format
 //! ([`super::format`]). The text between the marker and `<!-- /n -->` is the number as written;
 //! `report numbers --write` replaces it, the test fails where it differs.
 
@@ -183,11 +184,12 @@ fn parse_words(words_text: &str, from: Option<&str>) -> Result<Marker, String> {
     })
 }
 
-/// The values `pointer` selects in `v` (RFC 6901 with `*` and `key=value` segments).
+/// The values `pointer` selects in `v` (RFC 6901 with `*` and `key=value` segments, and `~s`
+/// for a space, which a marker's words cannot hold).
 pub fn select<'a>(v: &'a Value, pointer: &str) -> Vec<&'a Value> {
     let mut current = vec![v];
     for raw in pointer.split('/').skip(1) {
-        let seg = raw.replace("~1", "/").replace("~0", "~");
+        let seg = raw.replace("~1", "/").replace("~s", " ").replace("~0", "~");
         let mut next = Vec::new();
         for c in current {
             match c {
@@ -298,11 +300,13 @@ mod tests {
 
     #[test]
     fn selections() {
-        let v = json!({"p": [{"name": "a", "x": 1}, {"name": "b", "x": 2}], "m": {"k/l": 3}});
+        let v = json!({"p": [{"name": "a", "x": 1}, {"name": "b", "x": 2}], "m": {"k/l": 3, "a b": 4, "~s": 5}});
         assert_eq!(select(&v, "/p/name=b/x"), [&json!(2)]);
         assert_eq!(select(&v, "/p/*/x").len(), 2);
         assert_eq!(select(&v, "/p/1/name"), [&json!("b")]);
         assert_eq!(select(&v, "/m/k~1l"), [&json!(3)]);
+        assert_eq!(select(&v, "/m/a~sb"), [&json!(4)]);
+        assert_eq!(select(&v, "/m/~0s"), [&json!(5)]);
         assert!(select(&v, "/q").is_empty());
         let m = markers("<!-- n f.json /p/*/x .1f -->1<!-- /n -->").unwrap();
         assert!(

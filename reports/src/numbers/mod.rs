@@ -77,6 +77,19 @@ fn content(file: &str, message: String) -> Error {
     }
 }
 
+/// The revision of the results file `rel` under `root` (its value `v`): a CSV's is its JSON
+/// sidecar's (`<stem>.json` beside it; none recorded without one), any other file's its own.
+fn revision_of_file(root: &Path, rel: &str, v: &Value, current: &str) -> Revision {
+    if !rel.ends_with(".csv") {
+        return stale::revision_of(v, current);
+    }
+    let sidecar = root.join(rel).with_extension("json");
+    match crate::json_file::read_json(&sidecar, "a CSV's sidecar") {
+        Ok(s) => stale::revision_of(&s, current),
+        Err(_) => Revision::Unknown,
+    }
+}
+
 /// The report `text` (the file `rel` under `root`) with every number filled from its results
 /// file under `root` and its banner for the solver's `current` revision.
 ///
@@ -92,7 +105,7 @@ pub fn fill_text(root: &Path, rel: &str, text: &str, current: &str) -> Result<Fi
     let mut at = 0;
     for m in &markers {
         if !files.contains_key(&m.file) {
-            let v = crate::json_file::read_json(&root.join(&m.file), "a report's results file")
+            let v = crate::json_file::read_results(&root.join(&m.file), "a report's results file")
                 .map_err(|e| content(rel, format!("line {}: `{}`: {e}", m.line, m.words)))?;
             files.insert(m.file.clone(), v);
         }
@@ -114,7 +127,7 @@ pub fn fill_text(root: &Path, rel: &str, text: &str, current: &str) -> Result<Fi
     out.push_str(&text[at..]);
     let sources: BTreeMap<String, Revision> = files
         .iter()
-        .map(|(f, v)| (f.clone(), stale::revision_of(v, current)))
+        .map(|(f, v)| (f.clone(), revision_of_file(root, f, v, current)))
         .collect();
     let older: Vec<(String, Revision)> = sources
         .iter()

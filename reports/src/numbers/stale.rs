@@ -1,6 +1,7 @@
 //! Reports made from older results say so at their top (issue 63): a results file records the
 //! solver's physics revision it was made with (`made.solver_revision`, or a top-level
-//! `solver_revision` in the files that kept one before); a report quoting a file of another
+//! `solver_revision` in the files that kept one before, or `inputs.solver_revision` in a row file
+//! of `hpge-cv depletion --records`); a CSV's is its JSON sidecar's (`<stem>.json`); a report quoting a file of another
 //! revision, or of none recorded, carries a banner naming each such file.
 
 use serde_json::Value;
@@ -23,14 +24,28 @@ pub enum Revision {
     Unknown,
 }
 
-/// The revision of the results file `v`, against the solver's `current` one.
+/// The revision of the results file `v`, against the solver's `current` one. A JSONL or CSV
+/// file (an array of records) is as old as its oldest record: another revision where any
+/// record has one, none recorded where any record has none, current otherwise.
 pub fn revision_of(v: &Value, current: &str) -> Revision {
+    if let Value::Array(records) = v {
+        let all: Vec<Revision> = records.iter().map(|r| revision_of(r, current)).collect();
+        return all
+            .iter()
+            .find(|r| matches!(r, Revision::Other(_)))
+            .or_else(|| all.iter().find(|r| **r == Revision::Unknown))
+            .cloned()
+            .unwrap_or(Revision::Current);
+    }
     let recorded = match v.get(hpge_foundation::MADE_KEY) {
         Some(made) if made.is_object() => match made.get("solver_revision") {
             Some(Value::String(s)) => Some(s.as_str()),
             _ => return Revision::Current,
         },
-        _ => v.get("solver_revision").and_then(Value::as_str),
+        _ => v
+            .get("solver_revision")
+            .or_else(|| v.get("inputs").and_then(|i| i.get("solver_revision")))
+            .and_then(Value::as_str),
     };
     match recorded {
         Some(r) if r == current => Revision::Current,
@@ -113,6 +128,19 @@ mod tests {
         assert_eq!(
             revision_of(&json!({"version": "0.1.0"}), c),
             Revision::Unknown
+        );
+        assert_eq!(
+            revision_of(&json!({"inputs": {"solver_revision": c}, "row": {}}), c),
+            Revision::Current
+        );
+        let now = json!({"made": {"solver_revision": c}});
+        let old = json!({"solver_revision": "old"});
+        let none = json!({"x": 1});
+        assert_eq!(revision_of(&json!([now, now]), c), Revision::Current);
+        assert_eq!(revision_of(&json!([now, none]), c), Revision::Unknown);
+        assert_eq!(
+            revision_of(&json!([none, old, now]), c),
+            Revision::Other("old".into())
         );
     }
 
