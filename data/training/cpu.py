@@ -5,7 +5,7 @@
 Finds the `generate` process writing DIR, reads its CPU time (user + system, /proc/PID/stat)
 and its rows so far, and records them in DIR/cpu.json as the segment of that process (a run
 resumed by a new process starts a new segment). `cpu_per_row_s` is the CPU time of all segments
-over the rows they wrote. The `seconds` column of the rows is wall time, which other work on the
+over the rows they wrote; `solver_revision` is the run's (its generate.json). The `seconds` column of the rows is wall time, which other work on the
 cores inflates; this is the processor time the rows cost. Run it now and then while the run
 goes, and last just before stopping it: the rows a process wrote after the last call are not
 counted. ROWS_AT_START: the rows the folder had when the process started, for a first call
@@ -67,6 +67,11 @@ def main():
     record["rows_written"] = written
     record["cpu_s"] = total
     record["cpu_per_row_s"] = total / written if written else None
+    # The rows' solver revision (from the run's generate.json), so that a page quoting these
+    # figures says which physics made them (`hpge-cv report numbers`).
+    gen = os.path.join(folder, "generate.json")
+    if os.path.exists(gen):
+        record["solver_revision"] = json.load(open(gen)).get("solver_revision")
     with open(path + ".tmp", "w") as f:
         json.dump(record, f, indent=1)
         f.write("\n")

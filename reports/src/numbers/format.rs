@@ -1,5 +1,6 @@
 //! How a number from a results file is written into a report: an optional reduction over the
-//! values a pointer selects (`sum`, `mean`, `min`, `max`, `count`), an optional scale (`*K` or
+//! values a pointer selects (`sum`, `mean`, `min`, `max`, `count`, `maxabs` the largest
+//! magnitude, `rms` the root mean square), an optional scale (`*K` or
 //! `/K`) and a format.
 //!
 //! | format | writes | example (value 0.012345) |
@@ -28,6 +29,10 @@ pub enum Reduce {
     Max,
     /// How many there are.
     Count,
+    /// The largest magnitude, max |x|.
+    MaxAbs,
+    /// The root mean square, sqrt(sum x^2 / n).
+    Rms,
 }
 
 impl Reduce {
@@ -39,6 +44,8 @@ impl Reduce {
             "min" => Self::Min,
             "max" => Self::Max,
             "count" => Self::Count,
+            "maxabs" => Self::MaxAbs,
+            "rms" => Self::Rms,
             _ => return None,
         })
     }
@@ -60,6 +67,8 @@ impl Reduce {
             Self::Mean => xs.iter().sum::<f64>() / xs.len() as f64,
             Self::Min => xs.iter().copied().fold(f64::INFINITY, f64::min),
             Self::Max => xs.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+            Self::MaxAbs => xs.iter().fold(0.0, |m: f64, x| m.max(x.abs())),
+            Self::Rms => (xs.iter().map(|x| x * x).sum::<f64>() / xs.len() as f64).sqrt(),
             Self::Count => unreachable!("handled above"),
         };
         Ok(number(x))
@@ -224,6 +233,13 @@ mod tests {
         assert_eq!(Reduce::Min.apply(&r).unwrap(), json!(1.0));
         assert_eq!(Reduce::Max.apply(&r).unwrap(), json!(6.0));
         assert_eq!(Reduce::Count.apply(&r).unwrap(), json!(3));
+        let w = [json!(-4.0), json!(3.0)];
+        let q: Vec<&Value> = w.iter().collect();
+        assert_eq!(Reduce::MaxAbs.apply(&q).unwrap(), json!(4.0));
+        assert_eq!(
+            Reduce::Rms.apply(&q).unwrap(),
+            json!((25.0_f64 / 2.0).sqrt())
+        );
         assert!(Reduce::Sum.apply(&[]).is_err());
         assert!(Reduce::Sum.apply(&[&json!("a")]).is_err());
     }
