@@ -104,9 +104,10 @@ def main():
                 if made
                 else "no date or revision recorded (made before the runs recorded them)"
             )
+            lo = f"{ref['lo_V']:.3f}" if "lo_V" in ref else "n/a"
             print(
-                f"- {name}: {ref['parts']}x, bracket ({ref['lo_V'] if 'lo_V' in ref else 'n/a'}, "
-                f"{ref['pinch_off_V']}] V, {ref['seconds']:.0f} s; {when}"
+                f"- {name}: {ref['parts']}x ({ref['nodes']} nodes), the pinch-off in "
+                f"({lo}, {ref['pinch_off_V']:.3f}] V, {ref['seconds']:.0f} s; {when}"
             )
     bench_file = os.path.join(HERE, "depletion-bench.json")
     if os.path.exists(bench_file):
