@@ -46,7 +46,7 @@ pub(crate) fn read_results(file: &Path, what: &'static str) -> Result<Value> {
         let lines = text
             .lines()
             .filter(|l| !l.trim().is_empty())
-            .map(|l| serde_json::from_str(l))
+            .map(serde_json::from_str)
             .collect::<std::result::Result<Vec<Value>, _>>()
             .map_err(|source| Error::Json {
                 file: file.to_path_buf(),
