@@ -12,14 +12,19 @@ use crate::{Error, Result};
 /// [`Error::Read`] when the file cannot be read, [`Error::Json`] ("not JSON") when it does not
 /// parse.
 pub(crate) fn read_json(file: &Path, what: &'static str) -> Result<Value> {
-    let text = std::fs::read_to_string(file).map_err(|source| Error::Read {
-        file: file.to_path_buf(),
-        what,
-        source,
-    })?;
+    let text = read_text(file, what)?;
     serde_json::from_str(&text).map_err(|source| Error::Json {
         file: file.to_path_buf(),
         what: "not JSON",
+        source,
+    })
+}
+
+/// The text of `file`; `what` names what it should hold (for the read error).
+fn read_text(file: &Path, what: &'static str) -> Result<String> {
+    std::fs::read_to_string(file).map_err(|source| Error::Read {
+        file: file.to_path_buf(),
+        what,
         source,
     })
 }
@@ -37,11 +42,7 @@ pub(crate) fn read_results(file: &Path, what: &'static str) -> Result<Value> {
     if ext != "jsonl" && ext != "csv" {
         return read_json(file, what);
     }
-    let text = std::fs::read_to_string(file).map_err(|source| Error::Read {
-        file: file.to_path_buf(),
-        what,
-        source,
-    })?;
+    let text = read_text(file, what)?;
     if ext == "jsonl" {
         let lines = text
             .lines()
