@@ -100,7 +100,7 @@ fn is_identifier(s: &str) -> bool {
 
 /// A number or an expression over [`Parameters`], as written in a detector file.
 #[derive(Debug, Clone, PartialEq)]
-pub(crate) enum Quantity {
+pub enum Quantity {
     /// A literal number.
     Number(f64),
     /// An expression such as `"5.0 + d_li_mm"`.
@@ -110,7 +110,7 @@ pub(crate) enum Quantity {
 impl Quantity {
     /// Evaluates the quantity; the error ([`Error::Expression`]) says what failed (unknown name,
     /// syntax, non-finite).
-    pub(crate) fn eval(&self, params: &Parameters) -> Result<f64> {
+    pub fn eval(&self, params: &Parameters) -> Result<f64> {
         let value = match self {
             Quantity::Number(v) => *v,
             Quantity::Expr(text) => eval_expr(text, params)?,
@@ -123,6 +123,12 @@ impl Quantity {
                 reason: format!("{self} is not a finite number"),
             })
         }
+    }
+}
+
+impl From<f64> for Quantity {
+    fn from(v: f64) -> Self {
+        Quantity::Number(v)
     }
 }
 

@@ -82,7 +82,7 @@ pub mod internals {
 pub use detector::Detector;
 pub use drift::{Pulse, pulse};
 pub use error::{DetectorPart, Error, Result};
-pub use expr::{MAX_EXPRESSION_DEPTH, Parameters};
+pub use expr::{MAX_EXPRESSION_DEPTH, Parameters, Quantity};
 pub use field::{
     Backend, CvCurve, CvPoint, FieldSettings, Method, PointResult, WeightingMode, cv_curve,
     full_depletion_voltage, pinch_off_voltage, solve_point, solve_potential,

@@ -133,13 +133,14 @@ pub(crate) fn build(spec: &DetectorSpec, file: &Path, overrides: &Parameters) ->
         check_knots(knots, file, "semiconductor.rz_knots_mm")?;
         check_knots_in_crystal(knots, sb.r_max_mm, file, "semiconductor.rz_knots_mm")?;
     }
-    if let Some(knots) = &s.impurity.knots_mm {
+    if let Some(knots) = s.impurity.knots_mm() {
         check_knots_in_crystal(knots, sb.r_max_mm, file, "semiconductor.impurity.knots_mm")?;
     }
     let impurity_context = ImpurityContext {
         z_bottom_mm: z_bottom,
         z_top_mm: z_top,
         default_knots_mm: s.rz_knots_mm.clone(),
+        parameters: params.clone(),
     };
     let impurity: Arc<dyn ImpurityModel> = Arc::from(s.impurity.build(
         &impurity_context,
@@ -505,7 +506,7 @@ fn check_knots_in_crystal(knots: &[f64], r_max_mm: f64, file: &Path, key: &str) 
 
 /// Replaces the detector's impurity model by `spec` (read from `file`).
 pub(crate) fn set_impurity(det: &mut Detector, spec: &ImpuritySpec, file: &Path) -> Result<()> {
-    if let Some(knots) = &spec.knots_mm {
+    if let Some(knots) = spec.knots_mm() {
         check_knots_in_crystal(
             knots,
             det.semiconductor.geometry.bbox().r_max_mm,

@@ -31,7 +31,15 @@ impl Detector {
 
     /// As [`Detector::from_file`] for text already in memory; `file` is used in messages.
     pub fn from_toml_str(text: &str, file: &Path, overrides: &Parameters) -> Result<Self> {
-        let spec: spec::DetectorSpec = toml::from_str(text).map_err(|e| Error::parse(file, &e))?;
+        let spec: spec::DetectorSpec = toml::from_str(text).map_err(|e| {
+            let err = Error::parse(file, &e);
+            // An unknown key of the impurity table: say which model it belongs to.
+            if e.to_string().contains("impurity") {
+                crate::impurity::explain(err, None)
+            } else {
+                err
+            }
+        })?;
         build::build(&spec, file, overrides)
     }
 

@@ -1,6 +1,7 @@
 //! Tests of [`super::ImpuritySpec`]: parsing, every validation message, the paper's example.
 
 use super::*;
+use crate::impurity::LogTransform;
 use std::path::PathBuf;
 
 fn ctx() -> ImpurityContext {
@@ -8,6 +9,7 @@ fn ctx() -> ImpurityContext {
         z_bottom_mm: 0.0,
         z_top_mm: 70.0,
         default_knots_mm: None,
+        parameters: crate::Parameters::new(),
     }
 }
 
@@ -62,7 +64,10 @@ fn rz_with_y_default_knots_and_transform() {
     let text = "model = \"rz\"\ny_bot = [0.7062704, 0.7062704]\ny_top = [0.55060154, 0.55060154]\n\
                 transform = { g = 1000.0 }\n";
     let spec = ImpuritySpec::from_toml_str(text, &file()).unwrap();
-    assert_eq!(spec.transform, Some(LogTransform::default()));
+    let ModelSpec::Rz(rz) = &spec.model else {
+        panic!("an rz spec")
+    };
+    assert_eq!(rz.transform, Some(LogTransform::default()));
     let ctx = ImpurityContext {
         default_knots_mm: Some(vec![10.0, 30.0]),
         ..ctx()
@@ -122,30 +127,38 @@ fn missing_required_keys() {
     // The missing partner is reported before the missing knots.
     let (key, _) = invalid("model = \"rz\"\ny_bot = [0.5]\n");
     assert_eq!(key, "y_top");
-    let (key, msg) = invalid("model = \"constant\"\n");
-    assert_eq!(key, "zeta_cm3");
-    assert!(msg.contains("needs `zeta_cm3`"), "{msg}");
-    let (key, msg) = invalid("model = \"linear-z\"\nbottom_cm3 = 1e10\n");
-    assert_eq!(key, "top_cm3");
-    assert!(msg.contains("needs `bottom_cm3` and `top_cm3`"), "{msg}");
+    // A model's required keys are the parser's: the message names the key.
+    let msg = parse_error("model = \"constant\"\n");
+    assert!(msg.contains("missing field `zeta_cm3`"), "{msg}");
+    let msg = parse_error("model = \"linear-z\"\nbottom_cm3 = 1e10\n");
+    assert!(msg.contains("missing field `top_cm3`"), "{msg}");
 }
 
 #[test]
 fn keys_of_another_model() {
-    let (key, msg) = invalid(&format!(
+    let msg = parse_error(&format!(
         "{RZ_Y}zeta_cm3 = 1e10\ny_bot = [0.5, 0.5, 0.5, 0.5]\ny_top = [0.5, 0.5, 0.5, 0.5]\n"
     ));
-    assert_eq!(key, "zeta_cm3");
     assert!(
-        msg.contains("`zeta_cm3` is not used by model \"rz\""),
+        msg.contains(
+            "`zeta_cm3` (line 3) is not a key of this model; it belongs to model \"constant\""
+        ),
         "{msg}"
     );
-    let (key, msg) = invalid("model = \"constant\"\nzeta_cm3 = 1e10\nknots_mm = [1.0]\n");
-    assert_eq!(key, "knots_mm");
-    assert!(msg.contains("not used by model \"constant\""), "{msg}");
-    let (key, _) =
-        invalid("model = \"linear-z\"\nbottom_cm3 = 1.0\ntop_cm3 = 1.0\ntransform = {}\n");
-    assert_eq!(key, "transform");
+    let msg = parse_error("model = \"constant\"\nzeta_cm3 = 1e10\nknots_mm = [1.0]\n");
+    assert!(
+        msg.contains("`knots_mm` (line 3)") && msg.contains("model \"rz\""),
+        "{msg}"
+    );
+    let msg =
+        parse_error("model = \"linear-z\"\nbottom_cm3 = 1.0\ntop_cm3 = 1.0\ntransform = {}\n");
+    assert!(msg.contains("`transform` (line 4)"), "{msg}");
+    let msg = parse_error("model = \"constant\"\nzeta_cm3 = 1.0\nbottom_cm = 1.0\n");
+    assert!(msg.contains("is not a key of any impurity model"), "{msg}");
+    assert_eq!(
+        model_names(),
+        ["constant", "linear-z", "rz", "z-table", "polynomial-z"]
+    );
 }
 
 #[test]
@@ -275,7 +288,7 @@ fn invalid_transform_and_context() {
 #[test]
 fn parse_errors_name_the_key() {
     let msg = parse_error("model = \"constant\"\nzeta_cm3 = 1e10\nfoo = 1\n");
-    assert!(msg.contains("foo") && msg.contains("line 3"), "{msg}");
+    assert!(msg.contains("`foo` (line 3)"), "{msg}");
     let msg = parse_error("zeta_cm3 = 1e10\n");
     assert!(msg.contains("model"), "{msg}");
     let msg = parse_error("model = \"spline\"\n");
@@ -322,7 +335,12 @@ fn from_file_reads_and_reports_io_errors() {
     let path = dir.join("constant.toml");
     std::fs::write(&path, "model = \"constant\"\nzeta_cm3 = 1e10\n").unwrap();
     let spec = ImpuritySpec::from_file(&path).unwrap();
-    assert_eq!(spec.zeta_cm3, Some(1e10));
+    assert_eq!(
+        spec.model,
+        ModelSpec::Constant(ConstantSpec {
+            zeta_cm3: 1e10.into()
+        })
+    );
     std::fs::remove_file(&path).unwrap();
     assert!(matches!(
         ImpuritySpec::from_file(&path),

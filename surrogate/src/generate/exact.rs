@@ -1,5 +1,6 @@
 //! The exact solver at points of a parameter space: the space's values set on the detector
-//! (its `[parameters]` and the rz model's y knots), then a field solve per bias. Training rows
+//! (its `[parameters]`, and the space's impurity table with the `impurity:` targets' values,
+//! any model), then a field solve per bias. Training rows
 //! come from here, and so does the exact model inference checks the surrogate against.
 
 use std::path::{Path, PathBuf};
@@ -27,12 +28,14 @@ pub struct ExactSolver {
     /// Solver settings.
     pub settings: FieldSettings,
     targets: Vec<Target>,
+    /// The impurity table the `impurity:` targets fill in (None: the detector's model stays).
+    impurity_base: Option<toml::Table>,
 }
 
 impl ExactSolver {
-    /// Checks the space against the detector (every `parameter:` target declared, the y targets
-    /// knots 0, 1, ... of its rz model, one bias dimension) and builds the detector once at the
-    /// centre of the space.
+    /// Checks the space against the detector (every `parameter:` target declared, the
+    /// `impurity:` targets filling the space's impurity table, one bias dimension) and builds
+    /// the detector once at the centre of the space.
     pub fn new(
         space: ParameterSpace,
         detector_file: &Path,
@@ -43,33 +46,10 @@ impl ExactSolver {
             action: "cannot read the detector",
             source: e,
         })?;
-        // The detector must load, and the y targets must fit its rz knots.
+        // The detector must load, and the impurity targets must fill the space's table.
         let det = Detector::from_toml_str(&detector_text, detector_file, &Parameters::new())?;
         let targets = space.targets();
-        let ys: Vec<&Target> = targets
-            .iter()
-            .filter(|t| matches!(t, Target::YBot(_) | Target::YTop(_)))
-            .collect();
-        for face in [0, 1] {
-            let mut ks: Vec<usize> = targets
-                .iter()
-                .filter_map(|t| match (t, face) {
-                    (Target::YBot(k), 0) | (Target::YTop(k), 1) => Some(*k),
-                    _ => None,
-                })
-                .collect();
-            ks.sort_unstable();
-            if !ys.is_empty() && ks != (0..ks.len().max(1)).collect::<Vec<_>>() {
-                return Err(Error::Invalid {
-                    file: space.file.clone(),
-                    key: "dimensions".into(),
-                    message: format!(
-                        "the {} targets must be knots 0, 1, ... without gaps, got {ks:?}",
-                        if face == 0 { "y_bot" } else { "y_top" },
-                    ),
-                });
-            }
-        }
+        let impurity_base = impurity_base(&space, &targets)?;
         for t in &targets {
             if let Target::Parameter(p) = t
                 && det.parameters.get(p).is_none()
@@ -102,6 +82,7 @@ impl ExactSolver {
             detector_hash: format!("{:016x}", fnv1a(&det_bytes)),
             settings,
             targets,
+            impurity_base,
         };
         // A dry run at the centre of the space: the detector and impurity model build.
         let centre = exact.space.from_unit(&vec![0.5; exact.space.dim()]);
@@ -195,7 +176,7 @@ impl ExactSolver {
     }
 
     /// The detector with the space's non-bias values `params` (column order, a surrogate's
-    /// network order) set: its parameters and its rz model's y knots.
+    /// network order) set: its parameters and its impurity model's values.
     pub fn detector(&self, params: &[f64]) -> Result<Detector> {
         let nb = self.targets.len() - 1;
         if params.len() != nb {
@@ -281,34 +262,189 @@ impl ExactSolver {
     fn configure(&self, x: &[f64]) -> Result<(Detector, f64)> {
         let mut params = Parameters::new();
         let mut bias = 0.0;
-        let (mut yb, mut yt) = (Vec::new(), Vec::new());
+        let mut table = self.impurity_base.clone();
         for (t, &v) in self.targets.iter().zip(x) {
             match t {
                 Target::Bias => bias = v,
                 Target::Parameter(p) => params.set(p.clone(), v),
-                Target::YBot(k) => yb.push((*k, v)),
-                Target::YTop(k) => yt.push((*k, v)),
+                Target::Impurity { key, index } => {
+                    if let Some(table) = &mut table {
+                        set_value(table, key, *index, v);
+                    }
+                }
             }
         }
         let mut det = Detector::from_toml_str(&self.detector_text, &self.detector_file, &params)?;
-        if !yb.is_empty() {
-            yb.sort_by_key(|p| p.0);
-            yt.sort_by_key(|p| p.0);
-            let list = |v: &[(usize, f64)]| {
-                v.iter()
-                    .map(|p| format!("{:e}", p.1))
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            };
-            let text = format!(
-                "model = \"rz\"\ny_bot = [{}]\ny_top = [{}]\n",
-                list(&yb),
-                list(&yt)
-            );
+        if let Some(table) = table {
+            // Errors of the table name the space's file; the model is the generated sample's.
+            let spec = ImpuritySpec::from_table(table, &self.space.file)?;
             let name = Path::new("(generated sample)");
-            let spec = ImpuritySpec::from_toml_str(&text, name)?;
             det.set_impurity(&spec, name)?;
         }
         Ok((det, bias))
+    }
+}
+
+/// The impurity table a space's `impurity:` targets fill in: its `[impurity]`, or `model =
+/// "rz"` for the paper's `y_bot[K]` / `y_top[K]` without one; None without impurity targets.
+/// A list's targets must be its elements 0, 1, ... without gaps, or elements of a list the
+/// table already has; a single value's target must not be a list's.
+fn impurity_base(space: &ParameterSpace, targets: &[Target]) -> Result<Option<toml::Table>> {
+    let invalid = |message: String| Error::Invalid {
+        file: space.file.clone(),
+        key: "dimensions".into(),
+        message,
+    };
+    let mut lists: std::collections::BTreeMap<&str, Vec<usize>> = Default::default();
+    let mut singles: Vec<&str> = Vec::new();
+    for t in targets {
+        if let Target::Impurity { key, index } = t {
+            match index {
+                Some(k) => lists.entry(key.as_str()).or_default().push(*k),
+                None => singles.push(key.as_str()),
+            }
+        }
+    }
+    if lists.is_empty() && singles.is_empty() {
+        return Ok(None);
+    }
+    let base = match &space.impurity {
+        Some(t) => t.clone(),
+        None => {
+            if let Some(k) = singles
+                .first()
+                .or_else(|| lists.keys().find(|k| !matches!(**k, "y_bot" | "y_top")))
+            {
+                return Err(invalid(format!(
+                    "target `impurity:{k}` needs the space's `[impurity]` table (which model it is a key of)"
+                )));
+            }
+            let mut t = toml::Table::new();
+            t.insert("model".into(), toml::Value::String("rz".into()));
+            t
+        }
+    };
+    for key in &singles {
+        if lists.contains_key(key) {
+            return Err(invalid(format!(
+                "`impurity:{key}` is targeted both as a single value and as a list's elements"
+            )));
+        }
+    }
+    for (key, ks) in &mut lists {
+        ks.sort_unstable();
+        let given = base.get(*key).and_then(toml::Value::as_array).map(Vec::len);
+        let ok = match given {
+            Some(n) => ks.iter().all(|&k| k < n),
+            None => *ks == (0..ks.len()).collect::<Vec<_>>(),
+        };
+        if !ok {
+            return Err(invalid(match given {
+                Some(n) => format!(
+                    "the {key} targets must be elements of the [impurity] table's list of {n}, got {ks:?}"
+                ),
+                None => {
+                    format!("the {key} targets must be knots 0, 1, ... without gaps, got {ks:?}")
+                }
+            }));
+        }
+    }
+    Ok(Some(base))
+}
+
+/// Sets `table[key]` (element `index` of a list, which grows by one where `index` is its
+/// length) to `value`.
+fn set_value(table: &mut toml::Table, key: &str, index: Option<usize>, value: f64) {
+    let v = toml::Value::Float(value);
+    match index {
+        None => {
+            table.insert(key.to_string(), v);
+        }
+        Some(k) => {
+            let entry = table
+                .entry(key.to_string())
+                .or_insert_with(|| toml::Value::Array(Vec::new()));
+            if let toml::Value::Array(list) = entry {
+                if k < list.len() {
+                    list[k] = v;
+                } else {
+                    list.resize(k, toml::Value::Float(f64::NAN));
+                    list.push(v);
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn space(dims: &[&str], impurity: &str) -> ParameterSpace {
+        let mut text = String::from("name = \"t\"\n");
+        for (k, t) in dims.iter().enumerate() {
+            text.push_str(&format!(
+                "[[dimensions]]\nname = \"d{k}\"\nunit = \"1\"\nrange = [0.1, 0.5]\ntarget = \"{t}\"\n"
+            ));
+        }
+        text.push_str(impurity);
+        ParameterSpace::from_toml_str(&text, Path::new("space.toml")).unwrap()
+    }
+
+    fn base(dims: &[&str], impurity: &str) -> Result<Option<toml::Table>> {
+        let s = space(dims, impurity);
+        impurity_base(&s, &s.targets())
+    }
+
+    #[test]
+    fn the_targets_fill_the_spaces_impurity_table() {
+        assert_eq!(base(&["bias", "parameter:a"], "").unwrap(), None);
+        // The paper's spaces: y targets without a table mean the rz model.
+        let t = base(&["y_bot[0]", "y_top[0]", "bias"], "")
+            .unwrap()
+            .unwrap();
+        assert_eq!(t["model"].as_str(), Some("rz"));
+        let t = base(
+            &["impurity:z0_cm3", "bias"],
+            "[impurity]\nmodel = \"polynomial-z\"\ngradient_cm3_per_mm = 0.0\n",
+        )
+        .unwrap()
+        .unwrap();
+        let mut t = t;
+        set_value(&mut t, "z0_cm3", None, -1e10);
+        set_value(&mut t, "y", Some(1), 2.0);
+        set_value(&mut t, "y", Some(0), 1.0);
+        assert_eq!(t["z0_cm3"].as_float(), Some(-1e10));
+        assert_eq!(
+            t["y"].as_array().unwrap(),
+            &vec![toml::Value::Float(1.0), toml::Value::Float(2.0)]
+        );
+        // Elements of a list the table gives may be any of its elements.
+        assert!(
+            base(
+                &["impurity:values_cm3[2]", "bias"],
+                "[impurity]\nmodel = \"z-table\"\nz_mm = [0.0, 1.0, 2.0]\nvalues_cm3 = [1.0, 2.0, 3.0]\n"
+            )
+            .is_ok()
+        );
+    }
+
+    #[test]
+    fn targets_that_cannot_fill_the_table_are_refused() {
+        let msg = |r: Result<Option<toml::Table>>| r.unwrap_err().to_string();
+        let m = msg(base(&["impurity:z0_cm3", "bias"], ""));
+        assert!(m.contains("needs the space's `[impurity]` table"), "{m}");
+        let m = msg(base(&["y_bot[0]", "y_bot[2]", "bias"], ""));
+        assert!(m.contains("without gaps"), "{m}");
+        let m = msg(base(
+            &["impurity:values_cm3[3]", "bias"],
+            "[impurity]\nmodel = \"z-table\"\nz_mm = [0.0, 1.0]\nvalues_cm3 = [1.0, 2.0]\n",
+        ));
+        assert!(m.contains("list of 2"), "{m}");
+        let m = msg(base(
+            &["impurity:y_bot", "impurity:y_bot[0]", "bias"],
+            "[impurity]\nmodel = \"rz\"\n",
+        ));
+        assert!(m.contains("both as a single value"), "{m}");
     }
 }

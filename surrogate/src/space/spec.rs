@@ -27,14 +27,21 @@ pub enum Target {
     Bias,
     /// A detector parameter from its `[parameters]` table, e.g. `d_li_mm`.
     Parameter(String),
-    /// y at knot k of the rz model's bottom face.
-    YBot(usize),
-    /// y at knot k of the rz model's top face.
-    YTop(usize),
+    /// A value of the impurity model: key `key` (element `index` of a list) of the space's
+    /// `[impurity]` table, which then replaces the detector's model. Written
+    /// `impurity:KEY` or `impurity:KEY[K]`; the paper's spaces write `y_bot[K]` and `y_top[K]`,
+    /// the rz model's y at knot K (a space without `[impurity]` then means `model = "rz"`).
+    Impurity {
+        /// The impurity table's key, e.g. `y_bot` or `z0_cm3`.
+        key: String,
+        /// The element of a list, or None for a single value.
+        index: Option<usize>,
+    },
 }
 
 impl Target {
-    /// Parses `bias`, `parameter:NAME`, `y_bot[K]` or `y_top[K]`.
+    /// Parses `bias`, `parameter:NAME`, `impurity:KEY`, `impurity:KEY[K]`, `y_bot[K]` or
+    /// `y_top[K]`.
     pub fn parse(s: &str) -> Option<Target> {
         let s = s.trim();
         if s == "bias" {
@@ -44,13 +51,36 @@ impl Target {
             return (!name.is_empty()).then(|| Target::Parameter(name.to_string()));
         }
         let index = |rest: &str| rest.strip_prefix('[')?.strip_suffix(']')?.parse().ok();
-        if let Some(rest) = s.strip_prefix("y_bot") {
-            return index(rest).map(Target::YBot);
+        let word = |k: &str| {
+            let mut c = k.chars();
+            matches!(c.next(), Some(x) if x.is_ascii_alphabetic() || x == '_')
+                && c.all(|x| x.is_ascii_alphanumeric() || x == '_')
+        };
+        if let Some(rest) = s.strip_prefix("impurity:") {
+            let (key, idx) = match rest.find('[') {
+                Some(b) => (&rest[..b], Some(index(&rest[b..])?)),
+                None => (rest, None),
+            };
+            return word(key).then(|| Target::Impurity {
+                key: key.to_string(),
+                index: idx,
+            });
         }
-        if let Some(rest) = s.strip_prefix("y_top") {
-            return index(rest).map(Target::YTop);
+        for key in ["y_bot", "y_top"] {
+            if let Some(rest) = s.strip_prefix(key) {
+                return index(rest).map(|k| Target::Impurity {
+                    key: key.to_string(),
+                    index: Some(k),
+                });
+            }
         }
         None
+    }
+
+    /// Whether this is one of the paper's rz y targets (`y_bot[K]`, `y_top[K]`), whose values
+    /// must lie in [-1, 1].
+    pub fn is_rz_y(&self) -> bool {
+        matches!(self, Target::Impurity { key, index: Some(_) } if key == "y_bot" || key == "y_top")
     }
 }
 
@@ -67,7 +97,8 @@ pub struct Dimension {
     /// Distribution over the range.
     #[serde(default)]
     pub distribution: Distribution,
-    /// Where it enters the simulation: `bias`, `parameter:NAME`, `y_bot[K]`, `y_top[K]`.
+    /// Where it enters the simulation: `bias`, `parameter:NAME`, `impurity:KEY`,
+    /// `impurity:KEY[K]`, `y_bot[K]`, `y_top[K]` ([`Target`]).
     pub target: String,
     /// The name of an earlier dimension whose physical value this one takes instead of being
     /// sampled: a slice of a space that keeps the full space's columns (e.g. the B_Z slice of
@@ -87,6 +118,13 @@ pub struct ParameterSpace {
     pub description: String,
     /// The dimensions, in column order.
     pub dimensions: Vec<Dimension>,
+    /// The impurity model the `impurity:` targets fill in: a table as a detector's
+    /// `[semiconductor.impurity]` (any model), with the keys the targets set left out or given
+    /// (a list's elements are replaced). It replaces the detector's model at every point.
+    /// Without it, `y_bot[K]` and `y_top[K]` targets mean `model = "rz"` with the detector's
+    /// default knots (the paper's spaces).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub impurity: Option<toml::Table>,
     /// The file it came from.
     #[serde(skip)]
     pub file: PathBuf,
@@ -153,10 +191,7 @@ impl ParameterSpace {
                     ),
                 ));
             }
-            let is_y = matches!(
-                Target::parse(&d.target),
-                Some(Target::YBot(_) | Target::YTop(_))
-            );
+            let is_y = Target::parse(&d.target).is_some_and(|t| t.is_rz_y());
             if is_y && (lo < -1.0 || hi > 1.0) {
                 return Err(bad(
                     k,
@@ -172,7 +207,8 @@ impl ParameterSpace {
                     k,
                     "target",
                     format!(
-                        "`{}`: expected `bias`, `parameter:NAME`, `y_bot[K]` or `y_top[K]`",
+                        "`{}`: expected `bias`, `parameter:NAME`, `impurity:KEY`, `impurity:KEY[K]`, \
+                         `y_bot[K]` or `y_top[K]`",
                         d.target
                     ),
                 ));

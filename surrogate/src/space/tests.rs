@@ -24,7 +24,13 @@ fn shipped_space_is_the_papers() {
     assert_eq!(s.dimensions[9].range, [10.0, 3000.0]);
     assert_eq!(s.targets()[9], Target::Bias);
     assert_eq!(s.targets()[0], Target::Parameter("d_li_mm".into()));
-    assert_eq!(s.targets()[8], Target::YTop(3));
+    assert_eq!(
+        s.targets()[8],
+        Target::Impurity {
+            key: "y_top".into(),
+            index: Some(3)
+        }
+    );
 }
 
 #[test]
@@ -149,4 +155,35 @@ fn same_as_errors_name_the_key() {
         )
         .is_ok()
     );
+}
+
+#[test]
+fn impurity_targets_parse() {
+    let t = |s: &str| Target::parse(s);
+    assert_eq!(
+        t("impurity:z0_cm3"),
+        Some(Target::Impurity {
+            key: "z0_cm3".into(),
+            index: None
+        })
+    );
+    assert_eq!(
+        t("impurity:values_cm3[4]"),
+        Some(Target::Impurity {
+            key: "values_cm3".into(),
+            index: Some(4)
+        })
+    );
+    assert_eq!(t("y_bot[2]"), t("impurity:y_bot[2]"));
+    assert!(t("y_bot[2]").unwrap().is_rz_y());
+    assert!(!t("impurity:z0_cm3").unwrap().is_rz_y());
+    for bad in [
+        "impurity:",
+        "impurity:1x",
+        "impurity:a[",
+        "impurity:a[x]",
+        "impurity:a b",
+    ] {
+        assert_eq!(t(bad), None, "{bad}");
+    }
 }

@@ -24,13 +24,13 @@ fn set_quadratic(det: &mut Detector, extra: &[f64]) -> Result<()> {
         message,
     };
     let mut spec = det.semiconductor.impurity_spec().clone();
-    if spec.model.as_str() != "rz" {
+    let hpge_solver::impurity::ModelSpec::Rz(rz) = &mut spec.model else {
         return Err(cannot(format!(
             "the quadratic z term needs the rz impurity model, the detector has `{}`",
-            spec.model.as_str()
+            spec.model.name()
         )));
-    }
-    spec.y_quad = Some(extra[0]);
+    };
+    rz.y_quad = Some(extra[0].into());
     det.set_impurity(&spec, Path::new("(quadratic-z extension)"))
         .map_err(|e| cannot(e.to_string()))
 }
