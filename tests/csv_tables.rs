@@ -117,6 +117,8 @@ fn simulate_sensitivity_field_and_pulse_write_plain_tables() {
     assert_eq!(v["voltage_V"], 3000.0);
     assert_eq!(v["phi_deg"], 30.0);
     assert_eq!(v["csv"], "e.csv");
+    // What made it, as every results file records it (hpge_foundation::sidecar).
+    assert!(v["made"]["solver_revision"].is_string(), "{v}");
     assert!(
         v["command"]
             .as_array()
@@ -144,6 +146,7 @@ fn simulate_sensitivity_field_and_pulse_write_plain_tables() {
     let v = sidecar(&d.join("p.json"));
     assert_eq!(v["version"], env!("CARGO_PKG_VERSION"));
     assert_eq!(v["normalised"], true);
+    assert_eq!(v["made"]["program"], "hpge-cv");
     assert_eq!(v["at"]["z_mm"], 35.0);
     assert_eq!(v["parameters"]["d_li_mm"], 3.0);
     assert!(v["columns"]["q1"].is_string(), "{v}");

@@ -3,7 +3,8 @@
 //! of a sample (priors, diagnostics, held-out
 //! figures), a stable hash that names inputs in fingerprints and model files, strided shards of
 //! an index range (Slurm array tasks of `generate`, the coverage studies, `depletion`), and the
-//! one-writer lock of an output folder, and the record of what made a results file ([`Made`]).
+//! one-writer lock of an output folder, the record of what made a results file ([`Made`]) and
+//! the JSON sidecar of a CSV ([`sidecar`]).
 //!
 //! ```
 //! use hpge_foundation::{Shard, fnv1a, normal_cdf, normal_quantile, quantile};
@@ -25,6 +26,7 @@ mod made;
 mod normal;
 mod quantile;
 mod shard;
+pub mod sidecar;
 
 pub use chi_squared::chi_squared_sf;
 pub use error::{Error, Result};

@@ -202,7 +202,7 @@ pub fn csv_and_plot_outputs(
     let mut outputs = Vec::new();
     if let Some(p) = out {
         outputs.push(("--out", p.to_path_buf()));
-        outputs.push(("--out's sidecar", super::sidecar::path(p)));
+        outputs.push(("--out's sidecar", hpge_foundation::sidecar::path(p)));
     }
     if let Some(p) = plot {
         outputs.push(("--plot", p.to_path_buf()));

@@ -438,20 +438,18 @@ fn records(
         );
         // table.csv's provenance (its JSON sidecar, as every CSV without a summary of its own).
         let csv_path = out.join("table.csv");
-        let mut sidecar = super::sidecar::common(&csv_path);
-        sidecar.insert(
-            hpge_foundation::MADE_KEY.into(),
-            serde_json::to_value(hpge_solver::made())?,
+        let sidecar = hpge_foundation::sidecar::record(
+            &csv_path,
+            &hpge_solver::made(),
+            serde_json::json!({
+                "records": dir.display().to_string(),
+                "rows": rows.len(),
+                "gate_V": a.gate,
+                "measured_sigma_V": a.measured_sigma,
+                "prior": {"lo": prior.lo, "hi": prior.hi},
+            }),
         );
-        sidecar.insert("records".into(), dir.display().to_string().into());
-        sidecar.insert("rows".into(), rows.len().into());
-        sidecar.insert("gate_V".into(), a.gate.into());
-        sidecar.insert("measured_sigma_V".into(), a.measured_sigma.into());
-        sidecar.insert(
-            "prior".into(),
-            serde_json::json!({"lo": prior.lo, "hi": prior.hi}),
-        );
-        let sidecar = serde_json::to_string_pretty(&serde_json::Value::Object(sidecar))? + "\n";
+        let sidecar = serde_json::to_string_pretty(&sidecar)? + "\n";
         for (name, text) in [
             ("table.md", format!("{header}{md}")),
             ("table.csv", csv_table(&rows)),

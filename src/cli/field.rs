@@ -73,9 +73,10 @@ pub fn run(a: &FieldArgs) -> Result<()> {
         staged
             .write_with(path, |f| run.write_csv(f))
             .with_context(ctx)?;
-        super::sidecar::stage(
+        hpge_foundation::sidecar::stage(
             &mut staged,
             path,
+            &hpge_solver::made(),
             super::args::with_detector_provenance(
                 json!({
                     "voltage_V": a.voltage,

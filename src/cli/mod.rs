@@ -16,7 +16,6 @@ mod pulse;
 mod replace;
 mod report;
 mod sensitivity;
-mod sidecar;
 mod simulate;
 pub(crate) mod stdout;
 mod surrogate;

@@ -166,9 +166,10 @@ fn write_csv(
         .with_context(ctx)?;
     let (r, phi, z) = run.options.at;
     let normalised = run.options.normalise;
-    super::sidecar::stage(
+    hpge_foundation::sidecar::stage(
         staged,
         path,
+        &hpge_solver::made(),
         super::args::with_detector_provenance(
             json!({
                 "provenance": run.provenance_line(),

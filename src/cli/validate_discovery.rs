@@ -111,9 +111,10 @@ pub fn run(a: &DiscoveryArgs) -> Result<()> {
         let mut staged = hpge_files::Staged::new();
         staged.adopt(&csv);
         write_curve(&csv, &data)?;
-        super::sidecar::stage(
+        hpge_foundation::sidecar::stage(
             &mut staged,
             &csv,
+            &hpge_solver::made(),
             serde_json::json!({
                 "provenance": format!(
                     "validate discovery --seed {}: exact solver, hidden effect {} {:?}, paper noise x {} (seed {seed})",
