@@ -16,21 +16,7 @@ const DETECTOR: &str = "detectors/icpc-legend.toml";
 const PRIOR: &str = "priors/icpc-legend-z.toml";
 
 fn generate(out: &str, n: &str, offset: &str) {
-    ok(&run(&[
-        "generate",
-        "--space",
-        SPACE,
-        "--detector",
-        DETECTOR,
-        "--n",
-        n,
-        "--offset",
-        offset,
-        "--out",
-        out,
-        "--grid",
-        "adaptive=false",
-    ]));
+    common::generate_coarse(SPACE, DETECTOR, out, n, offset);
 }
 
 #[test]

@@ -15,24 +15,8 @@ const SPACE: &str = "spaces/ppc-z.toml";
 const DETECTOR: &str = "detectors/ppc.toml";
 const PRIOR: &str = "priors/ppc-z.toml";
 
-/// `generate` N rows of the PPC space from `offset` into `out` on the detector's default grid
-/// without adaptive refinement (fast; this pins the workflow, not the solver).
 fn generate(out: &str, n: &str, offset: &str) {
-    ok(&run(&[
-        "generate",
-        "--space",
-        SPACE,
-        "--detector",
-        DETECTOR,
-        "--n",
-        n,
-        "--offset",
-        offset,
-        "--out",
-        out,
-        "--grid",
-        "adaptive=false",
-    ]));
+    common::generate_coarse(SPACE, DETECTOR, out, n, offset);
 }
 
 #[test]

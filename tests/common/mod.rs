@@ -44,6 +44,26 @@ pub fn temp(tag: &str) -> PathBuf {
     d
 }
 
+/// `generate` `n` rows of `space` on `detector` from `offset` into `out`, on the detector's
+/// default grid without adaptive refinement (fast: it pins a workflow, not the solver).
+pub fn generate_coarse(space: &str, detector: &str, out: &str, n: &str, offset: &str) {
+    ok(&run(&[
+        "generate",
+        "--space",
+        space,
+        "--detector",
+        detector,
+        "--n",
+        n,
+        "--offset",
+        offset,
+        "--out",
+        out,
+        "--grid",
+        "adaptive=false",
+    ]));
+}
+
 /// Starts `hpge-cv ARGS` in the repository root and kills it (SIGKILL) as soon as `written()`
 /// holds (a checkpoint file exists), asserting it does within 600 s and before the run ends.
 pub fn kill_when(args: &[&str], what: &str, written: impl Fn() -> bool) {

@@ -152,14 +152,7 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<MergeReport> {
 /// The merge's sidecar: `<stem>.json` beside the merged CSV, `<name>.json` when the CSV's own
 /// name ends in `.json` (never the merged rows' own file).
 pub fn sidecar_path(out: &Path) -> PathBuf {
-    let p = out.with_extension("json");
-    if p == out {
-        let mut name = out.as_os_str().to_os_string();
-        name.push(".json");
-        PathBuf::from(name)
-    } else {
-        p
-    }
+    hpge_foundation::sidecar::path(out)
 }
 
 /// Refuses an output inside one of the shard folders: `--out s1/rows.csv` would overwrite the
