@@ -79,54 +79,17 @@ fn the_legend_profile_is_fitted_on_the_icpc() {
         "--out",
         &p("truth-cv.csv"),
     ]));
-    ok(&run(&[
-        "synthesize",
-        "--curve",
-        &p("truth-cv.csv"),
-        "--out",
-        &p("raw"),
-        "--seed",
-        "3",
-        "--pulses",
-        "40",
-        "--decimate",
-        "40",
-        "--draw-calibration",
-    ]));
     let cv = p("cv.csv");
-    ok(&run(&["measure", "--raw", &p("raw"), "--out", &cv]));
+    common::synthesize_and_measure(&p("truth-cv.csv"), &p("raw"), &cv);
 
-    let stdout = ok(&run(&[
-        "fit",
-        "--data",
+    let stdout = ok(&common::fit_at_test_size(
         &cv,
-        "--model",
         &model,
-        "--prior",
         PRIOR,
-        "--detector",
         DETECTOR,
-        "--out",
         &p("fit"),
-        "--ess",
-        "100",
-        "--max-seconds",
-        "30",
-        "--allow-unconverged",
-        "--exact-draws",
         "16",
-        "--exact-grid-check",
-        "0",
-        "--exact-ascents",
-        "0",
-        "--refine-rounds",
-        "1",
-        "--allow-exact-mismatch",
-        "--grid",
-        "adaptive=false",
-        "--no-plots",
-        "--json",
-    ]));
+    ));
     let v: serde_json::Value = serde_json::from_str(stdout.trim()).expect("one JSON object");
     let params = v["parameters"].as_array().unwrap();
     let names: Vec<&str> = params.iter().map(|p| p["name"].as_str().unwrap()).collect();

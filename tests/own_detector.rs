@@ -67,56 +67,12 @@ fn the_workflow_runs_on_a_point_contact_detector() {
         "--out",
         &p("truth-cv.csv"),
     ]));
-    ok(&run(&[
-        "synthesize",
-        "--curve",
-        &p("truth-cv.csv"),
-        "--out",
-        &p("raw"),
-        "--seed",
-        "3",
-        "--pulses",
-        "40",
-        "--decimate",
-        "40",
-        "--draw-calibration",
-    ]));
     let cv = p("cv.csv");
-    ok(&run(&["measure", "--raw", &p("raw"), "--out", &cv]));
+    common::synthesize_and_measure(&p("truth-cv.csv"), &p("raw"), &cv);
     assert!(d.join("cv.covariance.csv").is_file());
 
     let fit = |out: &str, detector: &str| {
-        run(&[
-            "fit",
-            "--data",
-            &cv,
-            "--model",
-            &model,
-            "--prior",
-            PRIOR,
-            "--detector",
-            detector,
-            "--out",
-            out,
-            "--ess",
-            "100",
-            "--max-seconds",
-            "30",
-            "--allow-unconverged",
-            "--exact-draws",
-            "24",
-            "--exact-grid-check",
-            "0",
-            "--exact-ascents",
-            "0",
-            "--refine-rounds",
-            "1",
-            "--allow-exact-mismatch",
-            "--grid",
-            "adaptive=false",
-            "--no-plots",
-            "--json",
-        ])
+        common::fit_at_test_size(&cv, &model, PRIOR, detector, out, "24")
     };
     let stdout = ok(&fit(&p("fit"), DETECTOR));
     let v: serde_json::Value = serde_json::from_str(stdout.trim()).expect("one JSON object");

@@ -64,6 +64,70 @@ pub fn generate_coarse(space: &str, detector: &str, out: &str, n: &str, offset: 
     ]));
 }
 
+/// A measured-like curve from a solver curve at test size: raw pulser data drawn from
+/// `curve` (seed 3, 40 pulses, decimated 40x, the circuit's calibration error drawn) into
+/// `raw`, measured back into `cv` (with its covariance).
+pub fn synthesize_and_measure(curve: &str, raw: &str, cv: &str) {
+    ok(&run(&[
+        "synthesize",
+        "--curve",
+        curve,
+        "--out",
+        raw,
+        "--seed",
+        "3",
+        "--pulses",
+        "40",
+        "--decimate",
+        "40",
+        "--draw-calibration",
+    ]));
+    ok(&run(&["measure", "--raw", raw, "--out", cv]));
+}
+
+/// `fit --json` at test size: ESS 100 within 30 s, `exact_draws` exact curves on the coarse
+/// grid, one refinement round, mismatches and unconverged chains allowed, no figures.
+pub fn fit_at_test_size(
+    cv: &str,
+    model: &str,
+    prior: &str,
+    detector: &str,
+    out: &str,
+    exact_draws: &str,
+) -> Output {
+    run(&[
+        "fit",
+        "--data",
+        cv,
+        "--model",
+        model,
+        "--prior",
+        prior,
+        "--detector",
+        detector,
+        "--out",
+        out,
+        "--ess",
+        "100",
+        "--max-seconds",
+        "30",
+        "--allow-unconverged",
+        "--exact-draws",
+        exact_draws,
+        "--exact-grid-check",
+        "0",
+        "--exact-ascents",
+        "0",
+        "--refine-rounds",
+        "1",
+        "--allow-exact-mismatch",
+        "--grid",
+        "adaptive=false",
+        "--no-plots",
+        "--json",
+    ])
+}
+
 /// Starts `hpge-cv ARGS` in the repository root and kills it (SIGKILL) as soon as `written()`
 /// holds (a checkpoint file exists), asserting it does within 600 s and before the run ends.
 pub fn kill_when(args: &[&str], what: &str, written: impl Fn() -> bool) {
